@@ -1,0 +1,57 @@
+//! Scalar functions that work with and without the standard library.
+//!
+//! The per-sample path must build for `no_std` flight targets, where `f64::sqrt` and
+//! friends are unavailable; these wrappers use `libm` there and the standard library's
+//! intrinsics otherwise, so results are bit-identical to ordinary `std` code.
+
+#[cfg(feature = "std")]
+mod imp {
+    #[inline]
+    pub fn sqrt(x: f64) -> f64 {
+        x.sqrt()
+    }
+    #[inline]
+    pub fn sin(x: f64) -> f64 {
+        x.sin()
+    }
+    #[inline]
+    pub fn cos(x: f64) -> f64 {
+        x.cos()
+    }
+    #[inline]
+    pub fn atan2(y: f64, x: f64) -> f64 {
+        y.atan2(x)
+    }
+}
+
+#[cfg(not(feature = "std"))]
+mod imp {
+    #[inline]
+    pub fn sqrt(x: f64) -> f64 {
+        libm::sqrt(x)
+    }
+    #[inline]
+    pub fn sin(x: f64) -> f64 {
+        libm::sin(x)
+    }
+    #[inline]
+    pub fn cos(x: f64) -> f64 {
+        libm::cos(x)
+    }
+    #[inline]
+    pub fn atan2(y: f64, x: f64) -> f64 {
+        libm::atan2(y, x)
+    }
+}
+
+pub(crate) use imp::{atan2, cos, sin, sqrt};
+
+/// `|x|` without `std`.
+#[inline]
+pub(crate) fn abs(x: f64) -> f64 {
+    if x < 0.0 {
+        -x
+    } else {
+        x
+    }
+}

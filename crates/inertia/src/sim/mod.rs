@@ -1,0 +1,236 @@
+//! Gyrostat simulator with sensor models (paper §III eq. 26 and §VI).
+//!
+//! Integrates eq. 26 with quaternion kinematics by RK4 on `substeps` equal substeps of
+//! each sample period (see [`crate::dynamics::rk4_step`]), with
+//!
+//! * the rotor momentum rate `ρ̇` from a [`InputLaw`] of time and true state (a controller);
+//! * a known external torque `τ` from another [`InputLaw`] (reported in telemetry);
+//! * an **unknown** white disturbance torque of one-sided spectral density
+//!   `disturbance_nm_rthz` (N m/√Hz) per axis, held constant over each substep Δ with
+//!   variance `σ²/Δ`, so the momentum it imparts over a time T has standard deviation
+//!   `σ √T` per axis. It is not reported in telemetry.
+//!
+//! Sensors ([`sensors`]): an integrating gyro with white rate noise (deg/s/√Hz); the
+//! measured attitude is propagated from the noisy increments, so `φ_k` carries the gyro
+//! noise. Rotor momentum is sampled at the nodes without noise. Everything is seeded and
+//! reproducible: ChaCha8 streams, one for the disturbance and one for the gyro.
+
+pub mod control;
+pub mod scenario;
+pub mod sensors;
+
+use crate::attitude::Quaternion;
+use crate::dynamics::{rk4_step, GyrostatState};
+use crate::telemetry::Sample;
+use nalgebra::{Matrix3, Vector3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::Distribution;
+
+/// A vector-valued input (ρ̇ or τ, N m) as a function of time and true state.
+pub trait InputLaw: Sync {
+    /// Value at `t_s` in state `x`.
+    fn eval(&self, t_s: f64, x: &GyrostatState) -> Vector3<f64>;
+}
+
+impl<F: Fn(f64, &GyrostatState) -> Vector3<f64> + Sync> InputLaw for F {
+    fn eval(&self, t_s: f64, x: &GyrostatState) -> Vector3<f64> {
+        self(t_s, x)
+    }
+}
+
+/// No input.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Zero;
+
+impl InputLaw for Zero {
+    fn eval(&self, _t_s: f64, _x: &GyrostatState) -> Vector3<f64> {
+        Vector3::zeros()
+    }
+}
+
+/// Simulation settings. Every field is public and overridable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// True inertia, kg m².
+    pub inertia_kg_m2: Matrix3<f64>,
+    /// State at `t0_s`.
+    pub initial: GyrostatState,
+    /// Start time, s.
+    pub t0_s: f64,
+    /// Sample period h, s.
+    pub dt_s: f64,
+    /// Number of telemetry nodes (samples).
+    pub samples: usize,
+    /// RK4 substeps per sample period.
+    pub substeps: usize,
+    /// Unknown disturbance torque spectral density, N m/√Hz per axis.
+    pub disturbance_nm_rthz: f64,
+    /// Gyro rate noise spectral density, deg/s/√Hz per axis.
+    pub gyro_noise_deg_s_rthz: f64,
+    /// Seed of the noise streams.
+    pub seed: u64,
+}
+
+impl SimConfig {
+    /// Number of nodes for a duration: `round(duration/dt) + 1`.
+    #[must_use]
+    pub fn samples_for(duration_s: f64, dt_s: f64) -> usize {
+        (duration_s / dt_s).round() as usize + 1
+    }
+}
+
+/// The true state at a node (for tests and error figures).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TruthSample {
+    /// Time, s.
+    pub t_s: f64,
+    /// True state.
+    pub state: GyrostatState,
+}
+
+/// A simulated run: telemetry as the estimator sees it and the truth beside it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOutput {
+    /// Measured telemetry, one per node.
+    pub samples: Vec<Sample>,
+    /// True state, one per node.
+    pub truth: Vec<TruthSample>,
+    /// True inertia, kg m².
+    pub inertia_kg_m2: Matrix3<f64>,
+}
+
+/// Why a simulation could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A setting is out of its range.
+    #[error("simulation setting `{field}` = {value} is invalid: {why}")]
+    InvalidSetting {
+        /// The field name.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        why: &'static str,
+    },
+}
+
+impl SimConfig {
+    /// Check every setting.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let bad = |field, value, why| Err(SimError::InvalidSetting { field, value, why });
+        if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
+            return bad("dt_s", self.dt_s, "must be finite and > 0");
+        }
+        if self.samples < 3 {
+            return bad("samples", self.samples as f64, "must be at least 3");
+        }
+        if self.substeps == 0 {
+            return bad("substeps", 0.0, "must be at least 1");
+        }
+        if !(self.disturbance_nm_rthz.is_finite() && self.disturbance_nm_rthz >= 0.0) {
+            return bad(
+                "disturbance_nm_rthz",
+                self.disturbance_nm_rthz,
+                "must be finite and >= 0",
+            );
+        }
+        if !(self.gyro_noise_deg_s_rthz.is_finite() && self.gyro_noise_deg_s_rthz >= 0.0) {
+            return bad(
+                "gyro_noise_deg_s_rthz",
+                self.gyro_noise_deg_s_rthz,
+                "must be finite and >= 0",
+            );
+        }
+        if !self.t0_s.is_finite() {
+            return bad("t0_s", self.t0_s, "must be finite");
+        }
+        let j = &self.inertia_kg_m2;
+        let asym = (j - j.transpose()).norm();
+        if !j.iter().all(|v| v.is_finite()) || asym > 1e-12 * j.norm() {
+            return bad("inertia_kg_m2", asym, "must be finite and symmetric");
+        }
+        let min_eig = j.symmetric_eigenvalues().min();
+        if min_eig <= 0.0 {
+            return bad("inertia_kg_m2", min_eig, "must be positive definite");
+        }
+        if self.initial.q.normalize().is_none()
+            || !self.initial.omega_rad_s.iter().all(|v| v.is_finite())
+            || !self.initial.rho_nms.iter().all(|v| v.is_finite())
+        {
+            return bad(
+                "initial",
+                f64::NAN,
+                "must be finite with a non-zero quaternion",
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Run the simulator. `rho_dot` is the wheel control law, `known_torque` the external
+/// torque that is reported in telemetry.
+pub fn simulate(
+    cfg: &SimConfig,
+    rho_dot: &dyn InputLaw,
+    known_torque: &dyn InputLaw,
+) -> Result<SimOutput, SimError> {
+    cfg.validate()?;
+    let j = cfg.inertia_kg_m2;
+    let j_inv = j
+        .try_inverse()
+        .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+    let n = cfg.samples;
+    let h = cfg.dt_s;
+    let sub = cfg.substeps;
+    let dt = h / sub as f64;
+
+    let mut dist_rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    dist_rng.set_stream(0);
+    let dist = sensors::normal(cfg.disturbance_nm_rthz / dt.sqrt());
+    let mut gyro = sensors::IntegratingGyro::new(cfg.gyro_noise_deg_s_rthz, h, cfg.seed);
+
+    let mut x = cfg.initial;
+    x.q = x.q.normalize().unwrap_or(Quaternion::IDENTITY);
+    let mut q_meas = x.q;
+    let mut samples = Vec::with_capacity(n);
+    let mut truth = Vec::with_capacity(n);
+    // One extra interval past the last node so the last sample's rate is defined.
+    for k in 0..n {
+        let t_k = cfg.t0_s + k as f64 * h;
+        let x_k = x;
+        let tau_k = known_torque.eval(t_k, &x_k);
+        let mut angle = Vector3::zeros();
+        for s in 0..sub {
+            let t = t_k + s as f64 * dt;
+            let d = Vector3::from_fn(|_, _| dist.sample(&mut dist_rng));
+            let f =
+                |tt: f64, xx: &GyrostatState| (rho_dot.eval(tt, xx), known_torque.eval(tt, xx) + d);
+            let (next, da) = rk4_step(&j, &j_inv, t, dt, &x, &f);
+            x = next;
+            angle += da;
+        }
+        let increment = x_k.q.conjugate().mul(&x.q);
+        let (noisy_increment, rate) = gyro.measure(&increment, &angle);
+        samples.push(Sample {
+            t_s: t_k,
+            q: q_meas,
+            rho_nms: x_k.rho_nms,
+            tau_nm: tau_k,
+            omega_rad_s: rate,
+        });
+        truth.push(TruthSample {
+            t_s: t_k,
+            state: x_k,
+        });
+        q_meas = q_meas
+            .mul(&noisy_increment)
+            .normalize()
+            .unwrap_or(Quaternion::IDENTITY);
+    }
+    Ok(SimOutput {
+        samples,
+        truth,
+        inertia_kg_m2: j,
+    })
+}

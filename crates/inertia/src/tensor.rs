@@ -1,0 +1,90 @@
+//! The inertia tensor and its six-component vector `j` (paper eqs. 7–9 and 48).
+//!
+//! `j = [J11, J22, J33, J12, J13, J23]ᵀ` in body axes, kg m². The matrix is symmetric,
+//! `J = Σ m_i S(r_i)ᵀ S(r_i)` (eq. 7). A physically realisable J has a positive
+//! semidefinite second-moment matrix `Σ = ½ tr(J) I − J` (ERRATA §4), which implies both
+//! `J ⪰ 0` and the triangle inequalities on the principal moments; the paper's eq. 9 tests
+//! only the diagonal in body axes, which is necessary but not sufficient.
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3, Vector6};
+
+/// Six inertia components in the paper's order `[J11, J22, J33, J12, J13, J23]` (eq. 48).
+pub type InertiaVector = Vector6<f64>;
+
+/// Names of the six components in the order of eq. 48.
+pub const COMPONENT_NAMES: [&str; 6] = ["J11", "J22", "J33", "J12", "J13", "J23"];
+
+/// `(row, col)` of each component of `j` in `J`.
+pub const COMPONENT_INDEX: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+
+/// Symmetric 3×3 matrix from `j` (eq. 48).
+#[must_use]
+pub fn matrix_from_j(j: &InertiaVector) -> Matrix3<f64> {
+    Matrix3::new(j[0], j[3], j[4], j[3], j[1], j[5], j[4], j[5], j[2])
+}
+
+/// `j` from a matrix (the upper triangle is read; symmetry is the caller's business).
+#[must_use]
+pub fn j_from_matrix(m: &Matrix3<f64>) -> InertiaVector {
+    InertiaVector::new(
+        m[(0, 0)],
+        m[(1, 1)],
+        m[(2, 2)],
+        m[(0, 1)],
+        m[(0, 2)],
+        m[(1, 2)],
+    )
+}
+
+/// The second-moment matrix `Σ = ½ tr(J) I − J` (ERRATA §4).
+#[must_use]
+pub fn second_moment(j: &Matrix3<f64>) -> Matrix3<f64> {
+    Matrix3::identity() * (0.5 * j.trace()) - j
+}
+
+/// Principal moments (ascending) and the principal axes as columns of a rotation matrix
+/// from principal to body axes. Std only (uses an iterative eigen-solver).
+#[must_use]
+pub fn principal(j: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+    let e = SymmetricEigen::new(*j);
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
+    let vals = Vector3::new(
+        e.eigenvalues[idx[0]],
+        e.eigenvalues[idx[1]],
+        e.eigenvalues[idx[2]],
+    );
+    let mut axes = Matrix3::zeros();
+    for (c, &i) in idx.iter().enumerate() {
+        axes.set_column(c, &e.eigenvectors.column(i));
+    }
+    if axes.determinant() < 0.0 {
+        let c = -axes.column(2);
+        axes.set_column(2, &c);
+    }
+    (vals, axes)
+}
+
+/// Relative Frobenius error `‖Ĵ − J‖_F / ‖J‖_F` (the paper's "normalized inertia error").
+#[must_use]
+pub fn relative_frobenius_error(estimate: &Matrix3<f64>, truth: &Matrix3<f64>) -> f64 {
+    (estimate - truth).norm() / truth.norm()
+}
+
+/// The true inertia of the paper's section VI examples, kg m².
+#[must_use]
+pub fn paper_j_true() -> Matrix3<f64> {
+    Matrix3::new(
+        1.0035, 0.0368, -0.0678, //
+        0.0368, 2.0047, -0.0755, //
+        -0.0678, -0.0755, 2.9918,
+    )
+}
+
+/// The paper's diagonal triangle inequalities (eq. 9): the three slacks
+/// `[J11 + J22 − J33, J11 + J33 − J22, J22 + J33 − J11]`, each ≥ 0 when satisfied.
+#[must_use]
+pub fn diagonal_triangle_slacks(j: &Matrix3<f64>) -> [f64; 3] {
+    let (a, b, c) = (j[(0, 0)], j[(1, 1)], j[(2, 2)]);
+    [a + b - c, a + c - b, b + c - a]
+}

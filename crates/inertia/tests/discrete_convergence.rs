@@ -1,0 +1,239 @@
+//! The discrete variational rows on exact trajectories (paper eqs. 46–54, ERRATA §1–2).
+//!
+//! For a trajectory integrated far more accurately than the effects measured, the
+//! residual `max_k ‖H_k j_true − y_k‖` must fall as h⁴. Four input cases: torque-free with
+//! constant ρ, time-varying ρ, a known external torque, and both. The torque sign printed
+//! in the paper (− h²/2 τ) gives order 2 instead, and the node value ρ(t_k) in place of
+//! the trapezoid interval value gives order 3.
+
+use inertia::attitude::Quaternion;
+use inertia::discrete::{Row, RowInput};
+use inertia::dynamics::GyrostatState;
+use inertia::sim::{simulate, InputLaw, SimConfig, Zero};
+use inertia::telemetry::Sample;
+use inertia::tensor::{j_from_matrix, paper_j_true};
+use nalgebra::Vector3;
+
+const DURATION_S: f64 = 8.0;
+const STEPS: [f64; 5] = [0.2, 0.1, 0.05, 0.025, 0.0125];
+
+fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+    Vector3::new(
+        0.05 * (0.7 * t).sin(),
+        0.03 * (1.1 * t).cos(),
+        -0.04 * (0.5 * t + 1.0).sin(),
+    )
+}
+
+fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+    Vector3::new(
+        0.02 * (0.9 * t).cos(),
+        -0.015 * (1.3 * t).sin(),
+        0.01 * (0.4 * t).sin() + 0.005,
+    )
+}
+
+fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
+    let cfg = SimConfig {
+        inertia_kg_m2: paper_j_true(),
+        initial: GyrostatState {
+            q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
+            omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
+            rho_nms: Vector3::new(0.1, -0.2, 0.3),
+        },
+        t0_s: 0.0,
+        dt_s: h,
+        samples: SimConfig::samples_for(DURATION_S, h),
+        substeps: 64,
+        disturbance_nm_rthz: 0.0,
+        gyro_noise_deg_s_rthz: 0.0,
+        seed: 0,
+    };
+    simulate(&cfg, rho, tau).expect("valid config").samples
+}
+
+/// Which variant of the row to evaluate.
+#[derive(Clone, Copy)]
+enum Variant {
+    /// As implemented (ERRATA-corrected).
+    Corrected,
+    /// With the paper's printed torque sign: y − h² τ_{k+1}.
+    PrintedTorqueSign,
+    /// With node values ρ(t_k), ρ(t_{k+1}) in place of interval values.
+    NodeRho,
+}
+
+fn max_residual(samples: &[Sample], variant: Variant) -> f64 {
+    let j = j_from_matrix(&paper_j_true());
+    samples
+        .windows(3)
+        .map(|w| {
+            let mut input = RowInput::from_samples([&w[0], &w[1], &w[2]]).expect("row input");
+            if let Variant::NodeRho = variant {
+                input.rho_k_nms = w[0].rho_nms;
+                input.rho_k1_nms = w[1].rho_nms;
+            }
+            let Row { h, mut y } = input.row().expect("row");
+            if let Variant::PrintedTorqueSign = variant {
+                y -= input.h_s * input.h_s * w[1].tau_nm;
+            }
+            (h * j - y).norm()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Least-squares slope of log(residual) against log(h).
+fn order(rho: &dyn InputLaw, tau: &dyn InputLaw, variant: Variant) -> f64 {
+    let pts: Vec<(f64, f64)> = STEPS
+        .iter()
+        .map(|&h| {
+            let r = max_residual(&exact_samples(h, rho, tau), variant);
+            (h.ln(), r.ln())
+        })
+        .collect();
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+fn assert_order(got: f64, lo: f64, hi: f64, what: &str) {
+    assert!(
+        (lo..=hi).contains(&got),
+        "{what}: fitted order {got:.3} not in [{lo}, {hi}]"
+    );
+}
+
+#[test]
+fn torque_free_constant_rho_is_fourth_order() {
+    assert_order(
+        order(&Zero, &Zero, Variant::Corrected),
+        3.8,
+        4.2,
+        "torque-free",
+    );
+}
+
+#[test]
+fn time_varying_rho_is_fourth_order() {
+    assert_order(
+        order(&rho_dot, &Zero, Variant::Corrected),
+        3.8,
+        4.2,
+        "varying rho",
+    );
+}
+
+#[test]
+fn known_torque_is_fourth_order() {
+    assert_order(
+        order(&Zero, &torque, Variant::Corrected),
+        3.8,
+        4.2,
+        "torque",
+    );
+}
+
+#[test]
+fn varying_rho_and_torque_is_fourth_order() {
+    assert_order(
+        order(&rho_dot, &torque, Variant::Corrected),
+        3.8,
+        4.2,
+        "rho and torque",
+    );
+}
+
+/// ERRATA §1: the paper's printed `− h²/2 τ_{k+1}` in eq. 54 is a sign error; with it
+/// the residual is the whole torque term, O(h²).
+#[test]
+fn printed_torque_sign_is_second_order() {
+    assert_order(
+        order(&Zero, &torque, Variant::PrintedTorqueSign),
+        1.8,
+        2.2,
+        "printed sign",
+    );
+}
+
+/// ERRATA §2: ρ_k is the interval value; node values degrade the order to 3.
+#[test]
+fn node_rho_is_third_order() {
+    assert_order(
+        order(&rho_dot, &Zero, Variant::NodeRho),
+        2.8,
+        3.2,
+        "node rho",
+    );
+}
+
+mod errors {
+    use super::*;
+    use inertia::discrete::RowError;
+
+    fn sample(t: f64, q: Quaternion) -> Sample {
+        Sample {
+            t_s: t,
+            q,
+            rho_nms: Vector3::zeros(),
+            tau_nm: Vector3::zeros(),
+            omega_rad_s: Vector3::zeros(),
+        }
+    }
+
+    #[test]
+    fn step_of_180_degrees_is_an_error_not_nan() {
+        let q0 = Quaternion::IDENTITY;
+        let q1 = Quaternion::exp(&Vector3::new(std::f64::consts::PI, 0.0, 0.0));
+        let q2 = q1.mul(&Quaternion::exp(&Vector3::new(0.1, 0.0, 0.0)));
+        let input =
+            RowInput::from_samples([&sample(0.0, q0), &sample(0.1, q1), &sample(0.2, q2)]).unwrap();
+        match input.row() {
+            Err(RowError::StepTooLarge {
+                interval: 0,
+                phi_norm,
+                angle_deg,
+            }) => {
+                assert!(phi_norm > 0.999 && (angle_deg - 180.0).abs() < 0.1);
+            }
+            other => panic!("expected StepTooLarge, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn non_unit_quaternion_is_an_error() {
+        let q = Quaternion::IDENTITY;
+        let bad = Quaternion::new(Vector3::new(0.0, 0.0, 0.01), 1.0);
+        let r = RowInput::from_samples([&sample(0.0, q), &sample(0.1, q), &sample(0.2, bad)]);
+        assert!(
+            matches!(r, Err(RowError::NonUnitQuaternion { node: 2, .. })),
+            "{r:?}"
+        );
+        let nan = Quaternion::new(Vector3::new(f64::NAN, 0.0, 0.0), 1.0);
+        let r = RowInput::from_samples([&sample(0.0, nan), &sample(0.1, q), &sample(0.2, q)]);
+        assert!(
+            matches!(r, Err(RowError::NonUnitQuaternion { node: 0, .. })),
+            "{r:?}"
+        );
+    }
+
+    #[test]
+    fn non_finite_inputs_and_uneven_steps_are_errors() {
+        let q = Quaternion::IDENTITY;
+        let mut s2 = sample(0.2, q);
+        s2.rho_nms.x = f64::INFINITY;
+        let input = RowInput::from_samples([&sample(0.0, q), &sample(0.1, q), &s2]).unwrap();
+        assert!(matches!(
+            input.row(),
+            Err(RowError::NonFinite {
+                what: "rotor momentum"
+            })
+        ));
+        let r = RowInput::from_samples([&sample(0.0, q), &sample(0.1, q), &sample(0.25, q)]);
+        assert!(matches!(r, Err(RowError::NonUniformStep { .. })), "{r:?}");
+        let r = RowInput::from_samples([&sample(0.0, q), &sample(0.0, q), &sample(0.1, q)]);
+        assert!(r.is_err());
+    }
+}
