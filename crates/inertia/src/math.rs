@@ -22,6 +22,10 @@ mod imp {
     pub fn atan2(y: f64, x: f64) -> f64 {
         y.atan2(x)
     }
+    #[inline]
+    pub fn ln(x: f64) -> f64 {
+        x.ln()
+    }
 }
 
 #[cfg(not(feature = "std"))]
@@ -42,9 +46,13 @@ mod imp {
     pub fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
     }
+    #[inline]
+    pub fn ln(x: f64) -> f64 {
+        libm::log(x)
+    }
 }
 
-pub(crate) use imp::{atan2, cos, sin, sqrt};
+pub(crate) use imp::{atan2, cos, ln, sin, sqrt};
 
 /// `|x|` without `std`.
 #[inline]

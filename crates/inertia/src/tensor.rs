@@ -88,3 +88,20 @@ pub fn diagonal_triangle_slacks(j: &Matrix3<f64>) -> [f64; 3] {
     let (a, b, c) = (j[(0, 0)], j[(1, 1)], j[(2, 2)]);
     [a + b - c, a + c - b, b + c - a]
 }
+
+/// Normalised error of each element, in the order of eq. 48: moments relative to their
+/// own true value, `(Ĵ_ii − J_ii)/J_ii`; products relative to the geometric mean of the
+/// two moments they couple, `(Ĵ_ij − J_ij)/√(J_ii J_jj)`. (A product's error relative to
+/// its own value is meaningless when the product is near zero.)
+#[must_use]
+pub fn normalized_element_errors(estimate: &Matrix3<f64>, truth: &Matrix3<f64>) -> [f64; 6] {
+    core::array::from_fn(|k| {
+        let (r, c) = COMPONENT_INDEX[k];
+        let scale = if r == c {
+            truth[(r, r)]
+        } else {
+            crate::math::sqrt(truth[(r, r)] * truth[(c, c)])
+        };
+        (estimate[(r, c)] - truth[(r, c)]) / scale
+    })
+}

@@ -1,0 +1,458 @@
+//! The feasible set of the estimator: paper eqs. 9, 55, 57, ERRATA §4, and a-priori bounds.
+//!
+//! ```text
+//! J(j) − ε I ⪰ 0                                  (eq. 57, first LMI)
+//! Σ(j) = ½ tr(J) I − J ⪰ 0                        (Consistency::Physical, the default)
+//!   or J11 + J22 ≥ J33, J11 + J33 ≥ J22, J22 + J33 ≥ J11   (Consistency::PaperTriangle, eq. 9)
+//! l_i ≤ j_i ≤ u_i                                  (a-priori bounds, any element)
+//! ```
+//!
+//! `Σ ⪰ 0` says the body's second-moment matrix is positive semidefinite. It is the exact
+//! condition for a J to be realisable by a mass distribution, and it implies the triangle
+//! inequalities on the principal moments (eq. 9 holds in *every* frame) and J ⪰ 0. The
+//! paper's eq. 9 constrains only the diagonal in body axes, which is necessary, not
+//! sufficient: ERRATA §4 gives a positive definite J that passes it and is not physical.
+//!
+//! A [`ConstraintSet`] is built by the user and turned into [`Constraints`] by
+//! [`ConstraintSet::validate`], before any data is read. Validation rejects non-finite or
+//! crossed bounds, and finds a strictly interior point (a phase-I problem: maximise the
+//! smallest constraint margin). If none exists, the bounds contradict the physical
+//! constraints and validation fails with the best margin achievable. The interior point
+//! also starts every interior-point solve.
+
+use crate::solver::barrier::{self, BarrierSettings, Lin, Lmi, Problem, MAX_LIN};
+use crate::tensor::{InertiaVector, COMPONENT_INDEX, COMPONENT_NAMES};
+use nalgebra::{Matrix3, SMatrix, SVector};
+
+/// Default ε of `J ⪰ εI`, kg m². Above the solvers' tolerances after scaling.
+pub const DEFAULT_EPSILON_KG_M2: f64 = 1e-6;
+
+/// Which physical-consistency condition to impose besides `J ⪰ εI`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Consistency {
+    /// `Σ = ½ tr(J) I − J ⪰ 0` (ERRATA §4). The default.
+    #[default]
+    Physical,
+    /// The paper's diagonal triangle inequalities (eq. 9), to reproduce the paper exactly.
+    PaperTriangle,
+    /// Only `J ⪰ εI`.
+    PositiveDefiniteOnly,
+}
+
+/// A user's constraint set. Build, then [`validate`](ConstraintSet::validate).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstraintSet {
+    /// ε of `J ⪰ εI`, kg m² (default [`DEFAULT_EPSILON_KG_M2`]).
+    pub epsilon_kg_m2: f64,
+    /// Consistency condition (default [`Consistency::Physical`]).
+    pub consistency: Consistency,
+    /// Lower bounds per component of `j` (order of eq. 48), kg m².
+    pub lower_kg_m2: [Option<f64>; 6],
+    /// Upper bounds per component of `j`, kg m².
+    pub upper_kg_m2: [Option<f64>; 6],
+}
+
+impl Default for ConstraintSet {
+    fn default() -> Self {
+        Self::physical()
+    }
+}
+
+/// Why a constraint set is unusable.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum ConstraintError {
+    /// A bound or ε is NaN or infinite.
+    #[error("{what} is not finite ({value})")]
+    NonFinite {
+        /// Which value.
+        what: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// ε must be positive.
+    #[error("epsilon must be > 0 kg m², got {0}")]
+    NonPositiveEpsilon(f64),
+    /// A lower bound above its upper bound.
+    #[error("bounds on {component} contradict each other: lower {lower} > upper {upper} kg m²")]
+    CrossedBounds {
+        /// Component name (J11 … J23).
+        component: &'static str,
+        /// Lower bound.
+        lower: f64,
+        /// Upper bound.
+        upper: f64,
+    },
+    /// No J satisfies every constraint strictly.
+    #[error("the bounds contradict J ⪰ εI and the {consistency} condition: no inertia satisfies all of them (best achievable margin {margin:.3e} kg m²)")]
+    Infeasible {
+        /// Name of the consistency condition.
+        consistency: &'static str,
+        /// The largest smallest-margin found (≤ 0).
+        margin: f64,
+    },
+}
+
+/// A component of `j` by name.
+#[must_use]
+pub fn component_by_name(name: &str) -> Option<usize> {
+    COMPONENT_NAMES
+        .iter()
+        .position(|n| n.eq_ignore_ascii_case(name))
+        .or_else(|| {
+            // J21 = J12 and so on.
+            let b = name.as_bytes();
+            if b.len() == 3 && (b[0] == b'J' || b[0] == b'j') {
+                let (r, c) = (b[1].wrapping_sub(b'1'), b[2].wrapping_sub(b'1'));
+                COMPONENT_INDEX
+                    .iter()
+                    .position(|&(i, k)| (i, k) == (c as usize, r as usize))
+            } else {
+                None
+            }
+        })
+}
+
+impl ConstraintSet {
+    /// `J ⪰ εI` and `Σ ⪰ 0`: the default.
+    #[must_use]
+    pub fn physical() -> Self {
+        Self {
+            epsilon_kg_m2: DEFAULT_EPSILON_KG_M2,
+            consistency: Consistency::Physical,
+            lower_kg_m2: [None; 6],
+            upper_kg_m2: [None; 6],
+        }
+    }
+
+    /// The paper's set (eq. 57): `J ⪰ εI` and the diagonal triangle inequalities.
+    #[must_use]
+    pub fn paper() -> Self {
+        Self {
+            consistency: Consistency::PaperTriangle,
+            ..Self::physical()
+        }
+    }
+
+    /// Only `J ⪰ εI`.
+    #[must_use]
+    pub fn positive_definite() -> Self {
+        Self {
+            consistency: Consistency::PositiveDefiniteOnly,
+            ..Self::physical()
+        }
+    }
+
+    /// Add `lower ≤ j[component] ≤ upper` (either side optional), intersecting with any
+    /// bound already present.
+    #[must_use]
+    pub fn with_bounds(mut self, component: usize, lower: Option<f64>, upper: Option<f64>) -> Self {
+        let c = component.min(5);
+        if let Some(l) = lower {
+            self.lower_kg_m2[c] = Some(self.lower_kg_m2[c].map_or(l, |o| o.max(l)));
+        }
+        if let Some(u) = upper {
+            self.upper_kg_m2[c] = Some(self.upper_kg_m2[c].map_or(u, |o| o.min(u)));
+        }
+        self
+    }
+
+    /// Add `|j[component] − nominal| ≤ fraction · |nominal|` (the paper's spin case bounds
+    /// J33 within 10 % of 3 kg m²: `with_nominal(2, 3.0, 0.10)`).
+    #[must_use]
+    pub fn with_nominal(self, component: usize, nominal: f64, fraction: f64) -> Self {
+        let w = (fraction * nominal).abs();
+        self.with_bounds(component, Some(nominal - w), Some(nominal + w))
+    }
+
+    /// `true` when any element bound is set (a prior that can fix the scale of J).
+    #[must_use]
+    pub fn has_bounds(&self) -> bool {
+        self.lower_kg_m2
+            .iter()
+            .chain(&self.upper_kg_m2)
+            .any(Option::is_some)
+    }
+
+    /// Check the set and find a strictly interior point.
+    pub fn validate(&self) -> Result<Constraints, ConstraintError> {
+        let eps = self.epsilon_kg_m2;
+        if !eps.is_finite() {
+            return Err(ConstraintError::NonFinite {
+                what: "epsilon",
+                value: eps,
+            });
+        }
+        if eps <= 0.0 {
+            return Err(ConstraintError::NonPositiveEpsilon(eps));
+        }
+        for (name, (lower, upper)) in COMPONENT_NAMES
+            .iter()
+            .zip(self.lower_kg_m2.iter().zip(&self.upper_kg_m2))
+        {
+            for (b, what) in [(lower, "a lower bound"), (upper, "an upper bound")] {
+                if let Some(v) = b {
+                    if !v.is_finite() {
+                        return Err(ConstraintError::NonFinite { what, value: *v });
+                    }
+                }
+            }
+            if let (Some(l), Some(u)) = (lower, upper) {
+                if l > u {
+                    return Err(ConstraintError::CrossedBounds {
+                        component: name,
+                        lower: *l,
+                        upper: *u,
+                    });
+                }
+            }
+        }
+        let mut c = Constraints {
+            set: *self,
+            lmis: [Lmi::zero(); 2],
+            n_lmi: 0,
+            lins: [Lin::zero(); MAX_LIN],
+            n_lin: 0,
+            interior: InertiaVector::zeros(),
+        };
+        // J − εI ⪰ 0.
+        c.push_lmi(Lmi {
+            f0: -Matrix3::identity() * eps,
+            fk: basis(),
+        });
+        match self.consistency {
+            Consistency::Physical => {
+                let mut fk = basis();
+                for (k, f) in fk.iter_mut().enumerate() {
+                    let tr = if k < 3 { 1.0 } else { 0.0 };
+                    *f = Matrix3::identity() * (0.5 * tr) - *f;
+                }
+                c.push_lmi(Lmi {
+                    f0: Matrix3::zeros(),
+                    fk,
+                });
+            }
+            Consistency::PaperTriangle => {
+                for (p, q, r) in [(0, 1, 2), (0, 2, 1), (1, 2, 0)] {
+                    let mut a = InertiaVector::zeros();
+                    a[p] = 1.0;
+                    a[q] = 1.0;
+                    a[r] = -1.0;
+                    c.push_lin(Lin { a, b: 0.0 });
+                }
+            }
+            Consistency::PositiveDefiniteOnly => {}
+        }
+        for i in 0..6 {
+            if let Some(l) = self.lower_kg_m2[i] {
+                c.push_lin(Lin {
+                    a: InertiaVector::ith(i, 1.0),
+                    b: l,
+                });
+            }
+            if let Some(u) = self.upper_kg_m2[i] {
+                c.push_lin(Lin {
+                    a: InertiaVector::ith(i, -1.0),
+                    b: -u,
+                });
+            }
+        }
+        let (interior, margin) = c.phase_one();
+        if margin <= 0.0 || !margin.is_finite() {
+            return Err(ConstraintError::Infeasible {
+                consistency: self.consistency_name(),
+                margin,
+            });
+        }
+        c.interior = interior;
+        Ok(c)
+    }
+
+    fn consistency_name(&self) -> &'static str {
+        match self.consistency {
+            Consistency::Physical => "physical-consistency (Σ = ½ tr(J) I − J ⪰ 0)",
+            Consistency::PaperTriangle => "diagonal triangle (eq. 9)",
+            Consistency::PositiveDefiniteOnly => "positive-definiteness",
+        }
+    }
+}
+
+/// `F_k = ∂J/∂j_k`: the symmetric basis matrices of eq. 48.
+fn basis() -> [Matrix3<f64>; 6] {
+    let mut fk = [Matrix3::zeros(); 6];
+    for (k, &(r, c)) in COMPONENT_INDEX.iter().enumerate() {
+        fk[k][(r, c)] = 1.0;
+        fk[k][(c, r)] = 1.0;
+    }
+    fk
+}
+
+/// A validated constraint set in the form the solvers use: up to two 3×3 LMIs
+/// `F0 + Σ j_k F_k ⪰ 0` and up to [`MAX_LIN`] linear inequalities `aᵀ j ≥ b`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constraints {
+    set: ConstraintSet,
+    lmis: [Lmi<6>; 2],
+    n_lmi: usize,
+    lins: [Lin<6>; MAX_LIN],
+    n_lin: usize,
+    interior: InertiaVector,
+}
+
+impl Constraints {
+    fn push_lmi(&mut self, l: Lmi<6>) {
+        self.lmis[self.n_lmi] = l;
+        self.n_lmi += 1;
+    }
+
+    fn push_lin(&mut self, l: Lin<6>) {
+        self.lins[self.n_lin] = l;
+        self.n_lin += 1;
+    }
+
+    /// The set this was validated from.
+    #[must_use]
+    pub fn set(&self) -> &ConstraintSet {
+        &self.set
+    }
+
+    /// The LMIs `F0 + Σ j_k F_k ⪰ 0`.
+    #[must_use]
+    pub fn lmis(&self) -> &[Lmi<6>] {
+        &self.lmis[..self.n_lmi]
+    }
+
+    /// The linear inequalities `aᵀ j ≥ b`.
+    #[must_use]
+    pub fn lins(&self) -> &[Lin<6>] {
+        &self.lins[..self.n_lin]
+    }
+
+    /// A strictly interior point (found at validation).
+    #[must_use]
+    pub fn interior(&self) -> &InertiaVector {
+        &self.interior
+    }
+
+    /// Total barrier degree `m` (3 per LMI, 1 per linear inequality).
+    #[must_use]
+    pub fn degree(&self) -> usize {
+        3 * self.n_lmi + self.n_lin
+    }
+
+    /// Smallest margin of `j`: the least eigenvalue of every LMI and the least linear slack
+    /// (kg m²). Positive means strictly feasible. Std only (eigen-decomposition).
+    #[must_use]
+    pub fn margin(&self, j: &InertiaVector) -> f64 {
+        let mut m = f64::INFINITY;
+        for l in self.lmis() {
+            m = m.min(l.eval(j).symmetric_eigenvalues().min());
+        }
+        for l in self.lins() {
+            m = m.min(l.eval(j));
+        }
+        m
+    }
+
+    /// `true` when `j` satisfies every constraint strictly (Cholesky test, no eigenvalues).
+    #[must_use]
+    pub fn strictly_feasible(&self, j: &InertiaVector) -> bool {
+        self.lmis().iter().all(|l| l.eval(j).cholesky().is_some())
+            && self.lins().iter().all(|l| l.eval(j) > 0.0)
+    }
+
+    /// Phase I: maximise `s` over `(j, s)` subject to `F_i(j) ⪰ s I`, `aᵀj − b ≥ s`,
+    /// `s ≤ 1` and a wide box on `j`. Returns the point and its margin `s`.
+    fn phase_one(&self) -> (InertiaVector, f64) {
+        // Start: J = c I with c above every lower bound, off-diagonals mid-bounds. The start
+        // need not be feasible: the initial s is set below its smallest margin.
+        let scale = self
+            .set
+            .lower_kg_m2
+            .iter()
+            .chain(&self.set.upper_kg_m2)
+            .flatten()
+            .fold(1.0f64, |a, &b| a.max(b.abs()));
+        let mut j0 = InertiaVector::zeros();
+        for i in 0..6 {
+            let (l, u) = (self.set.lower_kg_m2[i], self.set.upper_kg_m2[i]);
+            j0[i] = match (l, u) {
+                (Some(l), Some(u)) => 0.5 * (l + u),
+                (Some(l), None) => l.max(0.0) + scale,
+                (None, Some(u)) => u.min(if i < 3 { 2.0 * scale } else { 0.0 }),
+                (None, None) => {
+                    if i < 3 {
+                        2.0 * scale
+                    } else {
+                        0.0
+                    }
+                }
+            };
+        }
+        // A box of natural size, so the phase-I centre is a sensible inertia.
+        let bound = 10.0 * scale;
+        let mut lmis = [Lmi::<7>::zero(); 2];
+        for (dst, src) in lmis.iter_mut().zip(self.lmis()) {
+            dst.f0 = src.f0;
+            dst.fk[..6].copy_from_slice(&src.fk);
+            dst.fk[6] = -Matrix3::identity();
+        }
+        let mut lins = [Lin::<7>::zero(); MAX_LIN + 13];
+        let mut n = 0;
+        for l in self.lins() {
+            lins[n] = Lin {
+                a: SVector::<f64, 7>::from_fn(|i, _| if i < 6 { l.a[i] } else { -1.0 }),
+                b: l.b,
+            };
+            n += 1;
+        }
+        // s ≤ 1 and |j_k| ≤ bound.
+        lins[n] = Lin {
+            a: SVector::<f64, 7>::ith(6, -1.0),
+            b: -1.0,
+        };
+        n += 1;
+        for k in 0..6 {
+            for sign in [1.0, -1.0] {
+                lins[n] = Lin {
+                    a: SVector::<f64, 7>::ith(k, sign),
+                    b: -bound,
+                };
+                n += 1;
+            }
+        }
+        // Initial s strictly below every margin of j0.
+        let mut s0 = 0.0f64;
+        let mut m0 = f64::INFINITY;
+        for l in self.lmis() {
+            m0 = m0.min(l.eval(&j0).symmetric_eigenvalues().min());
+        }
+        for l in self.lins() {
+            m0 = m0.min(l.eval(&j0));
+        }
+        if m0.is_finite() {
+            s0 = m0.min(1.0) - 1.0 - 0.1 * m0.abs();
+        }
+        let x0 = SVector::<f64, 7>::from_fn(|i, _| if i < 6 { j0[i] } else { s0 });
+        let mut c = SVector::<f64, 7>::zeros();
+        c[6] = -1.0;
+        let problem = Problem {
+            a: SMatrix::<f64, 7, 7>::zeros(),
+            b: SVector::<f64, 7>::zeros(),
+            c,
+            lmis: &lmis[..self.n_lmi],
+            lins: &lins[..n],
+        };
+        let settings = BarrierSettings {
+            gap_tolerance: 1e-9,
+            ..BarrierSettings::default()
+        };
+        match barrier::solve(&problem, &x0, &settings) {
+            Ok(out) => {
+                let x = out.x;
+                let j = InertiaVector::from_fn(|i, _| x[i]);
+                (j, self.margin(&j))
+            }
+            Err(_) => (j0, m0.min(0.0)),
+        }
+    }
+}

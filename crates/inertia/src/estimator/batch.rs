@@ -1,0 +1,83 @@
+//! The batch estimator of eq. 57: stack every row, one Householder QR, one solve.
+//!
+//! Deliberately a different code path from the recursive Givens update (nalgebra's dense
+//! QR of the full `3N × 6` matrix), so that the two can be checked against each other.
+
+use super::observability::{assess, ObservabilitySettings};
+use super::qr::RecursiveQr;
+use super::rows::RowSource;
+use super::{Estimate, EstimatorError, MIN_SAMPLES};
+use crate::constraints::Constraints;
+use crate::solver::{solve, Backend};
+use crate::telemetry::Sample;
+use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
+
+/// The stacked system reduced to `(R, z, ρ²)` by a dense QR.
+pub fn reduce<S: RowSource>(
+    samples: &[Sample],
+    mut source: S,
+) -> Result<RecursiveQr, EstimatorError> {
+    if samples.len() < MIN_SAMPLES {
+        return Err(EstimatorError::TooFewSamples {
+            need: MIN_SAMPLES,
+            got: samples.len(),
+        });
+    }
+    let mut h = Vec::with_capacity(samples.len() * 18);
+    let mut y = Vec::with_capacity(samples.len() * 3);
+    for (i, s) in samples.iter().enumerate() {
+        if let Some(row) = source.push(s) {
+            let row = row.map_err(|source| EstimatorError::Row { sample: i, source })?;
+            for r in 0..3 {
+                h.extend(row.h.row(r).iter());
+                y.push(row.y[r]);
+            }
+        }
+    }
+    let m = y.len();
+    let hm = DMatrix::from_row_slice(m, 6, &h);
+    let yv = DVector::from_vec(y);
+    let y_energy = yv.norm_squared();
+    let qr = hm.qr();
+    let (q, r) = (qr.q(), qr.r());
+    let mut rr = Matrix6::from_fn(|i, k| r[(i, k)]);
+    let mut z: Vector6<f64> = Vector6::from_iterator((q.transpose() * &yv).iter().copied());
+    for i in 0..6 {
+        if rr[(i, i)] < 0.0 {
+            for k in 0..6 {
+                rr[(i, k)] = -rr[(i, k)];
+            }
+            z[i] = -z[i];
+        }
+    }
+    Ok(RecursiveQr {
+        r: rr,
+        z,
+        rss: (y_energy - z.norm_squared()).max(0.0),
+        y_energy,
+        rows: m,
+    })
+}
+
+/// Estimate J from all samples at once.
+pub fn estimate<S: RowSource>(
+    samples: &[Sample],
+    source: S,
+    constraints: &Constraints,
+    backend: &mut dyn Backend,
+    observability: &ObservabilitySettings,
+) -> Result<Estimate, EstimatorError> {
+    let qr = reduce(samples, source)?;
+    let observability = assess(&qr, constraints.set().has_bounds(), observability);
+    let solution = if observability.has_answer() {
+        Some(solve(backend, &qr.r, &qr.z, constraints, None)?)
+    } else {
+        None
+    };
+    Ok(Estimate {
+        t_s: samples.last().map_or(0.0, |s| s.t_s),
+        rows: qr.rows,
+        observability,
+        solution,
+    })
+}

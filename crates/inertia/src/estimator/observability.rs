@@ -1,0 +1,231 @@
+//! Can the data determine J? (paper §IV, last paragraph; ERRATA §5)
+//!
+//! `J` is determined only if `φ_k` changes in time (else `H_k = 0`) and some rotor momentum
+//! or known torque excites the rows (else `y ≡ 0` and J is fixed only up to scale). The
+//! test here looks at the singular values `σ_1 ≥ … ≥ σ_6` of `R` and at `Σ‖y_k‖²`:
+//!
+//! * `y ≡ 0` → [`Unobservable::NoExcitation`];
+//! * `σ_6 = 0` or fewer than six rows → [`Unobservable::RankDeficient`];
+//! * `σ_1/σ_6` above the threshold ([`DEFAULT_CONDITION_THRESHOLD`]) →
+//!   [`Unobservable::IllConditioned`];
+//! * the least-squares standard deviation of `j`, `‖σ_j‖/‖ĵ‖` with
+//!   `Cov(ĵ) = s² (RᵀR)⁻¹`, `s² = ρ²/(rows − 6)`, above [`DEFAULT_MAX_RELATIVE_SIGMA`] →
+//!   [`Unobservable::Uncertain`]. This catches rows made of sensor noise only (a
+//!   spacecraft at rest): random rows are well conditioned, but explain nothing, and
+//!   `R⁻¹ z` is then noise of arbitrary size.
+//!
+//! When the data fall short by at most one direction (one small singular value, or only
+//! the scale missing because `y ≡ 0`) and the constraint set has a-priori element
+//! bounds, the bounds can pin that direction: the estimate is reported as
+//! [`Observability::FromPrior`], an answer that leans on the prior. Otherwise the estimate
+//! is [`Observability::NotObservable`] and no answer is given.
+
+use super::qr::RecursiveQr;
+
+/// Default largest acceptable condition number `σ_1/σ_6` of `R`. Past it, noise in the
+/// weakest direction is amplified a million-fold relative to the strongest.
+pub const DEFAULT_CONDITION_THRESHOLD: f64 = 1e6;
+
+/// Default largest acceptable relative standard deviation `‖σ_j‖/‖ĵ‖` of the
+/// unconstrained estimate.
+pub const DEFAULT_MAX_RELATIVE_SIGMA: f64 = 0.1;
+
+/// Residual degrees of freedom needed before a variance estimate is trusted: with fewer,
+/// `s²` (and so every σ) is itself too uncertain to gate on.
+pub const MIN_RESIDUAL_DOF: usize = 6;
+
+/// Thresholds of the observability test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObservabilitySettings {
+    /// Largest acceptable `σ_1/σ_6` (default [`DEFAULT_CONDITION_THRESHOLD`]).
+    pub condition_threshold: f64,
+    /// Largest acceptable `‖σ_j‖/‖ĵ‖` (default [`DEFAULT_MAX_RELATIVE_SIGMA`]).
+    pub max_relative_sigma: f64,
+}
+
+impl Default for ObservabilitySettings {
+    fn default() -> Self {
+        Self {
+            condition_threshold: DEFAULT_CONDITION_THRESHOLD,
+            max_relative_sigma: DEFAULT_MAX_RELATIVE_SIGMA,
+        }
+    }
+}
+
+/// Why the data alone cannot determine J.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Unobservable {
+    /// No rotor momentum and no known torque: `y ≡ 0`, J fixed only up to scale.
+    NoExcitation,
+    /// Fewer than six independent rows (e.g. no motion, or a pure spin about a principal
+    /// axis).
+    RankDeficient {
+        /// Numerical rank of `R`.
+        rank: usize,
+    },
+    /// The rows explain too little: the estimate is mostly noise.
+    Uncertain {
+        /// `‖σ_j‖/‖ĵ‖` of the unconstrained estimate.
+        relative_sigma: f64,
+        /// The threshold it exceeds.
+        threshold: f64,
+    },
+    /// The weakest direction of `j` is too poorly determined.
+    IllConditioned {
+        /// `σ_1/σ_6`.
+        condition: f64,
+        /// The threshold it exceeds.
+        threshold: f64,
+    },
+}
+
+impl core::fmt::Display for Unobservable {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Unobservable::NoExcitation => write!(
+                f,
+                "no rotor momentum or known torque has excited the motion (y = 0): the data fix J only up to scale"
+            ),
+            Unobservable::RankDeficient { rank } => write!(
+                f,
+                "the rows have rank {rank} < 6: the attitude motion does not excite every inertia component"
+            ),
+            Unobservable::Uncertain {
+                relative_sigma,
+                threshold,
+            } => write!(
+                f,
+                "the data barely excite the dynamics: relative standard deviation of J {relative_sigma:.2e} > {threshold}"
+            ),
+            Unobservable::IllConditioned {
+                condition,
+                threshold,
+            } => write!(
+                f,
+                "the rows are ill-conditioned (condition number {condition:.2e} > {threshold:.0e})"
+            ),
+        }
+    }
+}
+
+/// Whether and how an estimate is determined.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Observability {
+    /// The data determine J.
+    Determined {
+        /// `σ_1/σ_6` of `R`.
+        condition: f64,
+    },
+    /// The data leave one direction open, which the a-priori bounds pin.
+    FromPrior(Unobservable),
+    /// Nothing determines J: no answer.
+    NotObservable(Unobservable),
+}
+
+impl Observability {
+    /// `true` when an answer may be reported.
+    #[must_use]
+    pub fn has_answer(&self) -> bool {
+        !matches!(self, Observability::NotObservable(_))
+    }
+}
+
+/// `‖σ_j‖/‖ĵ‖` of the unconstrained least-squares estimate, `∞` when it cannot be
+/// formed (fewer than [`MIN_RESIDUAL_DOF`] residual degrees of freedom or a singular `R`).
+#[must_use]
+pub fn relative_sigma(qr: &RecursiveQr) -> f64 {
+    if qr.rows < 6 + MIN_RESIDUAL_DOF {
+        return f64::INFINITY;
+    }
+    let Some(r_inv) = qr.r.try_inverse() else {
+        return f64::INFINITY;
+    };
+    let j = r_inv * qr.z;
+    let s2 = qr.rss / (qr.rows - 6) as f64;
+    // diag((RᵀR)⁻¹) = row norms² of R⁻¹.
+    let var: f64 = (0..6).map(|i| r_inv.row(i).norm_squared()).sum::<f64>() * s2;
+    let jn = j.norm();
+    if jn > 0.0 && var.is_finite() {
+        crate::math::sqrt(var) / jn
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// With `y ≡ 0` the data fix only the direction of `j`: the right singular vector `v_6`
+/// of `R`. Its relative standard deviation is `s √(Σ_{i≤5} σ_i⁻²)` with the per-row
+/// misfit `s² = σ_6²/(rows − 5)`.
+#[must_use]
+pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: usize) -> f64 {
+    if rows < 5 + MIN_RESIDUAL_DOF {
+        return f64::INFINITY;
+    }
+    let mut s = *sv;
+    s.as_mut_slice().sort_by(|a, b| b.total_cmp(a));
+    let inv: f64 = (0..5).map(|i| 1.0 / (s[i] * s[i])).sum();
+    let r = s[5] * crate::math::sqrt(inv / (rows - 5) as f64);
+    if r.is_finite() {
+        r
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Assess `qr` (uses an SVD of `R`).
+#[must_use]
+pub fn assess(
+    qr: &RecursiveQr,
+    has_bounds: bool,
+    settings: &ObservabilitySettings,
+) -> Observability {
+    let threshold = settings.condition_threshold;
+    let sv = qr.r.singular_values();
+    let smax = sv.max();
+    let tiny = smax * 1e-13;
+    let rank = if qr.rows == 0 || !(smax > 0.0) {
+        0
+    } else {
+        sv.iter().filter(|&&s| s > tiny).count().min(qr.rows)
+    };
+    let smin = sv.min();
+    let condition = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    let weak = sv.iter().filter(|&&s| s * threshold < smax).count();
+    let (reason, open_directions) = if qr.y_energy == 0.0 {
+        let rel = direction_relative_sigma(&sv, qr.rows);
+        if rel > settings.max_relative_sigma {
+            return Observability::NotObservable(Unobservable::Uncertain {
+                relative_sigma: rel,
+                threshold: settings.max_relative_sigma,
+            });
+        }
+        (Unobservable::NoExcitation, weak.max(1))
+    } else if rank < 6 {
+        (Unobservable::RankDeficient { rank }, 6 - rank)
+    } else if condition > threshold {
+        (
+            Unobservable::IllConditioned {
+                condition,
+                threshold,
+            },
+            weak,
+        )
+    } else {
+        let rel = relative_sigma(qr);
+        if rel > settings.max_relative_sigma {
+            return Observability::NotObservable(Unobservable::Uncertain {
+                relative_sigma: rel,
+                threshold: settings.max_relative_sigma,
+            });
+        }
+        return Observability::Determined { condition };
+    };
+    if has_bounds && open_directions <= 1 && rank >= 5 {
+        Observability::FromPrior(reason)
+    } else {
+        Observability::NotObservable(reason)
+    }
+}

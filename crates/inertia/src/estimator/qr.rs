@@ -1,0 +1,70 @@
+//! The fixed-size least-squares state of the recursive estimator (paper eqs. 58–61).
+//!
+//! Stacking rows `H_k j = y_k`, the thin QR factor `H_{1:N} = Q R` reduces
+//! `‖H_{1:N} j − y_{1:N}‖²` to `‖R j − z‖² + ρ²` with `z = Qᵀ y` and `ρ²` the part of
+//! `‖y‖²` no `j` can explain. [`RecursiveQr::add_row`] folds one new row into `(R, z, ρ²)`
+//! by six Givens rotations of `[R; h]` (eqs. 60–61), without allocating; a 3-row block is
+//! three calls. `R` keeps a non-negative diagonal.
+
+use crate::givens::fold_row;
+use crate::math::sqrt;
+use nalgebra::{Matrix3x6, Matrix6, Vector3, Vector6};
+
+/// `(R, z, ρ²)` and counters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecursiveQr {
+    /// Upper-triangular factor.
+    pub r: Matrix6<f64>,
+    /// `Qᵀ y` (first six components).
+    pub z: Vector6<f64>,
+    /// Residual sum of squares not explainable by any `j`.
+    pub rss: f64,
+    /// `Σ ‖y_k‖²`: zero exactly when no rotor momentum or known torque ever excited the rows.
+    pub y_energy: f64,
+    /// Scalar rows folded in.
+    pub rows: usize,
+}
+
+impl Default for RecursiveQr {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RecursiveQr {
+    /// The empty state.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            r: Matrix6::zeros(),
+            z: Vector6::zeros(),
+            rss: 0.0,
+            y_energy: 0.0,
+            rows: 0,
+        }
+    }
+
+    /// Fold one scalar row `hᵀ j = y` into the factor.
+    pub fn add_row(&mut self, h: &Vector6<f64>, y: f64) {
+        self.y_energy += y * y;
+        let left = fold_row(&mut self.r, h, Some((&mut self.z, y)));
+        self.rss += left * left;
+        self.rows += 1;
+    }
+
+    /// Fold a 3-row block `H_k j = y_k` into the factor.
+    pub fn add_block(&mut self, h: &Matrix3x6<f64>, y: &Vector3<f64>) {
+        for i in 0..3 {
+            self.add_row(&h.row(i).transpose(), y[i]);
+        }
+    }
+
+    /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
+    pub fn scale(&mut self, lambda: f64) {
+        let s = sqrt(lambda);
+        self.r *= s;
+        self.z *= s;
+        self.rss *= lambda;
+        self.y_energy *= lambda;
+    }
+}

@@ -1,0 +1,74 @@
+//! Folding a row into an upper-triangular factor by Givens rotations.
+//!
+//! Given `R` (n×n upper triangular) and a row `aᵀ` (with right-hand side `β`), rotate
+//! `[R | z; aᵀ | β]` so that the row becomes zero: afterwards `RᵀR` has gained `a aᵀ`,
+//! `Rᵀz` has gained `a β`, and the leftover `β'` is the part of `β` no solution can fit.
+//! The diagonal of `R` stays non-negative. Shared by the recursive least-squares state and
+//! the interior-point Newton systems; no allocation.
+
+use crate::math::sqrt;
+use nalgebra::{SMatrix, SVector};
+
+/// Fold `a` (and optionally the right-hand side `(z, β)`) into `r`. Returns the leftover
+/// of `β` (0 without a right-hand side).
+pub fn fold_row<const N: usize>(
+    r: &mut SMatrix<f64, N, N>,
+    a: &SVector<f64, N>,
+    mut rhs: Option<(&mut SVector<f64, N>, f64)>,
+) -> f64 {
+    let mut a = *a;
+    let mut beta = rhs.as_ref().map_or(0.0, |(_, b)| *b);
+    for i in 0..N {
+        let ai = a[i];
+        if ai == 0.0 {
+            continue;
+        }
+        let rii = r[(i, i)];
+        let rho = sqrt(rii * rii + ai * ai);
+        let (c, s) = (rii / rho, ai / rho);
+        r[(i, i)] = rho;
+        a[i] = 0.0;
+        for k in i + 1..N {
+            let (rk, ak) = (r[(i, k)], a[k]);
+            r[(i, k)] = c * rk + s * ak;
+            a[k] = -s * rk + c * ak;
+        }
+        if let Some((z, _)) = rhs.as_mut() {
+            let zi = z[i];
+            z[i] = c * zi + s * beta;
+            beta = -s * zi + c * beta;
+        }
+    }
+    beta
+}
+
+/// Solve `RᵀR d = g` for upper-triangular `R` by two triangular solves. `None` when a
+/// diagonal entry is zero or the result is not finite.
+#[must_use]
+pub fn solve_normal<const N: usize>(
+    r: &SMatrix<f64, N, N>,
+    g: &SVector<f64, N>,
+) -> Option<SVector<f64, N>> {
+    // Rᵀ w = g (forward), then R d = w (backward).
+    let mut w = SVector::<f64, N>::zeros();
+    for i in 0..N {
+        let mut s = g[i];
+        for k in 0..i {
+            s -= r[(k, i)] * w[k];
+        }
+        let d = r[(i, i)];
+        if d == 0.0 {
+            return None;
+        }
+        w[i] = s / d;
+    }
+    let mut x = SVector::<f64, N>::zeros();
+    for i in (0..N).rev() {
+        let mut s = w[i];
+        for k in i + 1..N {
+            s -= r[(i, k)] * x[k];
+        }
+        x[i] = s / r[(i, i)];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}

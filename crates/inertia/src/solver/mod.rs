@@ -1,0 +1,164 @@
+//! Constrained least squares over the inertia components (paper eqs. 57, 59).
+//!
+//! ```text
+//! minimise_j  ‖R j − z‖²   subject to  j ∈ C   (a validated constraint set)
+//! ```
+//!
+//! with `R` 6×6 upper triangular from the QR factor of the stacked rows (eqs. 58–61).
+//! The paper writes this as an SDP through a Schur-complement LMI (eq. 14); every backend
+//! here takes the quadratic objective directly, which is equivalent and better conditioned.
+//!
+//! [`solve`] is the one entry point. It
+//! 1. rejects non-finite data;
+//! 2. takes the **fast path**: when `R` is well enough conditioned for a triangular solve
+//!    and the unconstrained minimiser `R⁻¹ z` is strictly feasible, it is returned exactly,
+//!    with no iterations ([`SolveStatus::Unconstrained`]);
+//! 3. otherwise scales the data so that the objective is O(1) (`σ² = ‖z‖²`, the
+//!    objective at j = 0; when `z = 0`, `‖R‖²_F ‖j_c‖²` with `j_c` the constraint set's
+//!    interior point) and hands `(R/σ, z/σ)` to a [`Backend`].
+//!
+//! Backends: [`native::NativeSolver`] (pure Rust, default) and, with the `clarabel`
+//! feature, `clarabel_backend::ClarabelSolver` (the reference conic solver).
+
+pub mod barrier;
+#[cfg(feature = "clarabel")]
+pub mod clarabel_backend;
+pub mod native;
+
+use crate::constraints::Constraints;
+use crate::tensor::InertiaVector;
+use nalgebra::{Matrix6, Vector6};
+
+/// How a solution was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveStatus {
+    /// The unconstrained minimiser is strictly feasible and was returned exactly.
+    Unconstrained,
+    /// Solved to the backend's tolerances.
+    Optimal,
+    /// Stopped at an iteration limit; the point is feasible but less accurate.
+    Inaccurate,
+}
+
+/// Optimality residuals of an answer, in the scaled problem's units (objective O(1)).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Residuals {
+    /// Largest constraint violation, kg m² (0 for strictly feasible answers).
+    pub primal: f64,
+    /// Dual residual (stationarity of the Lagrangian) relative to the objective's
+    /// gradient.
+    pub dual: f64,
+    /// Complementarity (duality) gap, scaled units.
+    pub gap: f64,
+}
+
+/// A solver's answer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Solution {
+    /// The estimate `j`, kg m².
+    pub j: InertiaVector,
+    /// `‖R j − z‖²` in the original units.
+    pub objective: f64,
+    /// How it was obtained.
+    pub status: SolveStatus,
+    /// Iterations of the backend (0 on the fast path).
+    pub iterations: u32,
+    /// Optimality residuals.
+    pub residuals: Residuals,
+}
+
+/// Why a solve failed.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// `R` or `z` has NaN or infinite entries.
+    #[error("the least-squares data contain NaN or infinite values")]
+    NonFinite,
+    /// The backend failed numerically.
+    #[error("{backend} solver failed: {why}")]
+    Failed {
+        /// Backend name.
+        backend: &'static str,
+        /// What went wrong.
+        why: &'static str,
+    },
+}
+
+/// A constrained least-squares backend for `minimise ‖R j − z‖², j ∈ C`, on data already
+/// scaled by [`solve`] (objective O(1)). `warm` is the previous answer, if any.
+pub trait Backend {
+    /// Short name, e.g. `native` or `clarabel`.
+    fn name(&self) -> &'static str;
+
+    /// Solve the scaled problem.
+    fn solve_scaled(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<Solution, SolveError>;
+}
+
+/// Smallest `|R_ii| / max|R_jj|` for which the fast path trusts a triangular solve.
+pub const FAST_PATH_PIVOT_RATIO: f64 = 1e-10;
+
+/// The unconstrained minimiser `R⁻¹ z` of an upper-triangular `R` by back substitution,
+/// or `None` when a pivot is below [`FAST_PATH_PIVOT_RATIO`] of the largest.
+#[must_use]
+pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<InertiaVector> {
+    let dmax = r.diagonal().amax();
+    if !(dmax > 0.0) {
+        return None;
+    }
+    let mut x = Vector6::zeros();
+    for i in (0..6).rev() {
+        let d = r[(i, i)];
+        if d.abs() <= FAST_PATH_PIVOT_RATIO * dmax {
+            return None;
+        }
+        let mut s = z[i];
+        for k in i + 1..6 {
+            s -= r[(i, k)] * x[k];
+        }
+        x[i] = s / d;
+    }
+    Some(x)
+}
+
+/// Solve `minimise ‖R j − z‖², j ∈ C` with `backend` (see the module docs).
+pub fn solve(
+    backend: &mut dyn Backend,
+    r: &Matrix6<f64>,
+    z: &Vector6<f64>,
+    constraints: &Constraints,
+    warm: Option<&InertiaVector>,
+) -> Result<Solution, SolveError> {
+    if !r.iter().chain(z.iter()).all(|v| v.is_finite()) {
+        return Err(SolveError::NonFinite);
+    }
+    if let Some(j) = unconstrained_minimiser(r, z) {
+        if constraints.strictly_feasible(&j) {
+            return Ok(Solution {
+                j,
+                objective: (r * j - z).norm_squared(),
+                status: SolveStatus::Unconstrained,
+                iterations: 0,
+                residuals: Residuals::default(),
+            });
+        }
+    }
+    let zn = z.norm_squared();
+    let sigma2 = if zn > 0.0 {
+        zn
+    } else {
+        r.norm_squared() * constraints.interior().norm_squared()
+    };
+    let sigma = if sigma2 > 0.0 {
+        crate::math::sqrt(sigma2)
+    } else {
+        1.0
+    };
+    let mut sol = backend.solve_scaled(&(r / sigma), &(z / sigma), constraints, warm)?;
+    sol.objective = (r * sol.j - z).norm_squared();
+    Ok(sol)
+}

@@ -1,0 +1,162 @@
+//! The native backend: [`barrier`](super::barrier) on the 6-variable problem.
+//!
+//! Objective `‖R j − z‖²`, passed to the barrier method in least-squares form (the
+//! Newton systems are factored without forming `RᵀR`). The start is the previous
+//! answer pulled 1 % towards the constraint set's interior point (strictly feasible by
+//! convexity) when warm starting is on, else the interior point itself. Pure Rust, no
+//! allocation, `no_std`-capable.
+
+use super::barrier::{self, BarrierSettings, Problem};
+use super::{Backend, Residuals, Solution, SolveError, SolveStatus};
+use crate::constraints::Constraints;
+use crate::tensor::InertiaVector;
+use nalgebra::{Matrix6, Vector6};
+
+/// Settings of the native solver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NativeSettings {
+    /// Barrier-method settings (gap 1e-12 on the objective scaled to `f(0) = 1` by default).
+    pub barrier: BarrierSettings,
+    /// Start from the previous answer when one is given. Default `true`.
+    pub warm_start: bool,
+}
+
+impl Default for NativeSettings {
+    fn default() -> Self {
+        Self {
+            barrier: BarrierSettings::default(),
+            warm_start: true,
+        }
+    }
+}
+
+/// An invalid native setting.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("native solver setting `{field}` = {value} is invalid: {why}")]
+pub struct SettingsError {
+    /// Field name.
+    pub field: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// What it must be.
+    pub why: &'static str,
+}
+
+impl NativeSettings {
+    /// Check the settings.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let b = &self.barrier;
+        let positive = |field, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(SettingsError {
+                    field,
+                    value,
+                    why: "must be finite and > 0",
+                })
+            }
+        };
+        positive("gap_tolerance", b.gap_tolerance)?;
+        positive("acceptable_gap", b.acceptable_gap)?;
+        if !(b.gap_rel_tolerance >= 0.0) {
+            return Err(SettingsError {
+                field: "gap_rel_tolerance",
+                value: b.gap_rel_tolerance,
+                why: "must be >= 0",
+            });
+        }
+        if let Some(t0) = b.t0 {
+            positive("t0", t0)?;
+        }
+        positive("newton_tolerance", b.newton_tolerance)?;
+        if !(b.mu.is_finite() && b.mu > 1.0) {
+            return Err(SettingsError {
+                field: "mu",
+                value: b.mu,
+                why: "must be finite and > 1",
+            });
+        }
+        if b.max_newton_steps == 0 || b.max_centering_steps == 0 {
+            return Err(SettingsError {
+                field: "max_newton_steps",
+                value: 0.0,
+                why: "must be at least 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The pure-Rust backend.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NativeSolver {
+    /// Settings.
+    pub settings: NativeSettings,
+}
+
+impl NativeSolver {
+    /// A solver with the given (validated) settings.
+    pub fn new(settings: NativeSettings) -> Result<Self, SettingsError> {
+        settings.validate()?;
+        Ok(Self { settings })
+    }
+}
+
+impl Backend for NativeSolver {
+    fn name(&self) -> &'static str {
+        "native"
+    }
+
+    fn solve_scaled(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<Solution, SolveError> {
+        let problem = Problem {
+            a: *r,
+            b: *z,
+            c: Vector6::zeros(),
+            lmis: constraints.lmis(),
+            lins: constraints.lins(),
+        };
+        let interior = constraints.interior();
+        let start = match warm {
+            Some(w) if self.settings.warm_start && w.iter().all(|v| v.is_finite()) => {
+                let x = w * 0.99 + interior * 0.01;
+                if barrier::strictly_feasible(&problem, &x) {
+                    x
+                } else {
+                    *interior
+                }
+            }
+            _ => *interior,
+        };
+        let out = barrier::solve(&problem, &start, &self.settings.barrier).map_err(|e| {
+            SolveError::Failed {
+                backend: "native",
+                why: match e {
+                    barrier::BarrierError::NotInterior => "start point not interior",
+                    barrier::BarrierError::Numerical => "singular Newton system",
+                },
+            }
+        })?;
+        Ok(Solution {
+            j: out.x,
+            objective: (r * out.x - z).norm_squared(),
+            status: if out.converged {
+                SolveStatus::Optimal
+            } else {
+                SolveStatus::Inaccurate
+            },
+            iterations: out.newton_steps,
+            residuals: Residuals {
+                primal: 0.0,
+                dual: out.dual_residual,
+                gap: out.gap,
+            },
+        })
+    }
+}

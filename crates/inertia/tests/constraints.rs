@@ -1,0 +1,180 @@
+//! Constraint sets (paper eqs. 9, 55, 57; ERRATA §4) and the solver front end.
+
+use inertia::constraints::{component_by_name, ConstraintError, ConstraintSet};
+use inertia::solver::native::NativeSolver;
+use inertia::solver::{solve, SolveStatus};
+use inertia::tensor::{
+    diagonal_triangle_slacks, j_from_matrix, matrix_from_j, principal, second_moment,
+};
+use nalgebra::{Matrix3, Matrix6, Vector6};
+
+/// ERRATA §4: positive definite, passes eq. 9 on the diagonal, principal moments (1, 1, 2.5)
+/// violate the triangle inequality.
+fn errata_counterexample() -> Matrix3<f64> {
+    Matrix3::new(1.75, 0.0, 0.75, 0.0, 1.0, 0.0, 0.75, 0.0, 1.75)
+}
+
+#[test]
+fn counterexample_is_what_the_errata_says() {
+    let j = errata_counterexample();
+    let (pm, _) = principal(&j);
+    assert!((pm - nalgebra::Vector3::new(1.0, 1.0, 2.5)).norm() < 1e-12);
+    assert!(diagonal_triangle_slacks(&j).iter().all(|&s| s > 0.0));
+    assert!(second_moment(&j).symmetric_eigenvalues().min() < -0.2);
+}
+
+#[test]
+fn default_set_is_physical_and_has_an_interior_point() {
+    for set in [
+        ConstraintSet::default(),
+        ConstraintSet::paper(),
+        ConstraintSet::positive_definite(),
+        ConstraintSet::physical().with_nominal(2, 3.0, 0.1),
+        ConstraintSet::paper().with_nominal(2, 3.0, 0.1),
+        ConstraintSet::physical()
+            .with_bounds(0, Some(0.9), Some(1.1))
+            .with_bounds(3, Some(0.03), Some(0.04))
+            .with_bounds(5, None, Some(-0.07)),
+    ] {
+        let c = set.validate().unwrap();
+        assert!(c.strictly_feasible(c.interior()), "{set:?}");
+        assert!(
+            c.margin(c.interior()) > 1e-3,
+            "{set:?}: {}",
+            c.margin(c.interior())
+        );
+    }
+}
+
+#[test]
+fn crossed_and_contradictory_bounds_are_errors_before_any_data() {
+    let crossed = ConstraintSet::physical().with_bounds(1, Some(2.0), Some(1.0));
+    assert!(matches!(
+        crossed.validate(),
+        Err(ConstraintError::CrossedBounds {
+            component: "J22",
+            ..
+        })
+    ));
+    // Diagonal bounds that violate the triangle inequality: J11, J22 ≤ 1 and J33 ≥ 3.
+    for set in [ConstraintSet::physical(), ConstraintSet::paper()] {
+        let bad = set
+            .with_bounds(0, None, Some(1.0))
+            .with_bounds(1, None, Some(1.0))
+            .with_bounds(2, Some(3.0), None);
+        let err = bad.validate().unwrap_err();
+        assert!(matches!(err, ConstraintError::Infeasible { .. }), "{err}");
+        assert!(err.to_string().contains("no inertia satisfies"));
+    }
+    // A negative upper bound on a moment contradicts J ⪰ εI.
+    let neg = ConstraintSet::positive_definite().with_bounds(0, None, Some(-0.1));
+    assert!(matches!(
+        neg.validate(),
+        Err(ConstraintError::Infeasible { .. })
+    ));
+    let nan = ConstraintSet::physical().with_bounds(4, Some(f64::NAN), None);
+    assert!(matches!(
+        nan.validate(),
+        Err(ConstraintError::NonFinite { .. })
+    ));
+    let eps = ConstraintSet {
+        epsilon_kg_m2: 0.0,
+        ..ConstraintSet::physical()
+    };
+    assert!(matches!(
+        eps.validate(),
+        Err(ConstraintError::NonPositiveEpsilon(_))
+    ));
+}
+
+#[test]
+fn component_names() {
+    assert_eq!(component_by_name("J33"), Some(2));
+    assert_eq!(component_by_name("j12"), Some(3));
+    assert_eq!(component_by_name("J21"), Some(3));
+    assert_eq!(component_by_name("J32"), Some(5));
+    assert_eq!(component_by_name("J44"), None);
+}
+
+/// When the unconstrained minimiser is the ERRATA counterexample, the default set returns
+/// a physically consistent J and the paper's set returns the unphysical one.
+#[test]
+fn errata_counterexample_default_constraints_fix_it_paper_ones_do_not() {
+    let r = Matrix6::identity();
+    let z = j_from_matrix(&errata_counterexample());
+    let mut native = NativeSolver::default();
+
+    let paper = ConstraintSet::paper().validate().unwrap();
+    let sol = solve(&mut native, &r, &z, &paper, None).unwrap();
+    assert_eq!(sol.status, SolveStatus::Unconstrained);
+    assert_eq!(sol.j, z);
+    let (pm, _) = principal(&matrix_from_j(&sol.j));
+    assert!(
+        pm[0] + pm[1] < pm[2] - 0.4,
+        "paper set keeps the unphysical J: {pm}"
+    );
+
+    let physical = ConstraintSet::physical().validate().unwrap();
+    let sol = solve(&mut native, &r, &z, &physical, None).unwrap();
+    assert_eq!(sol.status, SolveStatus::Optimal);
+    let j = matrix_from_j(&sol.j);
+    let (pm, _) = principal(&j);
+    assert!(pm[0] + pm[1] >= pm[2] - 1e-8, "principal moments {pm}");
+    assert!(second_moment(&j).symmetric_eigenvalues().min() > -1e-8);
+    // It is the nearest physical J: moving it towards z only leaves the set.
+    assert!(physical.margin(&sol.j).abs() < 1e-6);
+    assert!(
+        sol.residuals.gap < 1e-9 && sol.residuals.dual < 1e-6,
+        "{:?}",
+        sol.residuals
+    );
+}
+
+/// The fast path returns the unconstrained least-squares answer exactly.
+#[test]
+fn fast_path_is_exact_least_squares() {
+    let r = Matrix6::from_fn(|i, k| {
+        if k >= i {
+            1.0 + (i * 7 + k * 3) as f64 * 0.1
+        } else {
+            0.0
+        }
+    });
+    // A physical J (the paper's J_true is not: see `paper_j_true_is_slightly_unphysical`).
+    let j_true = Vector6::new(1.0, 2.0, 2.5, 0.03, -0.06, -0.07);
+    let z = r * j_true;
+    let c = ConstraintSet::physical().validate().unwrap();
+    let sol = solve(&mut NativeSolver::default(), &r, &z, &c, None).unwrap();
+    assert_eq!(sol.status, SolveStatus::Unconstrained);
+    assert!((sol.j - j_true).norm() < 1e-12);
+    assert_eq!(sol.iterations, 0);
+}
+
+/// The paper's J_true has principal moments with λ1 + λ2 < λ3 by 4.9e-5 kg m²: it is
+/// slightly flatter than a flat plate, so Σ = ½ tr(J) I − J has a negative eigenvalue of
+/// −2.5e-5 kg m². The physical constraint set cannot return it exactly; the nearest
+/// physical J is ~1e-5 away in relative Frobenius norm, far below every error figure.
+#[test]
+fn paper_j_true_is_slightly_unphysical() {
+    let j = inertia::tensor::paper_j_true();
+    let (pm, _) = principal(&j);
+    let excess = pm[2] - pm[0] - pm[1];
+    assert!((excess - 4.93e-5).abs() < 1e-6, "λ3 − λ1 − λ2 = {excess:e}");
+    let min_sigma = second_moment(&j).symmetric_eigenvalues().min();
+    assert!((min_sigma + 2.46e-5).abs() < 1e-6, "{min_sigma:e}");
+    let c = ConstraintSet::physical().validate().unwrap();
+    let z = j_from_matrix(&j);
+    let sol = solve(
+        &mut NativeSolver::default(),
+        &Matrix6::identity(),
+        &z,
+        &c,
+        None,
+    )
+    .unwrap();
+    let rel = (matrix_from_j(&sol.j) - j).norm() / j.norm();
+    assert!(rel > 1e-6 && rel < 2e-5, "{rel:e}");
+    // The diagonal test of eq. 9 passes, so the paper's set accepts it.
+    let paper = ConstraintSet::paper().validate().unwrap();
+    assert!(paper.strictly_feasible(&z));
+}
