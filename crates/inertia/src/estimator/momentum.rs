@@ -106,6 +106,12 @@ impl MomentumRls {
         matrix_from_j(&self.j())
     }
 
+    /// Row blocks used so far.
+    #[must_use]
+    pub fn updates(&self) -> usize {
+        self.samples.saturating_sub(1)
+    }
+
     /// Estimated initial inertial momentum `h_N`, N m s.
     #[must_use]
     pub fn initial_momentum(&self) -> Vector3<f64> {

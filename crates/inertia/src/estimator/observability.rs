@@ -93,10 +93,19 @@ impl core::fmt::Display for Unobservable {
             Unobservable::Uncertain {
                 relative_sigma,
                 threshold,
-            } => write!(
-                f,
-                "the data barely excite the dynamics: relative standard deviation of J {relative_sigma:.2e} > {threshold}"
-            ),
+            } => {
+                if relative_sigma.is_finite() {
+                    write!(
+                        f,
+                        "the data barely excite the dynamics: relative standard deviation of J {relative_sigma:.2e} > {threshold}"
+                    )
+                } else {
+                    write!(
+                        f,
+                        "too few rows yet to judge the estimate's accuracy (fewer than {MIN_RESIDUAL_DOF} residual degrees of freedom)"
+                    )
+                }
+            }
             Unobservable::IllConditioned {
                 condition,
                 threshold,

@@ -4,6 +4,9 @@
 //! the gyro rate is the **average over the following interval** `[t_k, t_{k+1}]`, as an
 //! integrating (delta-angle) gyro reports it. Units SI, body axes, quaternion per
 //! [`crate::attitude`] (scalar last, Hamilton, body → inertial).
+//!
+//! With the `csv` feature, [`csv::TelemetryReader`] streams samples from a CSV file with
+//! validation that names the file, line and column of every problem.
 
 use crate::attitude::Quaternion;
 use nalgebra::Vector3;
@@ -22,3 +25,6 @@ pub struct Sample {
     /// Gyro rate averaged over `[t_k, t_{k+1}]`, rad/s, body axes.
     pub omega_rad_s: Vector3<f64>,
 }
+
+#[cfg(feature = "csv")]
+pub mod csv;

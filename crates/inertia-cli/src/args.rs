@@ -1,0 +1,153 @@
+//! Command-line arguments (parsed first; validated into a config by `config`).
+
+use crate::runner::{EstimatorKind, SolverKind};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+/// Estimate a spacecraft's inertia tensor from attitude telemetry.
+///
+/// Units are SI throughout (s, rad, rad/s, N m s, N m, kg m²); vectors are in body axes;
+/// quaternions are [x, y, z, w], scalar last, Hamilton, body → inertial, unless an input
+/// option says otherwise.
+#[derive(Debug, Parser)]
+#[command(name = "inertia", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Simulate telemetry of one of the paper's scenarios (§VI) into a CSV file, with the
+    /// true inertia beside it (FILE.truth.json).
+    Simulate(SimulateArgs),
+    /// Estimate the inertia from a telemetry CSV file.
+    Estimate(EstimateArgs),
+    /// Reproduce the paper's numerical examples on built-in simulated data: figures 1-10
+    /// (PNG and SVG), their data (CSV) and summary.md.
+    Reproduce(ReproduceArgs),
+}
+
+/// The paper's scenarios.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ScenarioArg {
+    /// Three-axis stabilised slews on reaction wheels (300 s).
+    Slew,
+    /// Major-axis spin with one wheel pulse at 30 s (180 s).
+    Spin,
+}
+
+/// `inertia simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Scenario.
+    #[arg(long, value_enum)]
+    pub scenario: ScenarioArg,
+    /// Duration, s [default: 300 for slew, 180 for spin].
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Sample period h, s.
+    #[arg(long, value_name = "S", default_value_t = 0.1)]
+    pub dt: f64,
+    /// Noise seed.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+    /// Gyro rate noise spectral density, deg/s/√Hz.
+    #[arg(long, value_name = "DEG_S_RTHZ", default_value_t = 1e-5)]
+    pub gyro_noise: f64,
+    /// Unknown disturbance torque spectral density, N m/√Hz.
+    #[arg(long, value_name = "NM_RTHZ", default_value_t = 1e-8)]
+    pub disturbance: f64,
+    /// Output CSV file (the truth goes to the same name with `.truth.json`).
+    #[arg(short = 'o', long, value_name = "FILE.csv")]
+    pub output: PathBuf,
+}
+
+/// Constraint sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum ConstraintArg {
+    /// J ⪰ εI and Σ = ½ tr(J) I − J ⪰ 0 (exact physical consistency; default).
+    #[default]
+    Physical,
+    /// J ⪰ εI and the paper's diagonal triangle inequalities (eq. 9).
+    Paper,
+    /// J ⪰ εI only.
+    PositiveDefinite,
+}
+
+/// Input-format options shared by commands that read telemetry.
+#[derive(Debug, Args)]
+pub struct InputArgs {
+    /// The quaternion columns hold [w, x, y, z] (scalar first) instead of [x, y, z, w].
+    #[arg(long, conflicts_with = "jpl")]
+    pub scalar_first: bool,
+    /// The quaternion follows the JPL/Shuster convention (inertial → body, scalar last).
+    #[arg(long)]
+    pub jpl: bool,
+    /// Rename a column, e.g. `--column t=time --column rho_x=h_wheel_x`.
+    #[arg(long = "column", value_name = "DEFAULT=NAME")]
+    pub columns: Vec<String>,
+    /// Largest | |q| − 1 | that is renormalised (beyond it, an error).
+    #[arg(long, value_name = "TOL", default_value_t = inertia::telemetry::csv::DEFAULT_UNIT_TOLERANCE)]
+    pub unit_tolerance: f64,
+    /// Largest relative deviation of a step from the sample period.
+    #[arg(long, value_name = "TOL", default_value_t = inertia::telemetry::csv::DEFAULT_PERIOD_TOLERANCE)]
+    pub period_tolerance: f64,
+}
+
+/// `inertia estimate`.
+#[derive(Debug, Args)]
+pub struct EstimateArgs {
+    /// Telemetry CSV file (see README: t, q_x..q_w, rho_x..rho_z, optional tau_*, w_*).
+    pub file: PathBuf,
+    /// Estimator.
+    #[arg(long, value_enum, default_value = "variational")]
+    pub estimator: EstimatorKind,
+    /// One batch solve over all samples instead of the recursive estimator.
+    #[arg(long)]
+    pub batch: bool,
+    /// Constraint set.
+    #[arg(long, value_enum, default_value = "physical")]
+    pub constraints: ConstraintArg,
+    /// Bound an element, kg m²: `J33=2.7:3.3`, `J12=:0.05`, `J11=0.9:` (repeatable).
+    #[arg(long = "bound", value_name = "Jij=LO:HI")]
+    pub bounds: Vec<String>,
+    /// Nominal inertia (JSON, as written by `simulate`), bounding every element with
+    /// `--tolerance`: moments within ±p·|J_ii|, products within ±p·√(J_ii J_jj).
+    #[arg(long, value_name = "J.json", requires = "tolerance")]
+    pub nominal: Option<PathBuf>,
+    /// Tolerance for `--nominal`, e.g. `10%` or `0.1`.
+    #[arg(long, value_name = "P", requires = "nominal")]
+    pub tolerance: Option<String>,
+    /// Solve every N samples (recursive estimators).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub every: usize,
+    /// True inertia (JSON) to report the relative Frobenius error against.
+    #[arg(long, value_name = "J.json")]
+    pub truth: Option<PathBuf>,
+    /// Write the estimate history to this CSV file.
+    #[arg(short = 'o', long, value_name = "FILE.csv")]
+    pub output: Option<PathBuf>,
+    /// Print one JSON object instead of the readable report.
+    #[arg(long)]
+    pub json: bool,
+    /// Solver backend.
+    #[arg(long, value_enum, default_value = "native")]
+    pub solver: SolverKind,
+    /// Input format.
+    #[command(flatten)]
+    pub input: InputArgs,
+}
+
+/// `inertia reproduce`.
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    pub out: PathBuf,
+    /// Noise seed of the simulated telemetry.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+}

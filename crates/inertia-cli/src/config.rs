@@ -1,0 +1,171 @@
+//! Arguments validated into configurations.
+
+use crate::args::{ConstraintArg, InputArgs};
+use crate::error::{input, CliError};
+use inertia::constraints::{component_by_name, ConstraintSet, Constraints};
+use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
+use inertia::tensor::{j_from_matrix, InertiaVector, COMPONENT_INDEX};
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// An inertia tensor file (`FILE.truth.json`, `--nominal`, `--truth`).
+#[derive(Debug, Serialize, Deserialize)]
+pub struct InertiaFile {
+    /// J, kg m², rows of the 3×3 matrix.
+    pub inertia_kg_m2: [[f64; 3]; 3],
+    /// `[J11, J22, J33, J12, J13, J23]`, kg m² (written for convenience; ignored on input).
+    #[serde(default, skip_deserializing)]
+    pub j: Option<[f64; 6]>,
+}
+
+impl InertiaFile {
+    /// From a matrix.
+    pub fn new(j: &Matrix3<f64>) -> Self {
+        let v = j_from_matrix(j);
+        Self {
+            inertia_kg_m2: [0, 1, 2].map(|r| [0, 1, 2].map(|c| j[(r, c)])),
+            j: Some([0, 1, 2, 3, 4, 5].map(|k| v[k])),
+        }
+    }
+
+    /// Read and check a file.
+    pub fn read(path: &Path) -> Result<Matrix3<f64>, CliError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
+        let f: InertiaFile = serde_json::from_str(&text).map_err(|e| {
+            input(format!(
+                "{}:{}:{}: {e} (expected {{\"inertia_kg_m2\": [[..],[..],[..]]}})",
+                path.display(),
+                e.line(),
+                e.column()
+            ))
+        })?;
+        let m = Matrix3::from_fn(|r, c| f.inertia_kg_m2[r][c]);
+        if !m.iter().all(|v| v.is_finite()) {
+            return Err(input(format!(
+                "{}: inertia_kg_m2 has non-finite entries",
+                path.display()
+            )));
+        }
+        if (m - m.transpose()).norm() > 1e-9 * m.norm() {
+            return Err(input(format!(
+                "{}: inertia_kg_m2 is not symmetric",
+                path.display()
+            )));
+        }
+        Ok(m)
+    }
+}
+
+/// Parse `Jij=LO:HI` into `(component, lower, upper)`.
+pub fn parse_bound(s: &str) -> Result<(usize, Option<f64>, Option<f64>), CliError> {
+    let bad = |why: &str| {
+        input(format!(
+            "--bound {s:?}: {why} (expected e.g. J33=2.7:3.3, J12=:0.05)"
+        ))
+    };
+    let (name, range) = s.split_once('=').ok_or_else(|| bad("missing `=`"))?;
+    let k = component_by_name(name.trim()).ok_or_else(|| bad("unknown element"))?;
+    let (lo, hi) = range.split_once(':').ok_or_else(|| bad("missing `:`"))?;
+    let num = |t: &str| -> Result<Option<f64>, CliError> {
+        let t = t.trim();
+        if t.is_empty() {
+            return Ok(None);
+        }
+        let v: f64 = t.parse().map_err(|_| bad("not a number"))?;
+        if v.is_finite() {
+            Ok(Some(v))
+        } else {
+            Err(bad("not finite"))
+        }
+    };
+    let (l, h) = (num(lo)?, num(hi)?);
+    if l.is_none() && h.is_none() {
+        return Err(bad("no bound given"));
+    }
+    Ok((k, l, h))
+}
+
+/// Parse `10%` or `0.1`.
+pub fn parse_fraction(s: &str) -> Result<f64, CliError> {
+    let t = s.trim();
+    let v = match t.strip_suffix('%') {
+        Some(p) => p.trim().parse::<f64>().map(|v| v / 100.0),
+        None => t.parse::<f64>(),
+    }
+    .map_err(|_| input(format!("--tolerance {s:?}: expected e.g. 10% or 0.1")))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(input(format!("--tolerance {s:?}: must be finite and >= 0")))
+    }
+}
+
+/// Build and validate a constraint set.
+pub fn constraints(
+    kind: ConstraintArg,
+    bounds: &[String],
+    nominal: Option<(&Matrix3<f64>, f64)>,
+) -> Result<Constraints, CliError> {
+    let mut set = match kind {
+        ConstraintArg::Physical => ConstraintSet::physical(),
+        ConstraintArg::Paper => ConstraintSet::paper(),
+        ConstraintArg::PositiveDefinite => ConstraintSet::positive_definite(),
+    };
+    if let Some((n, p)) = nominal {
+        let j: InertiaVector = j_from_matrix(n);
+        for (k, &(r, c)) in COMPONENT_INDEX.iter().enumerate() {
+            let w = if r == c {
+                p * n[(r, r)].abs()
+            } else {
+                p * (n[(r, r)] * n[(c, c)]).abs().sqrt()
+            };
+            set = set.with_bounds(k, Some(j[k] - w), Some(j[k] + w));
+        }
+    }
+    for b in bounds {
+        let (k, l, h) = parse_bound(b)?;
+        set = set.with_bounds(k, l, h);
+    }
+    set.validate()
+        .map_err(|e| input(format!("constraints: {e}")))
+}
+
+/// CSV options from the input arguments.
+pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
+    let mut columns = ColumnNames::default();
+    for c in &a.columns {
+        let (k, v) = c.split_once('=').ok_or_else(|| {
+            input(format!(
+                "--column {c:?}: expected DEFAULT=NAME, e.g. t=time"
+            ))
+        })?;
+        if !columns.rename(k.trim(), v.trim()) {
+            return Err(input(format!(
+                "--column {c:?}: unknown column {k:?} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
+            )));
+        }
+    }
+    for (name, v) in [
+        ("--unit-tolerance", a.unit_tolerance),
+        ("--period-tolerance", a.period_tolerance),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(input(format!("{name} {v}: must be finite and > 0")));
+        }
+    }
+    Ok(CsvOptions {
+        quaternion: if a.scalar_first {
+            QuaternionFormat::HamiltonScalarFirst
+        } else if a.jpl {
+            QuaternionFormat::Jpl
+        } else {
+            QuaternionFormat::HamiltonScalarLast
+        },
+        columns,
+        unit_tolerance: a.unit_tolerance,
+        period_tolerance: a.period_tolerance,
+        delimiter: b',',
+    })
+}

@@ -1,0 +1,284 @@
+//! `inertia estimate`.
+
+use crate::args::EstimateArgs;
+use crate::config::{self, InertiaFile};
+use crate::error::{input, internal, CliError};
+use crate::history::HistoryWriter;
+use crate::runner::{AnyBackend, EstimatorKind, HistoryRow, Runner};
+use inertia::estimator::batch;
+use inertia::estimator::observability::ObservabilitySettings;
+use inertia::estimator::rows::{FiniteDifferenceRows, VariationalRows};
+use inertia::estimator::EstimatorError;
+use inertia::telemetry::csv::{ReadStats, TelemetryReader};
+use inertia::tensor::{matrix_from_j, principal, relative_frobenius_error};
+use nalgebra::Matrix3;
+use serde_json::json;
+use std::io::IsTerminal;
+
+/// Run the command.
+pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
+    let options = config::csv_options(&a.input)?;
+    let nominal = match (&a.nominal, &a.tolerance) {
+        (Some(p), Some(t)) => Some((InertiaFile::read(p)?, config::parse_fraction(t)?)),
+        _ => None,
+    };
+    let constraints = config::constraints(
+        a.constraints,
+        &a.bounds,
+        nominal.as_ref().map(|(m, p)| (m, *p)),
+    )?;
+    let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
+    if a.every == 0 {
+        return Err(input("--every 0: must be at least 1"));
+    }
+    if a.batch && a.estimator == EstimatorKind::Momentum {
+        return Err(input(
+            "--batch applies to the variational and finite-difference estimators; the momentum baseline is recursive only",
+        ));
+    }
+    let mut backend = AnyBackend::new(a.solver).map_err(input)?;
+    let mut reader = TelemetryReader::open(&a.file, options).map_err(input)?;
+    let file = reader.file().to_string();
+    if a.estimator.needs_gyro() && !reader.has_gyro() {
+        return Err(input(format!(
+            "{file}:1: the {} estimator needs gyro-rate columns w_x,w_y,w_z",
+            a.estimator.name()
+        )));
+    }
+    let size = std::fs::metadata(&a.file).map(|m| m.len()).unwrap_or(0);
+    let progress = (std::io::stderr().is_terminal() && !a.json && size > 1 << 20).then(|| {
+        let p = indicatif::ProgressBar::new(size);
+        p.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {bytes}/{total_bytes} {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        p
+    });
+    let mut history = a.output.as_deref().map(HistoryWriter::create).transpose()?;
+    let row_error = |e: EstimatorError, line: u64| match e {
+        EstimatorError::Solve(e) => internal(format!("{file}:{line}: {e}")),
+        EstimatorError::Row { source, .. } => input(format!("{file}:{line}: {source}")),
+        other => input(format!("{file}:{line}: {other}")),
+    };
+
+    let mut last: Option<HistoryRow> = None;
+    let mut samples = 0usize;
+    let mut h_s = f64::NAN;
+    let mut t_prev = f64::NAN;
+    if a.batch {
+        let mut all = Vec::new();
+        for item in reader.by_ref() {
+            all.push(item.map_err(input)?);
+        }
+        samples = all.len();
+        if all.len() > 1 {
+            h_s = all[1].t_s - all[0].t_s;
+        }
+        let obs = ObservabilitySettings::default();
+        let est = match a.estimator {
+            EstimatorKind::Variational => batch::estimate(
+                &all,
+                VariationalRows::default(),
+                &constraints,
+                &mut backend,
+                &obs,
+            ),
+            _ => batch::estimate(
+                &all,
+                FiniteDifferenceRows::default(),
+                &constraints,
+                &mut backend,
+                &obs,
+            ),
+        };
+        let est = est.map_err(|e| match e {
+            EstimatorError::Row { sample, source } => {
+                input(format!("{file}: sample {sample}: {source}"))
+            }
+            EstimatorError::Solve(e) => internal(e),
+            other => input(format!("{file}: {other}")),
+        })?;
+        let row = HistoryRow::from_estimate(&est);
+        if let Some(h) = history.as_mut() {
+            h.write(&row)?;
+        }
+        last = Some(row);
+    } else {
+        let mut runner = Runner::new(a.estimator, constraints, backend, a.every).map_err(input)?;
+        while let Some(item) = reader.next() {
+            let s = item.map_err(input)?;
+            samples += 1;
+            if samples == 2 {
+                h_s = s.t_s - t_prev;
+            }
+            t_prev = s.t_s;
+            if let Some(row) = runner
+                .push(&s)
+                .map_err(|e| row_error(e, reader.last_line()))?
+            {
+                if let Some(h) = history.as_mut() {
+                    h.write(&row)?;
+                }
+                last = Some(row);
+            }
+            if let Some(p) = &progress {
+                if samples.is_multiple_of(4096) {
+                    p.set_position(reader.byte_position());
+                }
+            }
+        }
+    }
+    if let Some(p) = progress {
+        p.finish_and_clear();
+    }
+    if let Some(h) = history {
+        h.finish()?;
+    }
+    let stats = reader.stats();
+    let Some(last) = last else {
+        return Err(input(format!(
+            "{file}: too few samples for an estimate ({samples} read; at least {} needed)",
+            inertia::estimator::MIN_SAMPLES + 2
+        )));
+    };
+    let report = Report {
+        file: &file,
+        a,
+        stats,
+        samples,
+        h_s,
+        last: &last,
+        truth: truth.as_ref(),
+    };
+    if a.json {
+        println!("{}", report.json());
+    } else {
+        print!("{}", report.text());
+    }
+    Ok(())
+}
+
+struct Report<'a> {
+    file: &'a str,
+    a: &'a EstimateArgs,
+    stats: ReadStats,
+    samples: usize,
+    h_s: f64,
+    last: &'a HistoryRow,
+    truth: Option<&'a Matrix3<f64>>,
+}
+
+impl Report<'_> {
+    fn inertia(&self) -> Option<Matrix3<f64>> {
+        self.last.j.map(|j| matrix_from_j(&j))
+    }
+
+    fn json(&self) -> String {
+        let m = self.inertia();
+        let rows = |m: &Matrix3<f64>| -> Vec<Vec<f64>> {
+            (0..3)
+                .map(|r| (0..3).map(|c| m[(r, c)]).collect())
+                .collect()
+        };
+        let pr = m.map(|m| principal(&m));
+        let v = json!({
+            "file": self.file,
+            "estimator": self.a.estimator.name(),
+            "batch": self.a.batch,
+            "samples": self.samples,
+            "sample_period_s": self.h_s,
+            "renormalised": self.stats.renormalised,
+            "sign_flips": self.stats.sign_flips,
+            "t": self.last.t_s,
+            "status": self.last.status.code(),
+            "reason": self.last.status.reason(),
+            "condition": self.last.condition,
+            "inertia": m.as_ref().map(rows),
+            "j": self.last.j.map(|j| j.iter().copied().collect::<Vec<_>>()),
+            "principal_moments": pr.map(|(v, _)| v.iter().copied().collect::<Vec<_>>()),
+            "principal_axes": pr.map(|(_, ax)| rows(&ax)),
+            "relative_error": match (m, self.truth) {
+                (Some(m), Some(t)) => Some(relative_frobenius_error(&m, t)),
+                _ => None,
+            },
+        });
+        v.to_string()
+    }
+
+    fn text(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let st = &self.stats;
+        let _ = writeln!(
+            s,
+            "{}: {} samples, h = {:.6} s ({} renormalised, {} sign flips)",
+            self.file, self.samples, self.h_s, st.renormalised, st.sign_flips
+        );
+        let _ = writeln!(
+            s,
+            "estimator: {}{}, constraints: {}, t = {} s",
+            self.a.estimator.name(),
+            if self.a.batch {
+                " (batch)"
+            } else {
+                " (recursive)"
+            },
+            clap::ValueEnum::to_possible_value(&self.a.constraints)
+                .map_or_else(String::new, |v| v.get_name().to_string()),
+            self.last.t_s
+        );
+        let status = match (&self.last.status, self.last.condition) {
+            (crate::runner::RowStatus::Determined, Some(c)) => {
+                format!("determined by the data (condition number {c:.3e})")
+            }
+            (crate::runner::RowStatus::FromPrior(r), _) => {
+                format!("answer leans on the prior bounds: {r}")
+            }
+            (crate::runner::RowStatus::NotObservable(r), _) => format!("NOT OBSERVABLE: {r}"),
+            (crate::runner::RowStatus::Rls, _) => "recursive least squares (unconstrained)".into(),
+            (_, None) => "determined".into(),
+        };
+        let _ = writeln!(s, "status: {status}");
+        match self.inertia() {
+            None => {
+                let _ = writeln!(s, "no estimate: the data cannot determine J");
+            }
+            Some(m) => {
+                let _ = writeln!(s, "J [kg m²] =");
+                for r in 0..3 {
+                    let _ = writeln!(
+                        s,
+                        "  [ {:>12.6} {:>12.6} {:>12.6} ]",
+                        m[(r, 0)],
+                        m[(r, 1)],
+                        m[(r, 2)]
+                    );
+                }
+                let (pm, ax) = principal(&m);
+                let _ = writeln!(
+                    s,
+                    "principal moments [kg m²]: {:.6}  {:.6}  {:.6}",
+                    pm[0], pm[1], pm[2]
+                );
+                let _ = writeln!(s, "principal axes (columns, body axes):");
+                for r in 0..3 {
+                    let _ = writeln!(
+                        s,
+                        "  [ {:>9.5} {:>9.5} {:>9.5} ]",
+                        ax[(r, 0)],
+                        ax[(r, 1)],
+                        ax[(r, 2)]
+                    );
+                }
+                if let Some(t) = self.truth {
+                    let _ = writeln!(
+                        s,
+                        "relative Frobenius error vs truth: {:.3e}",
+                        relative_frobenius_error(&m, t)
+                    );
+                }
+            }
+        }
+        s
+    }
+}

@@ -1,0 +1,236 @@
+//! One estimator over a stream of samples, as history rows: shared by `estimate` and
+//! `reproduce`.
+
+use inertia::constraints::Constraints;
+use inertia::estimator::momentum::MomentumRls;
+use inertia::estimator::observability::Observability;
+use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
+use inertia::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
+use inertia::estimator::{Estimate, EstimatorError};
+use inertia::solver::native::NativeSolver;
+use inertia::solver::{Backend, Solution, SolveError};
+use inertia::telemetry::Sample;
+use inertia::tensor::InertiaVector;
+use nalgebra::{Matrix6, Vector6};
+
+/// Which estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum EstimatorKind {
+    /// The discrete variational estimator (paper Algorithm 1).
+    Variational,
+    /// The paper's finite-difference SDP baseline (eq. 26, differenced gyro rates).
+    FiniteDifference,
+    /// The momentum-based RLS baseline (Norman, Peck & O'Shaughnessy), unconstrained.
+    Momentum,
+}
+
+impl EstimatorKind {
+    /// Display name.
+    pub fn name(self) -> &'static str {
+        match self {
+            EstimatorKind::Variational => "variational",
+            EstimatorKind::FiniteDifference => "finite-difference",
+            EstimatorKind::Momentum => "momentum",
+        }
+    }
+
+    /// Whether the estimator needs gyro rates.
+    pub fn needs_gyro(self) -> bool {
+        !matches!(self, EstimatorKind::Variational)
+    }
+}
+
+/// Which solver backend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum SolverKind {
+    /// Pure-Rust barrier method (default).
+    #[default]
+    Native,
+    /// Clarabel (only in builds with the `clarabel` feature).
+    Clarabel,
+}
+
+/// A backend chosen at run time.
+pub enum AnyBackend {
+    /// Native.
+    Native(NativeSolver),
+    /// Clarabel.
+    #[cfg(feature = "clarabel")]
+    Clarabel(Box<inertia::solver::clarabel_backend::ClarabelSolver>),
+}
+
+impl AnyBackend {
+    /// The backend for `kind`, or a message when this build lacks it.
+    pub fn new(kind: SolverKind) -> Result<Self, String> {
+        match kind {
+            SolverKind::Native => Ok(AnyBackend::Native(NativeSolver::default())),
+            #[cfg(feature = "clarabel")]
+            SolverKind::Clarabel => Ok(AnyBackend::Clarabel(Box::default())),
+            #[cfg(not(feature = "clarabel"))]
+            SolverKind::Clarabel => Err("this build has no Clarabel backend (rebuild with `--features clarabel`, which needs system OpenBLAS)".into()),
+        }
+    }
+}
+
+impl Backend for AnyBackend {
+    fn name(&self) -> &'static str {
+        match self {
+            AnyBackend::Native(b) => b.name(),
+            #[cfg(feature = "clarabel")]
+            AnyBackend::Clarabel(b) => b.name(),
+        }
+    }
+
+    fn solve_scaled(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<Solution, SolveError> {
+        match self {
+            AnyBackend::Native(b) => b.solve_scaled(r, z, constraints, warm),
+            #[cfg(feature = "clarabel")]
+            AnyBackend::Clarabel(b) => b.solve_scaled(r, z, constraints, warm),
+        }
+    }
+}
+
+/// Status of one history row.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RowStatus {
+    /// The data determine J.
+    Determined,
+    /// The prior bounds fix what the data leave open.
+    FromPrior(String),
+    /// No answer.
+    NotObservable(String),
+    /// The momentum RLS (no observability test).
+    Rls,
+}
+
+impl RowStatus {
+    /// Short code for CSV and JSON.
+    pub fn code(&self) -> &'static str {
+        match self {
+            RowStatus::Determined => "determined",
+            RowStatus::FromPrior(_) => "from_prior",
+            RowStatus::NotObservable(_) => "not_observable",
+            RowStatus::Rls => "rls",
+        }
+    }
+
+    /// The reason, if any.
+    pub fn reason(&self) -> Option<&str> {
+        match self {
+            RowStatus::FromPrior(r) | RowStatus::NotObservable(r) => Some(r),
+            _ => None,
+        }
+    }
+}
+
+/// One estimate in a history.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HistoryRow {
+    /// Time, s.
+    pub t_s: f64,
+    /// `j` when an answer exists.
+    pub j: Option<InertiaVector>,
+    /// Status.
+    pub status: RowStatus,
+    /// Condition number of R (variational and finite-difference estimators).
+    pub condition: Option<f64>,
+    /// Solver iterations (0 on the fast path).
+    pub iterations: Option<u32>,
+}
+
+impl HistoryRow {
+    /// From a library estimate.
+    pub fn from_estimate(e: &Estimate) -> Self {
+        let (status, condition) = match e.observability {
+            Observability::Determined { condition } => (RowStatus::Determined, Some(condition)),
+            Observability::FromPrior(r) => (RowStatus::FromPrior(r.to_string()), None),
+            Observability::NotObservable(r) => (RowStatus::NotObservable(r.to_string()), None),
+        };
+        Self {
+            t_s: e.t_s,
+            j: e.j(),
+            status,
+            condition,
+            iterations: e.solution.map(|s| s.iterations),
+        }
+    }
+}
+
+/// An estimator of any kind.
+pub enum Runner {
+    /// Variational.
+    Variational(Box<RecursiveEstimator<VariationalRows, AnyBackend>>),
+    /// Finite difference.
+    FiniteDifference(Box<RecursiveEstimator<FiniteDifferenceRows, AnyBackend>>),
+    /// Momentum.
+    Momentum(Box<MomentumRls>, usize),
+}
+
+fn recursive<S: RowSource>(
+    source: S,
+    constraints: Constraints,
+    backend: AnyBackend,
+    settings: RecursiveSettings,
+) -> Result<Box<RecursiveEstimator<S, AnyBackend>>, EstimatorError> {
+    Ok(Box::new(RecursiveEstimator::new(
+        source,
+        constraints,
+        backend,
+        settings,
+    )?))
+}
+
+impl Runner {
+    /// A new runner. `every` is the solve period in samples.
+    pub fn new(
+        kind: EstimatorKind,
+        constraints: Constraints,
+        backend: AnyBackend,
+        every: usize,
+    ) -> Result<Self, EstimatorError> {
+        let settings = RecursiveSettings {
+            solve_every: every,
+            ..RecursiveSettings::default()
+        };
+        Ok(match kind {
+            EstimatorKind::Variational => Runner::Variational(recursive(
+                VariationalRows::default(),
+                constraints,
+                backend,
+                settings,
+            )?),
+            EstimatorKind::FiniteDifference => Runner::FiniteDifference(recursive(
+                FiniteDifferenceRows::default(),
+                constraints,
+                backend,
+                settings,
+            )?),
+            EstimatorKind::Momentum => Runner::Momentum(Box::default(), every.max(1)),
+        })
+    }
+
+    /// Feed a sample; returns a history row when an estimate was produced.
+    pub fn push(&mut self, s: &Sample) -> Result<Option<HistoryRow>, EstimatorError> {
+        match self {
+            Runner::Variational(e) => Ok(e.push(s)?.map(|e| HistoryRow::from_estimate(&e))),
+            Runner::FiniteDifference(e) => Ok(e.push(s)?.map(|e| HistoryRow::from_estimate(&e))),
+            Runner::Momentum(m, every) => {
+                let Some(j) = m.push(s) else { return Ok(None) };
+                let n = m.updates();
+                Ok((n % *every == 0).then_some(HistoryRow {
+                    t_s: s.t_s,
+                    j: Some(j),
+                    status: RowStatus::Rls,
+                    condition: None,
+                    iterations: None,
+                }))
+            }
+        }
+    }
+}

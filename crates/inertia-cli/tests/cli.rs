@@ -1,0 +1,412 @@
+//! End-to-end tests of the `inertia` binary.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn inertia(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_inertia"))
+        .args(args)
+        .output()
+        .expect("run inertia")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Simulate `scenario` for `duration` s into `dir/name.csv`.
+fn simulate(dir: &Path, name: &str, scenario: &str, duration: &str) -> PathBuf {
+    let path = dir.join(format!("{name}.csv"));
+    let o = inertia(&[
+        "simulate",
+        "--scenario",
+        scenario,
+        "--duration",
+        duration,
+        "-o",
+        path.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    path
+}
+
+fn json(o: &Output) -> serde_json::Value {
+    serde_json::from_str(stdout(o).trim()).unwrap_or_else(|e| panic!("{e}: {}", stdout(o)))
+}
+
+#[test]
+fn simulate_then_estimate_recovers_j_true() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "slew", "slew", "150");
+    let truth = dir.path().join("slew.truth.json");
+    assert!(truth.exists());
+    for est in ["variational", "finite-difference", "momentum"] {
+        let o = inertia(&[
+            "estimate",
+            csv.to_str().unwrap(),
+            "--estimator",
+            est,
+            "--truth",
+            truth.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{est}: {}", stderr(&o));
+        let v = json(&o);
+        let err = v["relative_error"].as_f64().unwrap();
+        assert!(err < 1e-3, "{est}: {err}");
+        assert_eq!(v["samples"], 1501);
+        assert_eq!(v["j"].as_array().unwrap().len(), 6);
+        assert_eq!(v["principal_moments"].as_array().unwrap().len(), 3);
+    }
+    // The readable report.
+    let o = inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--truth",
+        truth.to_str().unwrap(),
+    ]);
+    let text = stdout(&o);
+    assert!(text.contains("J [kg m²] ="), "{text}");
+    assert!(text.contains("principal moments"));
+    assert!(text.contains("status: determined"));
+    assert!(text.contains("relative Frobenius error vs truth"));
+    // Batch agrees with recursive.
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--batch", "--json"]);
+    let b = json(&o);
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--json"]);
+    let r = json(&o);
+    for k in 0..6 {
+        let (x, y) = (b["j"][k].as_f64().unwrap(), r["j"][k].as_f64().unwrap());
+        assert!((x - y).abs() < 1e-6 * (1.0 + y.abs()), "{k}: {x} vs {y}");
+    }
+}
+
+#[test]
+fn json_matches_the_last_history_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "spin", "spin", "60");
+    let hist = dir.path().join("h.csv");
+    let o = inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--constraints",
+        "paper",
+        "--bound",
+        "J33=2.7:3.3",
+        "--every",
+        "10",
+        "-o",
+        hist.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = json(&o);
+    let mut r = csv::Reader::from_path(&hist).unwrap();
+    let header = r.headers().unwrap().clone();
+    assert_eq!(
+        &header.iter().take(8).collect::<Vec<_>>(),
+        &["t", "J11", "J22", "J33", "J12", "J13", "J23", "status"]
+    );
+    let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+    assert!(rows.len() > 50, "{} rows", rows.len());
+    let last = rows.last().unwrap();
+    assert_eq!(last[0].parse::<f64>().unwrap(), v["t"].as_f64().unwrap());
+    for k in 0..6 {
+        assert_eq!(
+            last[k + 1].parse::<f64>().unwrap(),
+            v["j"][k].as_f64().unwrap()
+        );
+    }
+    assert_eq!(&last[7], v["status"].as_str().unwrap());
+    // Before the pulse the answers lean on the bound, and say so.
+    assert!(rows.iter().any(|r| &r[7] == "from_prior"));
+}
+
+#[test]
+fn reproduce_writes_every_figure_and_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("results");
+    let o = inertia(&["reproduce", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for stem in [
+        "fig01_slew_rotor_momentum",
+        "fig02_slew_body_rates",
+        "fig03_slew_total_error",
+        "fig04_slew_moment_errors",
+        "fig05_slew_product_errors",
+        "fig06_spin_body_rates",
+        "fig07_spin_rotor_momentum",
+        "fig08_spin_total_error",
+        "fig09_spin_moment_errors",
+        "fig10_spin_product_errors",
+    ] {
+        for ext in ["png", "svg", "csv"] {
+            let p = out.join(format!("{stem}.{ext}"));
+            let len = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
+            assert!(len > 1000, "{} missing or tiny ({len} bytes)", p.display());
+        }
+        let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    }
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    for needle in [
+        "## slew case",
+        "## spin case",
+        "| variational |",
+        "| momentum |",
+        "| finite difference |",
+        "variational, physical set",
+        "Final estimates",
+    ] {
+        assert!(summary.contains(needle), "summary lacks {needle:?}");
+    }
+    assert!(stderr(&o).contains("summary.md"));
+}
+
+/// Input conventions: the same telemetry stored scalar-first, as JPL, and with renamed
+/// columns gives the same estimate; flipping the sign of quaternions changes nothing but
+/// the count of sign flips.
+#[test]
+fn input_conventions_give_the_same_answer() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "slew", "slew", "120");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    let write = |name: &str, header: &str, f: &dyn Fn(usize, &mut Vec<String>)| -> PathBuf {
+        let mut s = String::from(header);
+        s.push('\n');
+        for (i, r) in rows.iter().enumerate() {
+            let mut r = r.clone();
+            f(i, &mut r);
+            s.push_str(&r.join(","));
+            s.push('\n');
+        }
+        let p = dir.path().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    // Scalar first: columns q_x..q_w hold w, x, y, z.
+    let sf = write("sf.csv", header, &|_, r| {
+        r[1..5].rotate_right(1);
+    });
+    // JPL: same components (see attitude docs).
+    let jpl = write("jpl.csv", header, &|_, r| {
+        let _ = r;
+    });
+    let flipped = write("flip.csv", header, &|i, r| {
+        if i % 2 == 1 {
+            for c in r.iter_mut().take(5).skip(1) {
+                *c = if let Some(s) = c.strip_prefix('-') {
+                    s.to_string()
+                } else {
+                    format!("-{c}")
+                };
+            }
+        }
+    });
+    let renamed = write("ren.csv", &header.replacen("t,", "time,", 1), &|_, _| {});
+    let base = json(&inertia(&["estimate", csv.to_str().unwrap(), "--json"]));
+    let cases: [(&PathBuf, &[&str]); 4] = [
+        (&sf, &["--scalar-first"]),
+        (&jpl, &["--jpl"]),
+        (&flipped, &[]),
+        (&renamed, &["--column", "t=time"]),
+    ];
+    for (p, extra) in cases {
+        let mut args = vec!["estimate", p.to_str().unwrap(), "--json"];
+        args.extend_from_slice(extra);
+        let o = inertia(&args);
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let v = json(&o);
+        for k in 0..6 {
+            let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
+            assert!(
+                (x - y).abs() < 1e-9 * (1.0 + y.abs()),
+                "{extra:?} {k}: {x} vs {y}"
+            );
+        }
+    }
+    let v = json(&inertia(&["estimate", flipped.to_str().unwrap(), "--json"]));
+    assert_eq!(v["sign_flips"].as_u64().unwrap(), 1200);
+    // Reading a scalar-last file as scalar-first is caught (non-unit or huge steps), not
+    // silently accepted... or gives a different answer.
+    let o = inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--scalar-first",
+        "--json",
+    ]);
+    if o.status.success() {
+        let v = json(&o);
+        let d: f64 = (0..6)
+            .map(|k| (v["j"][k].as_f64().unwrap_or(0.0) - base["j"][k].as_f64().unwrap()).abs())
+            .sum();
+        assert!(d > 1e-3);
+    }
+}
+
+/// A small valid file with one line replaced.
+fn bad_file(dir: &Path, name: &str, line: usize, replace: &dyn Fn(&str) -> String) -> PathBuf {
+    let src = simulate(dir, &format!("{name}_src"), "slew", "2");
+    let text = std::fs::read_to_string(&src).unwrap();
+    let out: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i + 1 == line {
+                replace(l)
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    let p = dir.join(format!("{name}.csv"));
+    std::fs::write(&p, out.join("\n") + "\n").unwrap();
+    p
+}
+
+fn field(line: &str, col: usize, value: &str) -> String {
+    let mut f: Vec<String> = line.split(',').map(str::to_string).collect();
+    f[col] = value.to_string();
+    f.join(",")
+}
+
+fn assert_bad(p: &Path, extra: &[&str], needles: &[&str]) {
+    let mut args = vec!["estimate", p.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = inertia(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "one line: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+    for n in needles {
+        assert!(e.contains(n), "{e:?} lacks {n:?}");
+    }
+}
+
+#[test]
+fn bad_number() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "num", 5, &|l| field(l, 2, "abc"));
+    assert_bad(&p, &[], &["num.csv:5", "`q_y`", "\"abc\""]);
+}
+
+#[test]
+fn nan_value() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "nan", 7, &|l| field(l, 6, "NaN"));
+    assert_bad(&p, &[], &["nan.csv:7", "`rho_y`", "not finite"]);
+}
+
+#[test]
+fn missing_column() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "miss", 1, &|l| l.replace("rho_z", "rho_q"));
+    assert_bad(&p, &[], &["miss.csv:1", "missing column `rho_z`"]);
+}
+
+#[test]
+fn non_unit_quaternion() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "unit", 9, &|l| field(l, 4, "0.9"));
+    assert_bad(&p, &[], &["unit.csv:9", "q_x,q_y,q_z,q_w", "norm"]);
+}
+
+#[test]
+fn non_increasing_time() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "time", 6, &|l| field(l, 0, "0.1"));
+    assert_bad(&p, &[], &["time.csv:6", "`t`", "does not increase"]);
+}
+
+#[test]
+fn non_uniform_period() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "period", 6, &|l| field(l, 0, "0.43"));
+    assert_bad(&p, &[], &["period.csv:6", "`t`", "sample period"]);
+}
+
+#[test]
+fn step_too_large() {
+    let d = tempfile::tempdir().unwrap();
+    // 180° about x relative to its neighbours.
+    let p = bad_file(d.path(), "step", 8, &|l| {
+        let l = field(l, 1, "1");
+        let l = field(&l, 2, "0");
+        let l = field(&l, 3, "0");
+        field(&l, 4, "0")
+    });
+    assert_bad(&p, &[], &["step.csv:8", "q_x,q_y,q_z,q_w", "too long"]);
+}
+
+#[test]
+fn malformed_row() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "mal", 4, &|l| format!("{l},1,2"));
+    assert_bad(&p, &[], &["mal.csv:4", "malformed"]);
+}
+
+#[test]
+fn missing_file_and_bad_options() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("nope.csv");
+    assert_bad(&p, &[], &["nope.csv"]);
+    let ok = simulate(d.path(), "ok", "slew", "2");
+    assert_bad(&ok, &["--bound", "J33=3.3:2.7"], &["J33", "contradict"]);
+    assert_bad(
+        &ok,
+        &["--bound", "J44=1:2"],
+        &["--bound", "unknown element"],
+    );
+    assert_bad(
+        &ok,
+        &[
+            "--bound", "J11=:1", "--bound", "J22=:1", "--bound", "J33=3:",
+        ],
+        &["no inertia satisfies"],
+    );
+    // Usage errors come from clap, also with exit code 2.
+    let o = inertia(&["estimate", ok.to_str().unwrap(), "--estimator", "magic"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn gyro_columns_required_by_the_baselines() {
+    let d = tempfile::tempdir().unwrap();
+    let p = bad_file(d.path(), "nogyro", 1, &|l| {
+        l.replace("w_x", "a")
+            .replace("w_y", "b")
+            .replace("w_z", "c")
+    });
+    assert_bad(
+        &p,
+        &["--estimator", "momentum"],
+        &["nogyro.csv:1", "w_x,w_y,w_z"],
+    );
+    // The variational estimator does not need them.
+    let o = inertia(&["estimate", p.to_str().unwrap()]);
+    assert_ne!(o.status.code(), Some(1), "{}", stderr(&o));
+}
+
+#[test]
+fn unobservable_data_are_reported_not_estimated() {
+    let d = tempfile::tempdir().unwrap();
+    // The spin case before its wheel pulse, without the J33 bound: y ≡ 0.
+    let csv = simulate(d.path(), "spin", "spin", "20");
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = json(&o);
+    assert_eq!(v["status"], "not_observable");
+    assert!(v["j"].is_null());
+    assert!(v["reason"].as_str().unwrap().contains("up to scale"));
+    let o = inertia(&["estimate", csv.to_str().unwrap()]);
+    assert!(stdout(&o).contains("NOT OBSERVABLE"));
+}

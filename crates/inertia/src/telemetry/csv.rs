@@ -1,0 +1,610 @@
+//! Reading telemetry from CSV files (feature `csv`).
+//!
+//! # Format
+//!
+//! A header line, then one row per node. Columns are found by name (defaults below,
+//! renamable with [`ColumnNames`]); extra columns are ignored. SI units, body axes.
+//!
+//! | columns | meaning | required |
+//! |---|---|---|
+//! | `t` | time, s | yes |
+//! | `q_x,q_y,q_z,q_w` | attitude quaternion (see [`QuaternionFormat`]) | yes |
+//! | `rho_x,rho_y,rho_z` | total rotor angular momentum, N m s | yes |
+//! | `tau_x,tau_y,tau_z` | known external torque, N m | no (zero) |
+//! | `w_x,w_y,w_z` | gyro rate averaged over `[t_k, t_{k+1}]`, rad/s | for the finite-difference and momentum estimators |
+//!
+//! # Validation
+//!
+//! Every error names the file, the line and the column: unparsable numbers, NaN or
+//! infinite values, missing columns, quaternions whose norm differs from 1 by more than
+//! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
+//! non-increasing time, a sample period that differs from the first one by more than
+//! [`CsvOptions::period_tolerance`] (relative), and steps whose rotation is too large for
+//! `|φ| < 1` ([`crate::discrete::MAX_PHI_NORM`]). Consecutive quaternions of opposite
+//! sign (`q` and `−q` are the same attitude) are accepted and counted. Nothing is dropped:
+//! a row is either returned or reported as an error, and [`ReadStats`] counts what was
+//! read, renormalised and sign-flipped.
+//!
+//! The reader is an iterator and holds one row at a time: memory does not grow with the
+//! file.
+
+use super::Sample;
+use crate::attitude::{incremental_rotation, Quaternion};
+use crate::discrete::{check_phi, RowError};
+use nalgebra::Vector3;
+use std::fs::File;
+use std::io::Read;
+use std::path::Path;
+
+/// Default tolerance on `| |q| − 1 |` below which quaternions are renormalised.
+pub const DEFAULT_UNIT_TOLERANCE: f64 = 1e-3;
+/// Default relative tolerance on the uniformity of the sample period.
+pub const DEFAULT_PERIOD_TOLERANCE: f64 = 1e-3;
+
+/// Where the scalar part of the quaternion is stored, and what the quaternion means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum QuaternionFormat {
+    /// Hamilton, body → inertial, the four columns are the vector part then the scalar
+    /// (this crate's convention). The default.
+    #[default]
+    HamiltonScalarLast,
+    /// Hamilton, body → inertial, but the column named for `q_x` holds the scalar:
+    /// columns `[q_x, q_y, q_z, q_w]` hold `[w, x, y, z]`.
+    HamiltonScalarFirst,
+    /// JPL/Shuster (inertial → body attitude matrix, scalar last). Converted with
+    /// [`Quaternion::from_jpl_xyzw`].
+    Jpl,
+}
+
+/// Column names. Defaults are those of the table in the module docs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ColumnNames {
+    /// Time.
+    pub t: String,
+    /// Quaternion, in storage order.
+    pub q: [String; 4],
+    /// Rotor momentum.
+    pub rho: [String; 3],
+    /// Known torque.
+    pub tau: [String; 3],
+    /// Gyro rate.
+    pub w: [String; 3],
+}
+
+impl Default for ColumnNames {
+    fn default() -> Self {
+        let v =
+            |p: &str, s: &[&str]| -> Vec<String> { s.iter().map(|c| format!("{p}_{c}")).collect() };
+        let arr3 = |v: Vec<String>| -> [String; 3] { [v[0].clone(), v[1].clone(), v[2].clone()] };
+        let q = v("q", &["x", "y", "z", "w"]);
+        Self {
+            t: "t".into(),
+            q: [q[0].clone(), q[1].clone(), q[2].clone(), q[3].clone()],
+            rho: arr3(v("rho", &["x", "y", "z"])),
+            tau: arr3(v("tau", &["x", "y", "z"])),
+            w: arr3(v("w", &["x", "y", "z"])),
+        }
+    }
+}
+
+impl ColumnNames {
+    /// Rename one column, e.g. `rename("t", "time")`. Returns `false` for an unknown key.
+    pub fn rename(&mut self, key: &str, name: &str) -> bool {
+        let d = Self::default();
+        if key == d.t {
+            self.t = name.into();
+            return true;
+        }
+        for (dst, def) in self
+            .q
+            .iter_mut()
+            .zip(&d.q)
+            .chain(self.rho.iter_mut().zip(&d.rho))
+            .chain(self.tau.iter_mut().zip(&d.tau))
+            .chain(self.w.iter_mut().zip(&d.w))
+        {
+            if key == def {
+                *dst = name.into();
+                return true;
+            }
+        }
+        false
+    }
+}
+
+/// Reading options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsvOptions {
+    /// Quaternion storage and convention.
+    pub quaternion: QuaternionFormat,
+    /// Column names.
+    pub columns: ColumnNames,
+    /// Quaternions with `| |q| − 1 |` up to this are renormalised (and counted); beyond it
+    /// they are an error. Default [`DEFAULT_UNIT_TOLERANCE`].
+    pub unit_tolerance: f64,
+    /// Relative tolerance on the sample period. Default [`DEFAULT_PERIOD_TOLERANCE`].
+    pub period_tolerance: f64,
+    /// Field delimiter. Default `,`.
+    pub delimiter: u8,
+}
+
+impl Default for CsvOptions {
+    fn default() -> Self {
+        Self {
+            quaternion: QuaternionFormat::default(),
+            columns: ColumnNames::default(),
+            unit_tolerance: DEFAULT_UNIT_TOLERANCE,
+            period_tolerance: DEFAULT_PERIOD_TOLERANCE,
+            delimiter: b',',
+        }
+    }
+}
+
+/// Counts of what was read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ReadStats {
+    /// Data rows returned.
+    pub rows: usize,
+    /// Quaternions renormalised (within the tolerance).
+    pub renormalised: usize,
+    /// Quaternions whose sign was opposite to the previous one's (same attitude).
+    pub sign_flips: usize,
+    /// Rows rejected (the reader stops at the first; this is 0 or 1).
+    pub rejected: usize,
+}
+
+/// What is wrong, where.
+#[derive(Debug, thiserror::Error)]
+pub enum TelemetryError {
+    /// The file could not be opened or read.
+    #[error("{file}: {source}")]
+    Io {
+        /// File name.
+        file: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The CSV structure is broken (e.g. a row with a different number of fields).
+    #[error("{file}:{line}: malformed CSV: {message}")]
+    Malformed {
+        /// File name.
+        file: String,
+        /// Line (1-based).
+        line: u64,
+        /// The parser's message.
+        message: String,
+    },
+    /// A required column is absent from the header.
+    #[error("{file}:1: missing column `{column}` (columns present: {present})")]
+    MissingColumn {
+        /// File name.
+        file: String,
+        /// The column.
+        column: String,
+        /// The header's columns.
+        present: String,
+    },
+    /// A field is not a number.
+    #[error("{file}:{line}: column `{column}`: cannot parse {value:?} as a number")]
+    Parse {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: String,
+        /// The field.
+        value: String,
+    },
+    /// A field is NaN or infinite.
+    #[error("{file}:{line}: column `{column}`: value {value} is not finite")]
+    NonFinite {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: String,
+        /// The value.
+        value: f64,
+    },
+    /// A quaternion's norm is too far from 1.
+    #[error("{file}:{line}: columns `{columns}`: quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}")]
+    NonUnitQuaternion {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// The quaternion columns.
+        columns: String,
+        /// Its norm.
+        norm: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// Time does not increase.
+    #[error("{file}:{line}: column `{column}`: time {t} s does not increase (previous row: {previous} s)")]
+    NonIncreasingTime {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: String,
+        /// This row's time.
+        t: f64,
+        /// Previous row's time.
+        previous: f64,
+    },
+    /// The sample period changed.
+    #[error("{file}:{line}: column `{column}`: step {dt} s differs from the sample period {period} s by more than {tolerance:e} (relative); resample or split the file")]
+    NonUniformPeriod {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: String,
+        /// This step.
+        dt: f64,
+        /// The period set by the first step.
+        period: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// The rotation since the previous row is too large.
+    #[error("{file}:{line}: columns `{columns}`: {source}")]
+    StepTooLarge {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// The quaternion columns.
+        columns: String,
+        /// The row error.
+        source: RowError,
+    },
+}
+
+impl TelemetryError {
+    /// The 1-based line of the problem, when it is tied to one.
+    #[must_use]
+    pub fn line(&self) -> Option<u64> {
+        match self {
+            TelemetryError::Io { .. } => None,
+            TelemetryError::MissingColumn { .. } => Some(1),
+            TelemetryError::Malformed { line, .. }
+            | TelemetryError::Parse { line, .. }
+            | TelemetryError::NonFinite { line, .. }
+            | TelemetryError::NonUnitQuaternion { line, .. }
+            | TelemetryError::NonIncreasingTime { line, .. }
+            | TelemetryError::NonUniformPeriod { line, .. }
+            | TelemetryError::StepTooLarge { line, .. } => Some(*line),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Indices {
+    t: usize,
+    q: [usize; 4],
+    rho: [usize; 3],
+    tau: Option<[usize; 3]>,
+    w: Option<[usize; 3]>,
+}
+
+/// A streaming, validating CSV telemetry reader.
+pub struct TelemetryReader<R: Read> {
+    reader: csv::Reader<R>,
+    record: csv::StringRecord,
+    file: String,
+    options: CsvOptions,
+    idx: Indices,
+    headers: Vec<String>,
+    stats: ReadStats,
+    prev: Option<Sample>,
+    period: Option<f64>,
+    failed: bool,
+}
+
+impl TelemetryReader<File> {
+    /// Open a file.
+    pub fn open(path: &Path, options: CsvOptions) -> Result<Self, TelemetryError> {
+        let file = path.display().to_string();
+        let f = File::open(path).map_err(|source| TelemetryError::Io {
+            file: file.clone(),
+            source,
+        })?;
+        Self::new(f, &file, options)
+    }
+}
+
+impl<R: Read> TelemetryReader<R> {
+    /// Read from any reader; `file` names it in messages.
+    pub fn new(input: R, file: &str, options: CsvOptions) -> Result<Self, TelemetryError> {
+        let mut reader = csv::ReaderBuilder::new()
+            .delimiter(options.delimiter)
+            .trim(csv::Trim::All)
+            .comment(Some(b'#'))
+            .from_reader(input);
+        let headers: Vec<String> = reader
+            .headers()
+            .map_err(|e| csv_error(file, &e))?
+            .iter()
+            .map(str::to_string)
+            .collect();
+        let find = |name: &str| headers.iter().position(|h| h == name);
+        let need = |name: &str| {
+            find(name).ok_or_else(|| TelemetryError::MissingColumn {
+                file: file.to_string(),
+                column: name.to_string(),
+                present: headers.join(","),
+            })
+        };
+        let c = &options.columns;
+        let optional3 = |names: &[String; 3]| -> Result<Option<[usize; 3]>, TelemetryError> {
+            let found: Vec<Option<usize>> = names.iter().map(|n| find(n)).collect();
+            if found.iter().all(Option::is_none) {
+                return Ok(None);
+            }
+            // Some present: all must be.
+            Ok(Some([need(&names[0])?, need(&names[1])?, need(&names[2])?]))
+        };
+        let idx = Indices {
+            t: need(&c.t)?,
+            q: [
+                need(&c.q[0])?,
+                need(&c.q[1])?,
+                need(&c.q[2])?,
+                need(&c.q[3])?,
+            ],
+            rho: [need(&c.rho[0])?, need(&c.rho[1])?, need(&c.rho[2])?],
+            tau: optional3(&c.tau)?,
+            w: optional3(&c.w)?,
+        };
+        Ok(Self {
+            reader,
+            record: csv::StringRecord::new(),
+            file: file.to_string(),
+            options,
+            idx,
+            headers,
+            stats: ReadStats::default(),
+            prev: None,
+            period: None,
+            failed: false,
+        })
+    }
+
+    /// Counts so far.
+    #[must_use]
+    pub fn stats(&self) -> ReadStats {
+        self.stats
+    }
+
+    /// `true` when the file has gyro-rate columns.
+    #[must_use]
+    pub fn has_gyro(&self) -> bool {
+        self.idx.w.is_some()
+    }
+
+    /// `true` when the file has known-torque columns.
+    #[must_use]
+    pub fn has_torque(&self) -> bool {
+        self.idx.tau.is_some()
+    }
+
+    /// Bytes consumed so far (for progress reporting).
+    #[must_use]
+    pub fn byte_position(&self) -> u64 {
+        self.reader.position().byte()
+    }
+
+    /// Line (1-based) of the last record read.
+    #[must_use]
+    pub fn last_line(&self) -> u64 {
+        self.record.position().map_or(0, csv::Position::line)
+    }
+
+    /// The file name used in messages.
+    #[must_use]
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    fn field(&self, line: u64, i: usize) -> Result<f64, TelemetryError> {
+        let raw = self.record.get(i).unwrap_or("");
+        let v: f64 = raw.parse().map_err(|_| TelemetryError::Parse {
+            file: self.file.clone(),
+            line,
+            column: self.headers[i].clone(),
+            value: raw.to_string(),
+        })?;
+        if !v.is_finite() {
+            return Err(TelemetryError::NonFinite {
+                file: self.file.clone(),
+                line,
+                column: self.headers[i].clone(),
+                value: v,
+            });
+        }
+        Ok(v)
+    }
+
+    fn vec3(&self, line: u64, i: &[usize; 3]) -> Result<Vector3<f64>, TelemetryError> {
+        Ok(Vector3::new(
+            self.field(line, i[0])?,
+            self.field(line, i[1])?,
+            self.field(line, i[2])?,
+        ))
+    }
+
+    fn q_columns(&self) -> String {
+        self.idx.q.map(|i| self.headers[i].clone()).join(",")
+    }
+
+    fn parse_row(&mut self, line: u64) -> Result<Sample, TelemetryError> {
+        let t = self.field(line, self.idx.t)?;
+        let c = [
+            self.field(line, self.idx.q[0])?,
+            self.field(line, self.idx.q[1])?,
+            self.field(line, self.idx.q[2])?,
+            self.field(line, self.idx.q[3])?,
+        ];
+        let raw = match self.options.quaternion {
+            QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(c),
+            QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(c),
+            QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(c),
+        };
+        let norm = raw.norm();
+        if (norm - 1.0).abs() > self.options.unit_tolerance {
+            return Err(TelemetryError::NonUnitQuaternion {
+                file: self.file.clone(),
+                line,
+                columns: self.q_columns(),
+                norm,
+                tolerance: self.options.unit_tolerance,
+            });
+        }
+        let mut q = raw;
+        if norm != 1.0 {
+            if let Some(n) = raw.normalize() {
+                if (norm - 1.0).abs() > 1e-12 {
+                    self.stats.renormalised += 1;
+                }
+                q = n;
+            }
+        }
+        let rho = self.vec3(line, &self.idx.rho)?;
+        let tau = match self.idx.tau {
+            Some(i) => self.vec3(line, &i)?,
+            None => Vector3::zeros(),
+        };
+        let w = match self.idx.w {
+            Some(i) => self.vec3(line, &i)?,
+            None => Vector3::repeat(f64::NAN),
+        };
+        if let Some(prev) = self.prev {
+            let dt = t - prev.t_s;
+            if !(dt > 0.0) {
+                return Err(TelemetryError::NonIncreasingTime {
+                    file: self.file.clone(),
+                    line,
+                    column: self.headers[self.idx.t].clone(),
+                    t,
+                    previous: prev.t_s,
+                });
+            }
+            match self.period {
+                None => self.period = Some(dt),
+                Some(p) => {
+                    if (dt - p).abs() > self.options.period_tolerance * p {
+                        return Err(TelemetryError::NonUniformPeriod {
+                            file: self.file.clone(),
+                            line,
+                            column: self.headers[self.idx.t].clone(),
+                            dt,
+                            period: p,
+                            tolerance: self.options.period_tolerance,
+                        });
+                    }
+                }
+            }
+            if prev.q.v.dot(&q.v) + prev.q.s * q.s < 0.0 {
+                self.stats.sign_flips += 1;
+            }
+            check_phi(&incremental_rotation(&prev.q, &q), 0).map_err(|source| {
+                TelemetryError::StepTooLarge {
+                    file: self.file.clone(),
+                    line,
+                    columns: self.q_columns(),
+                    source,
+                }
+            })?;
+        }
+        Ok(Sample {
+            t_s: t,
+            q,
+            rho_nms: rho,
+            tau_nm: tau,
+            omega_rad_s: w,
+        })
+    }
+}
+
+fn csv_error(file: &str, e: &csv::Error) -> TelemetryError {
+    let line = e.position().map_or(0, csv::Position::line);
+    TelemetryError::Malformed {
+        file: file.to_string(),
+        line,
+        message: e.to_string(),
+    }
+}
+
+impl<R: Read> Iterator for TelemetryReader<R> {
+    type Item = Result<Sample, TelemetryError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.failed {
+            return None;
+        }
+        let mut record = core::mem::take(&mut self.record);
+        let res = self.reader.read_record(&mut record);
+        self.record = record;
+        let item = match res {
+            Ok(false) => return None,
+            Err(e) => Err(match e.kind() {
+                csv::ErrorKind::Io(_) => TelemetryError::Io {
+                    file: self.file.clone(),
+                    source: std::io::Error::other(e.to_string()),
+                },
+                _ => csv_error(&self.file, &e),
+            }),
+            Ok(true) => {
+                let line = self.record.position().map_or(0, csv::Position::line);
+                self.parse_row(line)
+            }
+        };
+        match &item {
+            Ok(s) => {
+                self.stats.rows += 1;
+                self.prev = Some(*s);
+            }
+            Err(_) => {
+                self.stats.rejected += 1;
+                self.failed = true;
+            }
+        }
+        Some(item)
+    }
+}
+
+/// Write samples as CSV in the default format (scalar-last Hamilton quaternion, all
+/// columns). Used by the simulator's command-line front end and by tests.
+pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record([
+        "t", "q_x", "q_y", "q_z", "q_w", "rho_x", "rho_y", "rho_z", "tau_x", "tau_y", "tau_z",
+        "w_x", "w_y", "w_z",
+    ])?;
+    for s in samples {
+        let v = [
+            s.t_s,
+            s.q.v.x,
+            s.q.v.y,
+            s.q.v.z,
+            s.q.s,
+            s.rho_nms.x,
+            s.rho_nms.y,
+            s.rho_nms.z,
+            s.tau_nm.x,
+            s.tau_nm.y,
+            s.tau_nm.z,
+            s.omega_rad_s.x,
+            s.omega_rad_s.y,
+            s.omega_rad_s.z,
+        ];
+        w.write_record(v.iter().map(|x| format!("{x:?}")))?;
+    }
+    w.flush()
+}
