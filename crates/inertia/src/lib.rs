@@ -85,6 +85,7 @@ pub mod attitude;
 pub mod constraints;
 pub mod discrete;
 pub mod dynamics;
+mod eigen3;
 pub mod estimator;
 mod givens;
 mod math;

@@ -48,7 +48,7 @@ pub fn second_moment(j: &Matrix3<f64>) -> Matrix3<f64> {
 pub fn principal(j: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
     let e = SymmetricEigen::new(*j);
     let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
+    idx.sort_unstable_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
     let vals = Vector3::new(
         e.eigenvalues[idx[0]],
         e.eigenvalues[idx[1]],

@@ -11,12 +11,14 @@
 //!
 //! Every estimate says whether the data determine J ([`observability`]).
 
+#[cfg(feature = "std")]
 pub mod batch;
 pub mod momentum;
 pub mod observability;
 pub mod qr;
 pub mod recursive;
 pub mod rows;
+pub mod svd_tracker;
 
 use crate::discrete::RowError;
 use crate::solver::{Solution, SolveError};

@@ -141,18 +141,17 @@ impl Observability {
 
 /// `‖σ_j‖/‖ĵ‖` of the unconstrained least-squares estimate, `∞` when it cannot be
 /// formed (fewer than [`MIN_RESIDUAL_DOF`] residual degrees of freedom or a singular `R`).
+/// `sv` are the singular values of `R`: `tr((RᵀR)⁻¹) = Σ σ_k⁻²`.
 #[must_use]
-pub fn relative_sigma(qr: &RecursiveQr) -> f64 {
-    if qr.rows < 6 + MIN_RESIDUAL_DOF {
+pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
+    if qr.rows < 6 + MIN_RESIDUAL_DOF || sv.min() <= 0.0 {
         return f64::INFINITY;
     }
-    let Some(r_inv) = qr.r.try_inverse() else {
+    let Some(j) = crate::solver::unconstrained_minimiser(&qr.r, &qr.z) else {
         return f64::INFINITY;
     };
-    let j = r_inv * qr.z;
     let s2 = qr.rss / (qr.rows - 6) as f64;
-    // diag((RᵀR)⁻¹) = row norms² of R⁻¹.
-    let var: f64 = (0..6).map(|i| r_inv.row(i).norm_squared()).sum::<f64>() * s2;
+    let var: f64 = sv.iter().map(|s| 1.0 / (s * s)).sum::<f64>() * s2;
     let jn = j.norm();
     if jn > 0.0 && var.is_finite() {
         crate::math::sqrt(var) / jn
@@ -170,7 +169,7 @@ pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: usize) -> f64
         return f64::INFINITY;
     }
     let mut s = *sv;
-    s.as_mut_slice().sort_by(|a, b| b.total_cmp(a));
+    s.as_mut_slice().sort_unstable_by(|a, b| b.total_cmp(a));
     let inv: f64 = (0..5).map(|i| 1.0 / (s[i] * s[i])).sum();
     let r = s[5] * crate::math::sqrt(inv / (rows - 5) as f64);
     if r.is_finite() {
@@ -180,15 +179,27 @@ pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: usize) -> f64
     }
 }
 
-/// Assess `qr` (uses an SVD of `R`).
+/// Assess `qr` (computes an SVD of `R`).
 #[must_use]
 pub fn assess(
     qr: &RecursiveQr,
     has_bounds: bool,
     settings: &ObservabilitySettings,
 ) -> Observability {
+    assess_with(qr, &qr.r.singular_values(), has_bounds, settings)
+}
+
+/// Assess `qr` given the singular values `sv` of `R` (any order), e.g. from a
+/// [`super::svd_tracker::SvdTracker`].
+#[must_use]
+pub fn assess_with(
+    qr: &RecursiveQr,
+    sv: &nalgebra::Vector6<f64>,
+    has_bounds: bool,
+    settings: &ObservabilitySettings,
+) -> Observability {
     let threshold = settings.condition_threshold;
-    let sv = qr.r.singular_values();
+    let sv = *sv;
     let smax = sv.max();
     let tiny = smax * 1e-13;
     let rank = if qr.rows == 0 || !(smax > 0.0) {
@@ -223,7 +234,7 @@ pub fn assess(
             weak,
         )
     } else {
-        let rel = relative_sigma(qr);
+        let rel = relative_sigma(qr, &sv);
         if rel > settings.max_relative_sigma {
             return Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: rel,

@@ -9,9 +9,10 @@
 //! The state is fixed-size (`R` 6×6, `z`, residual sum of squares); the per-sample update
 //! does not allocate. The previous answer warm-starts the next solve.
 
-use super::observability::{assess, Observability, ObservabilitySettings};
+use super::observability::{assess, assess_with, Observability, ObservabilitySettings};
 use super::qr::RecursiveQr;
 use super::rows::RowSource;
+use super::svd_tracker::SvdTracker;
 use super::{Estimate, EstimatorError};
 use crate::constraints::Constraints;
 use crate::solver::{solve, Backend};
@@ -74,6 +75,7 @@ impl RecursiveSettings {
 pub struct RecursiveEstimator<S: RowSource, B: Backend> {
     source: S,
     qr: RecursiveQr,
+    svd: SvdTracker,
     constraints: Constraints,
     backend: B,
     settings: RecursiveSettings,
@@ -94,6 +96,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         Ok(Self {
             source,
             qr: RecursiveQr::new(),
+            svd: SvdTracker::new(),
             constraints,
             backend,
             settings,
@@ -132,8 +135,10 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// Solve with the data so far, stamped `t_s`.
     pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
-        let observability = assess(
+        let sv = self.svd.singular_values(&self.qr.r);
+        let observability = assess_with(
             &self.qr,
+            &sv,
             self.constraints.set().has_bounds(),
             &self.settings.observability,
         );

@@ -20,9 +20,11 @@
 //! Backends: [`native::NativeSolver`] (pure Rust, default) and, with the `clarabel`
 //! feature, `clarabel_backend::ClarabelSolver` (the reference conic solver).
 
+pub mod active_set;
 pub mod barrier;
 #[cfg(feature = "clarabel")]
 pub mod clarabel_backend;
+pub mod lmi_face;
 pub mod native;
 
 use crate::constraints::Constraints;

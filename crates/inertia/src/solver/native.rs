@@ -1,6 +1,9 @@
 //! The native backend: [`barrier`](super::barrier) on the 6-variable problem.
 //!
-//! Objective `‖R j − z‖²`, passed to the barrier method in least-squares form (the
+//! First an exact active-set solve of the linear constraints alone
+//! ([`super::active_set`]); when its answer satisfies the LMIs strictly it is optimal
+//! and is returned. Otherwise the barrier method:
+//! objective `‖R j − z‖²`, passed to the barrier method in least-squares form (the
 //! Newton systems are factored without forming `RᵀR`). The start is the previous
 //! answer pulled 1 % towards the constraint set's interior point (strictly feasible by
 //! convexity) when warm starting is on, else the interior point itself. Pure Rust, no
@@ -122,6 +125,33 @@ impl Backend for NativeSolver {
             lmis: constraints.lmis(),
             lins: constraints.lins(),
         };
+        // Exact answer when only linear constraints are active (module docs of
+        // `active_set`); the LMIs are then checked, strictly.
+        if let Some(a) = super::active_set::solve_linear(r, z, constraints) {
+            let lmis_hold = constraints
+                .lmis()
+                .iter()
+                .all(|l| l.eval(&a.j).cholesky().is_some());
+            if lmis_hold {
+                return Ok(Solution {
+                    j: a.j,
+                    objective: (r * a.j - z).norm_squared(),
+                    status: SolveStatus::Optimal,
+                    iterations: a.iterations,
+                    residuals: Residuals {
+                        primal: 0.0,
+                        dual: a.dual_residual,
+                        gap: a.gap,
+                    },
+                });
+            }
+        }
+        // One LMI face active: Newton on its KKT system from the previous answer.
+        if let Some(w) = warm.filter(|_| self.settings.warm_start) {
+            if let Some(sol) = face_solution(r, z, constraints, w, 0) {
+                return Ok(sol);
+            }
+        }
         let interior = constraints.interior();
         let start = match warm {
             Some(w) if self.settings.warm_start && w.iter().all(|v| v.is_finite()) => {
@@ -143,6 +173,12 @@ impl Backend for NativeSolver {
                 },
             }
         })?;
+        // Polish: if the barrier answer sits on one LMI face, solve that face exactly.
+        if out.converged {
+            if let Some(sol) = face_solution(r, z, constraints, &out.x, out.newton_steps) {
+                return Ok(sol);
+            }
+        }
         Ok(Solution {
             j: out.x,
             objective: (r * out.x - z).norm_squared(),
@@ -159,4 +195,35 @@ impl Backend for NativeSolver {
             },
         })
     }
+}
+
+/// Try the exact face solver on each LMI that is nearly active at `start`.
+fn face_solution(
+    r: &Matrix6<f64>,
+    z: &Vector6<f64>,
+    constraints: &Constraints,
+    start: &InertiaVector,
+    prior_steps: u32,
+) -> Option<Solution> {
+    let scale = start.amax().max(1.0);
+    for (i, l) in constraints.lmis().iter().enumerate() {
+        let m = crate::eigen3::symmetric_eigen3(&l.eval(start)).0[0];
+        if m.abs() > 1e-3 * scale {
+            continue;
+        }
+        if let Some(f) = super::lmi_face::solve(r, z, constraints, i, start) {
+            return Some(Solution {
+                j: f.j,
+                objective: (r * f.j - z).norm_squared(),
+                status: SolveStatus::Optimal,
+                iterations: prior_steps + f.steps.max(1),
+                residuals: Residuals {
+                    primal: (-crate::eigen3::symmetric_eigen3(&l.eval(&f.j)).0[0]).max(0.0),
+                    dual: f.dual_residual,
+                    gap: 0.0,
+                },
+            });
+        }
+    }
+    None
 }
