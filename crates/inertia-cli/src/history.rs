@@ -25,6 +25,7 @@ pub const HEADER: [&str; 11] = [
 pub struct HistoryWriter {
     w: csv::Writer<BufWriter<File>>,
     path: PathBuf,
+    buf: ryu::Buffer,
 }
 
 impl HistoryWriter {
@@ -36,23 +37,29 @@ impl HistoryWriter {
         Ok(Self {
             w,
             path: path.to_path_buf(),
+            buf: ryu::Buffer::new(),
         })
     }
 
-    /// Append one row.
+    /// Append one row (shortest round-trip float formatting, no allocation per field).
     pub fn write(&mut self, r: &HistoryRow) -> Result<(), CliError> {
-        let mut rec: Vec<String> = Vec::with_capacity(HEADER.len());
-        rec.push(r.t_s.to_string());
-        for k in 0..6 {
-            rec.push(r.j.map_or(String::new(), |j| j[k].to_string()));
-        }
-        rec.push(r.status.code().to_string());
-        rec.push(r.condition.map_or(String::new(), |c| c.to_string()));
-        rec.push(r.iterations.map_or(String::new(), |c| c.to_string()));
-        rec.push(r.status.reason().unwrap_or("").to_string());
-        self.w
-            .write_record(&rec)
-            .map_err(|e| write_failed(&self.path, e))
+        let buf = &mut self.buf;
+        let mut field = |w: &mut csv::Writer<BufWriter<File>>, v: Option<f64>| match v {
+            Some(v) if v.is_finite() => w.write_field(buf.format_finite(v)),
+            _ => w.write_field(b""),
+        };
+        let res = (|| {
+            field(&mut self.w, Some(r.t_s))?;
+            for k in 0..6 {
+                field(&mut self.w, r.j.map(|j| j[k]))?;
+            }
+            self.w.write_field(r.status.code())?;
+            field(&mut self.w, r.condition)?;
+            field(&mut self.w, r.iterations.map(f64::from))?;
+            self.w.write_field(r.status.reason().unwrap_or(""))?;
+            self.w.write_record(None::<&[u8]>)
+        })();
+        res.map_err(|e| write_failed(&self.path, e))
     }
 
     /// Flush to disk.

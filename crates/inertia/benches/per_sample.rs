@@ -159,7 +159,7 @@ fn per_sample(c: &mut Criterion) {
         #[cfg(feature = "clarabel")]
         {
             use inertia::solver::clarabel_backend::ClarabelSolver;
-            let (snaps, fast_c, active_c) = snapshots(&samples, set, ClarabelSolver::default());
+            let (snaps, fast_c, active_c) = snapshots(&samples, set, ClarabelSolver::single_pass());
             // The same samples as the native figures where the classification agrees.
             let _ = (fast_c, active_c);
             bench_push(

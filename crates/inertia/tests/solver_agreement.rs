@@ -22,7 +22,7 @@ use inertia::solver::{solve, SolveStatus};
 
 #[test]
 fn native_agrees_with_clarabel_on_random_problems() {
-    let n = 1000;
+    let n = 10_000;
     let (mut worst_obj, mut worst_j) = (0.0f64, 0.0f64);
     let (mut compared, mut reference_weak, mut active, mut native_better) = (0, 0, 0, 0);
     for (i, p) in common::problems(7, n).iter().enumerate() {

@@ -8,7 +8,7 @@ use inertia::solver::{solve, SolveStatus};
 
 #[test]
 fn native_answers_are_feasible_and_optimal_on_random_problems() {
-    let n = 1000;
+    let n = 10_000;
     let mut active = 0;
     let mut worst_dual = 0.0f64;
     let mut worst_gap = 0.0f64;

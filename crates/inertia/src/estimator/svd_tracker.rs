@@ -13,8 +13,9 @@ use nalgebra::{Matrix6, Vector6};
 
 /// Sweeps at most per update.
 const MAX_SWEEPS: u32 = 30;
-/// Columns count as orthogonal when `|b_iᵀb_j| ≤ TOL ‖b_i‖ ‖b_j‖`.
-const TOL: f64 = 1e-15;
+/// Columns count as orthogonal when `|b_iᵀb_j| ≤ TOL ‖b_i‖ ‖b_j‖`; the singular values
+/// are then accurate to about `TOL²` relative (second order).
+const TOL: f64 = 1e-13;
 
 /// The tracked right singular vectors.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,14 +47,14 @@ impl SvdTracker {
             reorthonormalise(&mut self.v);
         }
         let mut b = r * self.v;
+        let mut norms = Vector6::from_fn(|k, _| b.column(k).norm_squared());
         for _ in 0..MAX_SWEEPS {
             let mut rotated = false;
             for i in 0..5 {
                 for k in i + 1..6 {
-                    let alpha = b.column(i).norm_squared();
-                    let beta = b.column(k).norm_squared();
+                    let (alpha, beta) = (norms[i], norms[k]);
                     let gamma = b.column(i).dot(&b.column(k));
-                    if gamma.abs() <= TOL * sqrt(alpha * beta) || gamma == 0.0 {
+                    if gamma == 0.0 || gamma.abs() <= TOL * sqrt(alpha * beta) {
                         continue;
                     }
                     rotated = true;
@@ -63,6 +64,9 @@ impl SvdTracker {
                     let s = c * t;
                     rotate(&mut b, i, k, c, s);
                     rotate(&mut self.v, i, k, c, s);
+                    // Hestenes: the rotation moves t·γ between the two column norms.
+                    norms[i] = alpha - t * gamma;
+                    norms[k] = beta + t * gamma;
                 }
             }
             if !rotated {

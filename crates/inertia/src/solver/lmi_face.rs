@@ -43,6 +43,8 @@ pub struct FaceSolution {
     pub steps: u32,
     /// `‖∇f − μ∇g‖∞ / max(1, ‖∇f‖∞)`.
     pub dual_residual: f64,
+    /// The active eigenvalue `λ_min(F(j))` (≈ 0; negative values are the violation).
+    pub eigenvalue: f64,
 }
 
 /// Sorted eigenpairs of a symmetric 3×3 matrix, ascending.
@@ -68,18 +70,7 @@ pub fn solve(
     let scale = start.amax().max(1.0);
     let mut j = *start;
     let rt = r.transpose();
-    // Initial multiplier: least-squares fit of ∇f = μ∇g.
-    let mut mu = {
-        let (_, v) = eigen(&lmi.eval(&j));
-        let g = bilinear(lmi, &v[0], &v[0]);
-        let grad = rt * (r * j - z) * 2.0;
-        let gg = g.norm_squared();
-        if gg > 0.0 {
-            grad.dot(&g) / gg
-        } else {
-            return None;
-        }
-    };
+    let mut mu = f64::NAN;
     for step in 1..=MAX_STEPS {
         let (lam, v) = eigen(&lmi.eval(&j));
         if !(lam[1] - lam[0] > 1e-9 * scale) {
@@ -87,11 +78,19 @@ pub fn solve(
         }
         let grad_g = bilinear(lmi, &v[0], &v[0]);
         let grad_f = rt * (r * j - z) * 2.0;
+        if step == 1 {
+            // Initial multiplier: least-squares fit of ∇f = μ∇g.
+            let gg = grad_g.norm_squared();
+            if !(gg > 0.0) {
+                return None;
+            }
+            mu = grad_f.dot(&grad_g) / gg;
+        }
         let rd = grad_f - grad_g * mu;
         let g = lam[0];
         let done = g.abs() <= 1e-14 * scale && rd.amax() <= 1e-12 * grad_f.amax().max(1.0);
         if done {
-            return accept(r, z, constraints, index, j, mu, step - 1, &rd, &grad_f);
+            return accept(constraints, index, j, mu, g, step - 1, &rd, &grad_f);
         }
         // Factor of the Lagrangian Hessian 2RᵀR − μ∇²g.
         let mut u = Matrix6::zeros();
@@ -120,23 +119,25 @@ pub fn solve(
         if !j.iter().all(|x| x.is_finite()) || !mu.is_finite() {
             return None;
         }
+        // Converged to round-off: the step no longer changes j.
+        if dj.amax() <= 1e-15 * scale && g.abs() <= 1e-13 * scale {
+            return accept(constraints, index, j, mu, g, step, &rd, &grad_f);
+        }
     }
     None
 }
 
 #[allow(clippy::too_many_arguments)]
 fn accept(
-    r: &Matrix6<f64>,
-    z: &Vector6<f64>,
     constraints: &Constraints,
     index: usize,
     j: Vector6<f64>,
     mu: f64,
+    g: f64,
     steps: u32,
     rd: &Vector6<f64>,
     grad_f: &Vector6<f64>,
 ) -> Option<FaceSolution> {
-    let _ = (r, z);
     if mu < 0.0 {
         return None; // the constraint would not be active: not this face
     }
@@ -154,5 +155,6 @@ fn accept(
         mu,
         steps,
         dual_residual: rd.amax() / grad_f.amax().max(1.0),
+        eigenvalue: g,
     })
 }

@@ -207,8 +207,9 @@ fn face_solution(
 ) -> Option<Solution> {
     let scale = start.amax().max(1.0);
     for (i, l) in constraints.lmis().iter().enumerate() {
-        let m = crate::eigen3::symmetric_eigen3(&l.eval(start)).0[0];
-        if m.abs() > 1e-3 * scale {
+        // Only nearly active LMIs: F − 1e-3·scale·I not positive definite.
+        let shifted = l.eval(start) - nalgebra::Matrix3::identity() * (1e-3 * scale);
+        if shifted.cholesky().is_some() {
             continue;
         }
         if let Some(f) = super::lmi_face::solve(r, z, constraints, i, start) {
@@ -218,9 +219,9 @@ fn face_solution(
                 status: SolveStatus::Optimal,
                 iterations: prior_steps + f.steps.max(1),
                 residuals: Residuals {
-                    primal: (-crate::eigen3::symmetric_eigen3(&l.eval(&f.j)).0[0]).max(0.0),
+                    primal: (-f.eigenvalue).max(0.0),
                     dual: f.dual_residual,
-                    gap: 0.0,
+                    gap: (f.mu * f.eigenvalue).abs(),
                 },
             });
         }

@@ -324,14 +324,13 @@ impl<R: Read> TelemetryReader<R> {
     pub fn new(input: R, file: &str, options: CsvOptions) -> Result<Self, TelemetryError> {
         let mut reader = csv::ReaderBuilder::new()
             .delimiter(options.delimiter)
-            .trim(csv::Trim::All)
             .comment(Some(b'#'))
             .from_reader(input);
         let headers: Vec<String> = reader
             .headers()
             .map_err(|e| csv_error(file, &e))?
             .iter()
-            .map(str::to_string)
+            .map(|h| h.trim().to_string())
             .collect();
         let find = |name: &str| headers.iter().position(|h| h == name);
         let need = |name: &str| {
@@ -413,7 +412,7 @@ impl<R: Read> TelemetryReader<R> {
     }
 
     fn field(&self, line: u64, i: usize) -> Result<f64, TelemetryError> {
-        let raw = self.record.get(i).unwrap_or("");
+        let raw = self.record.get(i).unwrap_or("").trim();
         let v: f64 = raw.parse().map_err(|_| TelemetryError::Parse {
             file: self.file.clone(),
             line,
