@@ -125,7 +125,6 @@ fn draw<DB: DrawingBackend>(
     let areas = root.split_evenly((panels.len(), 1));
     let (x0, x1) = x_range(panels);
     for (idx, (area, p)) in areas.iter().zip(panels).enumerate() {
-        let first = idx == 0;
         let (y0, y1) = y_range(p);
         let mut b = ChartBuilder::on(area);
         b.caption(&p.title, ("sans-serif", 20))
@@ -143,29 +142,7 @@ fn draw<DB: DrawingBackend>(
                 .y_label_formatter(&|v| format!("{v:.0e}"))
                 .label_style(("sans-serif", 15))
                 .draw()?;
-            // The first series is the main one: drawn last (on top) and thicker.
-            for (n, s) in p.series.iter().enumerate().rev() {
-                let width = if n == 0 { 3 } else { 2 };
-                for (i, seg) in segments(&s.points, true).into_iter().enumerate() {
-                    let series =
-                        chart.draw_series(LineSeries::new(seg, s.color.stroke_width(width)))?;
-                    if i == 0 && first {
-                        let c = s.color;
-                        series.label(&s.name).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
-                        });
-                    }
-                }
-            }
-            if first {
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 15))
-                    .position(SeriesLabelPosition::UpperRight)
-                    .draw()?;
-            }
+            lines(&mut chart, p, true, idx == 0)?;
         } else {
             let mut chart = b.build_cartesian_2d(x0..x1, y0..y1)?;
             chart
@@ -175,30 +152,55 @@ fn draw<DB: DrawingBackend>(
                 .x_label_formatter(&|v| format!("{v:.0}"))
                 .label_style(("sans-serif", 15))
                 .draw()?;
-            // The first series is the main one: drawn last (on top) and thicker.
-            for (n, s) in p.series.iter().enumerate().rev() {
-                let width = if n == 0 { 3 } else { 2 };
-                for (i, seg) in segments(&s.points, false).into_iter().enumerate() {
-                    let series =
-                        chart.draw_series(LineSeries::new(seg, s.color.stroke_width(width)))?;
-                    if i == 0 && first {
-                        let c = s.color;
-                        series.label(&s.name).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
-                        });
-                    }
-                }
-            }
-            if first {
-                chart
-                    .configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 15))
-                    .position(SeriesLabelPosition::UpperRight)
-                    .draw()?;
+            lines(&mut chart, p, false, idx == 0)?;
+        }
+    }
+    Ok(())
+}
+
+/// Draw a panel's series (the first one last, on top, and thicker) and, on the first
+/// panel, the legend.
+fn lines<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    p: &Panel,
+    log: bool,
+    legend: bool,
+) -> DrawResult<DB::ErrorType>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    for (n, s) in p.series.iter().enumerate().rev() {
+        let width = if n == 0 { 3 } else { 2 };
+        for (i, seg) in segments(&s.points, log).into_iter().enumerate() {
+            // Two-point paths: the bitmap backend draws thick polylines with unlimited
+            // miter joins, which turn sharp zig-zags of noisy data into long spikes.
+            let style = s.color.stroke_width(width);
+            let pieces: Vec<PathElement<(f64, f64)>> = if seg.len() == 1 {
+                vec![PathElement::new(vec![seg[0], seg[0]], style)]
+            } else {
+                seg.windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], style))
+                    .collect()
+            };
+            let series = chart.draw_series(pieces)?;
+            if i == 0 && legend {
+                let c = s.color;
+                series.label(&s.name).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
+                });
             }
         }
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
     }
     Ok(())
 }
