@@ -28,6 +28,35 @@ pub enum Command {
     /// Reproduce the paper's numerical examples on built-in simulated data: figures 1-10
     /// (PNG and SVG), their data (CSV) and summary.md.
     Reproduce(ReproduceArgs),
+    /// Run a Monte Carlo campaign of a scenario (one seed per run, in parallel) and write
+    /// error percentiles (5/50/95 %) over time for each estimator, as CSV and a figure.
+    MonteCarlo(MonteCarloArgs),
+}
+
+/// `inertia monte-carlo`.
+#[derive(Debug, Args)]
+pub struct MonteCarloArgs {
+    /// Scenario.
+    #[arg(long, value_enum)]
+    pub scenario: ScenarioArg,
+    /// Number of runs (run i uses seed SEED + i).
+    #[arg(long, value_name = "N", default_value_t = 200)]
+    pub runs: u64,
+    /// First seed.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+    /// Gyro rate noise spectral density, deg/s/√Hz.
+    #[arg(long, value_name = "DEG_S_RTHZ", default_value_t = 1e-5)]
+    pub gyro_noise: f64,
+    /// Unknown disturbance torque spectral density, N m/√Hz.
+    #[arg(long, value_name = "NM_RTHZ", default_value_t = 1e-8)]
+    pub disturbance: f64,
+    /// Duration, s [default: the scenario's].
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Output directory.
+    #[arg(long, value_name = "DIR", default_value = "monte-carlo")]
+    pub out: PathBuf,
 }
 
 /// The paper's scenarios.

@@ -7,6 +7,7 @@ mod config;
 mod error;
 mod estimate;
 mod history;
+mod monte_carlo;
 mod plot;
 mod reproduce;
 mod runner;
@@ -23,6 +24,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => simulate::run(a),
         Command::Estimate(a) => estimate::run(a),
         Command::Reproduce(a) => reproduce::run(a),
+        Command::MonteCarlo(a) => monte_carlo::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -21,7 +21,8 @@ pub fn register_font() -> Result<(), CliError> {
     result
 }
 
-/// One line. `NaN` y values break the line (no estimate there).
+/// One line. `NaN` y values break the line (no estimate there). An empty name keeps it
+/// out of the legend.
 pub struct Series {
     /// Legend label.
     pub name: String,
@@ -29,6 +30,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Colour.
     pub color: RGBColor,
+    /// Line width, px.
+    pub width: u32,
 }
 
 /// One set of axes.
@@ -171,8 +174,9 @@ where
     X: Ranged<ValueType = f64>,
     Y: Ranged<ValueType = f64>,
 {
-    for (n, s) in p.series.iter().enumerate().rev() {
-        let width = if n == 0 { 3 } else { 2 };
+    // Drawn in reverse, so the first (main) series ends up on top.
+    for s in p.series.iter().rev() {
+        let width = s.width;
         for (i, seg) in segments(&s.points, log).into_iter().enumerate() {
             // Two-point paths: the bitmap backend draws thick polylines with unlimited
             // miter joins, which turn sharp zig-zags of noisy data into long spikes.
@@ -185,7 +189,7 @@ where
                     .collect()
             };
             let series = chart.draw_series(pieces)?;
-            if i == 0 && legend {
+            if i == 0 && legend && !s.name.is_empty() {
                 let c = s.color;
                 series.label(&s.name).legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))

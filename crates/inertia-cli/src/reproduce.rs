@@ -10,9 +10,8 @@ use crate::args::ReproduceArgs;
 use crate::error::{internal, write_failed, CliError};
 use crate::history::HistoryWriter;
 use crate::plot::{self, Panel, Series, COLORS};
-use crate::runner::{AnyBackend, EstimatorKind, HistoryRow, Runner};
-use inertia::constraints::ConstraintSet;
-use inertia::sim::scenario::{Common, Scenario, SPIN_J33_NOMINAL, SPIN_J33_TOLERANCE};
+use crate::runner::{paper_estimators, HistoryRow, Run};
+use inertia::sim::scenario::{Common, Scenario};
 use inertia::sim::SimOutput;
 use inertia::tensor::{
     matrix_from_j, normalized_element_errors, relative_frobenius_error, COMPONENT_NAMES,
@@ -25,12 +24,6 @@ use std::time::Instant;
 /// Times at which the summary reports errors, s (the end is added).
 const REPORT_TIMES: [f64; 4] = [10.0, 30.0, 60.0, 120.0];
 
-struct Run {
-    label: &'static str,
-    file: &'static str,
-    history: Vec<HistoryRow>,
-}
-
 struct Case {
     scenario: Scenario,
     out: SimOutput,
@@ -38,62 +31,17 @@ struct Case {
     constraint_note: &'static str,
 }
 
-fn estimator_runs(scenario: &Scenario, out: &SimOutput) -> Result<Vec<Run>, CliError> {
-    let spin = scenario.name() == "spin";
-    let bound = |s: ConstraintSet| {
-        if spin {
-            s.with_nominal(2, SPIN_J33_NOMINAL, SPIN_J33_TOLERANCE)
-        } else {
-            s
-        }
-    };
-    let plan: [(&str, &str, EstimatorKind, ConstraintSet); 4] = [
-        (
-            "variational",
-            "variational",
-            EstimatorKind::Variational,
-            bound(ConstraintSet::paper()),
-        ),
-        (
-            "finite difference",
-            "finite_difference",
-            EstimatorKind::FiniteDifference,
-            bound(ConstraintSet::paper()),
-        ),
-        (
-            "momentum",
-            "momentum",
-            EstimatorKind::Momentum,
-            ConstraintSet::paper(),
-        ),
-        (
-            "variational, physical set",
-            "variational_physical",
-            EstimatorKind::Variational,
-            bound(ConstraintSet::physical()),
-        ),
-    ];
-    let mut runs = Vec::new();
-    for (label, file, kind, set) in plan {
-        let c = set.validate().map_err(internal)?;
-        let backend = AnyBackend::new(crate::runner::SolverKind::Native).map_err(internal)?;
-        let mut runner = Runner::new(kind, c, backend, 1).map_err(internal)?;
-        let mut history = Vec::with_capacity(out.samples.len());
-        for s in &out.samples {
-            if let Some(r) = runner.push(s).map_err(internal)? {
-                history.push(r);
-            }
-        }
-        runs.push(Run {
-            label,
-            file,
-            history,
-        });
+/// The paper's estimator (first) drawn thicker than the others.
+fn main_width(n: usize) -> u32 {
+    if n == 0 {
+        3
+    } else {
+        2
     }
-    Ok(runs)
 }
 
-fn total_error(r: &HistoryRow, truth: &Matrix3<f64>) -> f64 {
+/// Relative Frobenius error of a history row (`NaN` without an answer).
+pub fn total_error(r: &HistoryRow, truth: &Matrix3<f64>) -> f64 {
     r.j.map_or(f64::NAN, |j| {
         relative_frobenius_error(&matrix_from_j(&j), truth)
     })
@@ -136,6 +84,7 @@ fn signal_figure(
             name: format!("{prefix}_{ax}"),
             points: data.iter().map(|(t, v)| (*t, v[i])).collect(),
             color: COLORS[i],
+            width: 2,
         })
         .collect();
     plot::figure(
@@ -180,7 +129,8 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
         .runs
         .iter()
         .zip(COLORS)
-        .map(|(r, color)| Series {
+        .enumerate()
+        .map(|(n, (r, color))| Series {
             name: r.label.into(),
             points: r
                 .history
@@ -188,6 +138,7 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                 .map(|h| (h.t_s, total_error(h, truth)))
                 .collect(),
             color,
+            width: main_width(n),
         })
         .collect();
     let stem = format!("fig{:02}_{name}_total_error", first_fig);
@@ -244,8 +195,10 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                     .runs
                     .iter()
                     .zip(COLORS)
-                    .map(|(r, color)| Series {
+                    .enumerate()
+                    .map(|(n, (r, color))| Series {
                         name: r.label.into(),
+                        width: main_width(n),
                         points: r
                             .history
                             .iter()
@@ -382,7 +335,7 @@ pub fn run(a: &ReproduceArgs) -> Result<(), CliError> {
             ..Common::paper()
         };
         let out = scenario.simulate(&common).map_err(internal)?;
-        let runs = estimator_runs(&scenario, &out)?;
+        let runs = paper_estimators(&scenario, &out)?;
         let constraint_note = if scenario.name() == "spin" {
             "SDP-based estimators: the paper's constraints (J ⪰ εI, eq. 9) and J33 within 10 % of 3 kg m²; the last row uses the exact physical set (Σ ⪰ 0) with the same bound."
         } else {

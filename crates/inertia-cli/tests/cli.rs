@@ -410,3 +410,46 @@ fn unobservable_data_are_reported_not_estimated() {
     let o = inertia(&["estimate", csv.to_str().unwrap()]);
     assert!(stdout(&o).contains("NOT OBSERVABLE"));
 }
+
+/// Monte Carlo output is identical whatever the number of threads.
+#[test]
+fn monte_carlo_is_deterministic_across_thread_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut outputs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("mc{threads}"));
+        let o = Command::new(env!("CARGO_BIN_EXE_inertia"))
+            .args([
+                "monte-carlo",
+                "--scenario",
+                "spin",
+                "--runs",
+                "6",
+                "--duration",
+                "40",
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(stdout(&o).contains("| variational |"));
+        for f in [
+            "spin_error_percentiles.png",
+            "spin_error_percentiles.svg",
+            "spin_summary.md",
+        ] {
+            assert!(out.join(f).exists(), "{f}");
+        }
+        outputs.push((
+            std::fs::read_to_string(out.join("spin_error_percentiles.csv")).unwrap(),
+            std::fs::read_to_string(out.join("spin_final_errors.csv")).unwrap(),
+        ));
+    }
+    assert_eq!(outputs[0], outputs[1]);
+    // Six runs, and they differ from each other (the seeds matter).
+    let finals: Vec<&str> = outputs[0].1.lines().skip(1).collect();
+    assert_eq!(finals.len(), 6);
+    assert_ne!(finals[0].split(',').nth(2), finals[1].split(',').nth(2));
+}
