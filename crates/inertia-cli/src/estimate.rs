@@ -6,6 +6,7 @@ use crate::error::{input, internal, CliError};
 use crate::history::HistoryWriter;
 use crate::runner::{AnyBackend, EstimatorKind, HistoryRow, Runner};
 use inertia::estimator::batch;
+use inertia::estimator::excitation::{diagnose, Excitation};
 use inertia::estimator::observability::ObservabilitySettings;
 use inertia::estimator::rows::{FiniteDifferenceRows, VariationalRows};
 use inertia::estimator::EstimatorError;
@@ -62,6 +63,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     };
 
     let mut last: Option<HistoryRow> = None;
+    let excitation: Option<Excitation>;
     let mut samples = 0usize;
     let mut h_s = f64::NAN;
     let mut t_prev = f64::NAN;
@@ -103,6 +105,11 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             h.write(&row)?;
         }
         last = Some(row);
+        excitation = match a.estimator {
+            EstimatorKind::Variational => batch::reduce(&all, VariationalRows::default()).ok(),
+            _ => batch::reduce(&all, FiniteDifferenceRows::default()).ok(),
+        }
+        .map(|q| diagnose(&q));
     } else {
         let mut runner = Runner::new(a.estimator, constraints, backend, a.every).map_err(input)?;
         while let Some(item) = reader.next() {
@@ -127,6 +134,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
                 }
             }
         }
+        excitation = runner.qr().map(diagnose);
     }
     if let Some(p) = progress {
         p.finish_and_clear();
@@ -149,6 +157,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         h_s,
         last: &last,
         truth: truth.as_ref(),
+        excitation: excitation.as_ref(),
     };
     if a.json {
         println!("{}", report.json());
@@ -166,6 +175,7 @@ struct Report<'a> {
     h_s: f64,
     last: &'a HistoryRow,
     truth: Option<&'a Matrix3<f64>>,
+    excitation: Option<&'a Excitation>,
 }
 
 impl Report<'_> {
@@ -201,6 +211,13 @@ impl Report<'_> {
                 (Some(m), Some(t)) => Some(relative_frobenius_error(&m, t)),
                 _ => None,
             },
+            "excitation": self.excitation.map(|x| json!({
+                "singular_values": x.singular_values,
+                "element_sigma_kg_m2": x.element_sigma,
+                "weakest_direction": x.weakest_direction.iter().copied().collect::<Vec<_>>(),
+                "weak_elements": x.weak_elements,
+                "advice": x.advice,
+            })),
         });
         v.to_string()
     }
@@ -277,6 +294,32 @@ impl Report<'_> {
                         relative_frobenius_error(&m, t)
                     );
                 }
+            }
+        }
+        if let Some(x) = self.excitation {
+            let sv = x.singular_values;
+            let _ = writeln!(
+                s,
+                "excitation: singular values of R {}",
+                sv.iter()
+                    .map(|v| format!("{v:.2e}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            );
+            if let Some(sig) = x.element_sigma {
+                let _ = writeln!(
+                    s,
+                    "  1-sigma per element (sensor noise only) [kg m²]: {}",
+                    inertia::tensor::COMPONENT_NAMES
+                        .iter()
+                        .zip(sig)
+                        .map(|(n, v)| format!("{n} {v:.1e}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            for a in &x.advice {
+                let _ = writeln!(s, "  warning: {a}");
             }
         }
         s

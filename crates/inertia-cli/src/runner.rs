@@ -218,6 +218,15 @@ impl Runner {
         })
     }
 
+    /// The least-squares state (the SDP-based estimators only).
+    pub fn qr(&self) -> Option<&inertia::estimator::qr::RecursiveQr> {
+        match self {
+            Runner::Variational(e) => Some(e.qr()),
+            Runner::FiniteDifference(e) => Some(e.qr()),
+            Runner::Momentum(..) => None,
+        }
+    }
+
     /// Feed a sample; returns a history row when an estimate was produced.
     pub fn push(&mut self, s: &Sample) -> Result<Option<HistoryRow>, EstimatorError> {
         match self {

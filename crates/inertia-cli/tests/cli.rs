@@ -407,6 +407,15 @@ fn unobservable_data_are_reported_not_estimated() {
     assert_eq!(v["status"], "not_observable");
     assert!(v["j"].is_null());
     assert!(v["reason"].as_str().unwrap().contains("up to scale"));
+    let advice = v["excitation"]["advice"].as_array().unwrap();
+    assert!(advice[0]
+        .as_str()
+        .unwrap()
+        .contains("reaction-wheel momentum change"));
+    assert_eq!(
+        v["excitation"]["singular_values"].as_array().unwrap().len(),
+        6
+    );
     let o = inertia(&["estimate", csv.to_str().unwrap()]);
     assert!(stdout(&o).contains("NOT OBSERVABLE"));
 }

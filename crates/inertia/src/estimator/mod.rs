@@ -13,6 +13,8 @@
 
 #[cfg(feature = "std")]
 pub mod batch;
+#[cfg(feature = "std")]
+pub mod excitation;
 pub mod momentum;
 pub mod observability;
 pub mod qr;
