@@ -92,6 +92,13 @@ pub struct SimulateArgs {
     /// Output CSV file (the truth goes to the same name with `.truth.json`).
     #[arg(short = 'o', long, value_name = "FILE.csv")]
     pub output: PathBuf,
+    /// Step change of the inertia: at T seconds J becomes SCALE·J (angular momentum
+    /// conserved), e.g. `300:1.1`.
+    #[arg(long, value_name = "T:SCALE", conflicts_with = "inertia_ramp")]
+    pub inertia_step: Option<String>,
+    /// Linear change of the inertia from T0 to T1 seconds, to SCALE·J, e.g. `300:360:0.9`.
+    #[arg(long, value_name = "T0:T1:SCALE")]
+    pub inertia_ramp: Option<String>,
 }
 
 /// Constraint sets.
@@ -153,6 +160,10 @@ pub struct EstimateArgs {
     /// Solve every N samples (recursive estimators).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub every: usize,
+    /// Forget old data with this time constant, s (exponential weighting, for an inertia
+    /// that changes). Shorter memory tracks faster and is noisier (README).
+    #[arg(long, value_name = "S")]
+    pub memory: Option<f64>,
     /// True inertia (JSON) to report the relative Frobenius error against.
     #[arg(long, value_name = "J.json")]
     pub truth: Option<PathBuf>,

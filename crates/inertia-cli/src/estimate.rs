@@ -32,6 +32,16 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     if a.every == 0 {
         return Err(input("--every 0: must be at least 1"));
     }
+    if let Some(m) = a.memory {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(input(format!("--memory {m}: must be finite and > 0 s")));
+        }
+        if a.batch {
+            return Err(input(
+                "--memory applies to the recursive estimators, not --batch",
+            ));
+        }
+    }
     if a.batch && a.estimator == EstimatorKind::Momentum {
         return Err(input(
             "--batch applies to the variational and finite-difference estimators; the momentum baseline is recursive only",
@@ -111,9 +121,27 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         }
         .map(|q| diagnose(&q));
     } else {
-        let mut runner = Runner::new(a.estimator, constraints, backend, a.every).map_err(input)?;
-        while let Some(item) = reader.next() {
-            let s = item.map_err(input)?;
+        // The first two samples fix the period, and with it the forgetting factor.
+        let mut head = Vec::with_capacity(2);
+        for item in reader.by_ref().take(2) {
+            head.push(item.map_err(input)?);
+        }
+        let forgetting = match (a.memory, head.as_slice()) {
+            (Some(tau), [s0, s1]) => (-(s1.t_s - s0.t_s) / tau).exp(),
+            _ => 1.0,
+        };
+        let mut runner =
+            Runner::with_forgetting(a.estimator, constraints, backend, a.every, forgetting)
+                .map_err(input)?;
+        let mut pending = head.into_iter();
+        loop {
+            let s = match pending.next() {
+                Some(s) => s,
+                None => match reader.next() {
+                    Some(item) => item.map_err(input)?,
+                    None => break,
+                },
+            };
             samples += 1;
             if samples == 2 {
                 h_s = s.t_s - t_prev;

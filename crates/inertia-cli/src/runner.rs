@@ -197,8 +197,20 @@ impl Runner {
         backend: AnyBackend,
         every: usize,
     ) -> Result<Self, EstimatorError> {
+        Self::with_forgetting(kind, constraints, backend, every, 1.0)
+    }
+
+    /// A new runner with a forgetting factor per sample (`1`: none).
+    pub fn with_forgetting(
+        kind: EstimatorKind,
+        constraints: Constraints,
+        backend: AnyBackend,
+        every: usize,
+        forgetting: f64,
+    ) -> Result<Self, EstimatorError> {
         let settings = RecursiveSettings {
             solve_every: every,
+            forgetting,
             ..RecursiveSettings::default()
         };
         Ok(match kind {
@@ -214,7 +226,13 @@ impl Runner {
                 backend,
                 settings,
             )?),
-            EstimatorKind::Momentum => Runner::Momentum(Box::default(), every.max(1)),
+            EstimatorKind::Momentum => Runner::Momentum(
+                Box::new(MomentumRls::new(
+                    inertia::estimator::momentum::DEFAULT_P0,
+                    forgetting,
+                )),
+                every.max(1),
+            ),
         })
     }
 

@@ -462,3 +462,41 @@ fn monte_carlo_is_deterministic_across_thread_counts() {
     assert_eq!(finals.len(), 6);
     assert_ne!(finals[0].split(',').nth(2), finals[1].split(',').nth(2));
 }
+
+/// A step change of inertia: `--memory` tracks the new J, the default does not.
+#[test]
+fn memory_tracks_a_changed_inertia() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("step.csv");
+    let o = inertia(&[
+        "simulate",
+        "--scenario",
+        "slew",
+        "--inertia-step",
+        "150:1.1",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let truth = dir.path().join("step.truth.json");
+    let err = |extra: &[&str]| {
+        let mut args = vec![
+            "estimate",
+            csv.to_str().unwrap(),
+            "--constraints",
+            "paper",
+            "--json",
+            "--truth",
+            truth.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        json(&inertia(&args))["relative_error"].as_f64().unwrap()
+    };
+    let (with, without) = (err(&["--memory", "30"]), err(&[]));
+    assert!(
+        with < 2e-2 && without > 4e-2,
+        "with memory {with:e}, without {without:e}"
+    );
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--memory", "-1"]);
+    assert_eq!(o.status.code(), Some(2));
+}

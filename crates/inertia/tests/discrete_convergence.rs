@@ -48,6 +48,7 @@ fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> 
         disturbance_nm_rthz: 0.0,
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
+        inertia_change: None,
     };
     simulate(&cfg, rho, tau).expect("valid config").samples
 }

@@ -23,6 +23,7 @@ fn torque_free(
         disturbance_nm_rthz: 0.0,
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
+        inertia_change: None,
     };
     simulate(&cfg, &Zero, &Zero).unwrap()
 }

@@ -56,6 +56,7 @@ pub fn reduce<S: RowSource>(
         rss: (y_energy - z.norm_squared()).max(0.0),
         y_energy,
         rows: m,
+        weight: m as f64,
     })
 }
 

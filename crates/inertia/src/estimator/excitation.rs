@@ -50,8 +50,8 @@ pub fn diagnose(qr: &RecursiveQr) -> Excitation {
     let v_t = svd.v_t.unwrap_or_else(nalgebra::Matrix6::identity);
     let weakest = InertiaVector::from_fn(|k, _| v_t[(order[5], k)]);
     // With y ≡ 0 the residual is zero by construction: no variance to report.
-    let element_sigma = (qr.rows > 6 && sv[5] > 0.0 && qr.y_energy > 0.0).then(|| {
-        let s2 = qr.rss / (qr.rows - 6) as f64;
+    let element_sigma = (qr.weight > 6.0 && sv[5] > 0.0 && qr.y_energy > 0.0).then(|| {
+        let s2 = qr.rss / (qr.weight - 6.0);
         core::array::from_fn(|k| {
             let var: f64 = (0..6)
                 .map(|i| (v_t[(i, k)] / svd.singular_values[i]).powi(2))

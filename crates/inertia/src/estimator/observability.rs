@@ -144,13 +144,13 @@ impl Observability {
 /// `sv` are the singular values of `R`: `tr((RᵀR)⁻¹) = Σ σ_k⁻²`.
 #[must_use]
 pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
-    if qr.rows < 6 + MIN_RESIDUAL_DOF || sv.min() <= 0.0 {
+    if qr.weight < (6 + MIN_RESIDUAL_DOF) as f64 || sv.min() <= 0.0 {
         return f64::INFINITY;
     }
     let Some(j) = crate::solver::unconstrained_minimiser(&qr.r, &qr.z) else {
         return f64::INFINITY;
     };
-    let s2 = qr.rss / (qr.rows - 6) as f64;
+    let s2 = qr.rss / (qr.weight - 6.0);
     let var: f64 = sv.iter().map(|s| 1.0 / (s * s)).sum::<f64>() * s2;
     let jn = j.norm();
     if jn > 0.0 && var.is_finite() {
@@ -164,14 +164,14 @@ pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
 /// of `R`. Its relative standard deviation is `s √(Σ_{i≤5} σ_i⁻²)` with the per-row
 /// misfit `s² = σ_6²/(rows − 5)`.
 #[must_use]
-pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: usize) -> f64 {
-    if rows < 5 + MIN_RESIDUAL_DOF {
+pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: f64) -> f64 {
+    if rows < (5 + MIN_RESIDUAL_DOF) as f64 {
         return f64::INFINITY;
     }
     let mut s = *sv;
     s.as_mut_slice().sort_unstable_by(|a, b| b.total_cmp(a));
     let inv: f64 = (0..5).map(|i| 1.0 / (s[i] * s[i])).sum();
-    let r = s[5] * crate::math::sqrt(inv / (rows - 5) as f64);
+    let r = s[5] * crate::math::sqrt(inv / (rows - 5.0));
     if r.is_finite() {
         r
     } else {
@@ -215,7 +215,7 @@ pub fn assess_with(
     };
     let weak = sv.iter().filter(|&&s| s * threshold < smax).count();
     let (reason, open_directions) = if qr.y_energy == 0.0 {
-        let rel = direction_relative_sigma(&sv, qr.rows);
+        let rel = direction_relative_sigma(&sv, qr.weight);
         if rel > settings.max_relative_sigma {
             return Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: rel,

@@ -23,6 +23,9 @@ pub struct RecursiveQr {
     pub y_energy: f64,
     /// Scalar rows folded in.
     pub rows: usize,
+    /// Effective number of rows: the sum of their current weights (equals `rows` without
+    /// forgetting). Degrees of freedom of the noise statistics use this.
+    pub weight: f64,
 }
 
 impl Default for RecursiveQr {
@@ -41,6 +44,7 @@ impl RecursiveQr {
             rss: 0.0,
             y_energy: 0.0,
             rows: 0,
+            weight: 0.0,
         }
     }
 
@@ -50,6 +54,7 @@ impl RecursiveQr {
         let left = fold_row(&mut self.r, h, Some((&mut self.z, y)));
         self.rss += left * left;
         self.rows += 1;
+        self.weight += 1.0;
     }
 
     /// Fold a 3-row block `H_k j = y_k` into the factor.
@@ -66,5 +71,6 @@ impl RecursiveQr {
         self.z *= s;
         self.rss *= lambda;
         self.y_energy *= lambda;
+        self.weight *= lambda;
     }
 }

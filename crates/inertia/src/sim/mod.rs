@@ -49,6 +49,67 @@ impl InputLaw for Zero {
     }
 }
 
+/// A change of the inertia during a run (fuel use, a deployment, docking), modelled as an
+/// internal mass redistribution: total angular momentum is conserved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum InertiaChange {
+    /// At `at_s` the inertia jumps to `to_kg_m2`; the body rate jumps so that `Jω`
+    /// is unchanged.
+    Step {
+        /// Time of the step, s.
+        at_s: f64,
+        /// Inertia after it, kg m².
+        to_kg_m2: Matrix3<f64>,
+    },
+    /// Linear change from the initial inertia at `start_s` to `to_kg_m2` at `end_s`; the
+    /// term `−J̇ω` enters eq. 26.
+    Ramp {
+        /// Start, s.
+        start_s: f64,
+        /// End, s.
+        end_s: f64,
+        /// Inertia at the end, kg m².
+        to_kg_m2: Matrix3<f64>,
+    },
+}
+
+impl InertiaChange {
+    /// The inertia at `t_s`, given the initial one.
+    #[must_use]
+    pub fn inertia_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
+        match *self {
+            InertiaChange::Step { at_s, to_kg_m2 } => {
+                if t_s >= at_s {
+                    to_kg_m2
+                } else {
+                    *initial
+                }
+            }
+            InertiaChange::Ramp {
+                start_s,
+                end_s,
+                to_kg_m2,
+            } => {
+                let u = ((t_s - start_s) / (end_s - start_s)).clamp(0.0, 1.0);
+                initial + (to_kg_m2 - initial) * u
+            }
+        }
+    }
+
+    /// `J̇` at `t_s` (zero for a step).
+    #[must_use]
+    pub fn rate_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
+        match *self {
+            InertiaChange::Ramp {
+                start_s,
+                end_s,
+                to_kg_m2,
+            } if t_s >= start_s && t_s < end_s => (to_kg_m2 - initial) / (end_s - start_s),
+            _ => Matrix3::zeros(),
+        }
+    }
+}
+
 /// Simulation settings. Every field is public and overridable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimConfig {
@@ -70,6 +131,8 @@ pub struct SimConfig {
     pub gyro_noise_deg_s_rthz: f64,
     /// Seed of the noise streams.
     pub seed: u64,
+    /// A change of inertia during the run (none by default).
+    pub inertia_change: Option<InertiaChange>,
 }
 
 impl SimConfig {
@@ -96,8 +159,20 @@ pub struct SimOutput {
     pub samples: Vec<Sample>,
     /// True state, one per node.
     pub truth: Vec<TruthSample>,
-    /// True inertia, kg m².
+    /// True inertia at the start, kg m².
     pub inertia_kg_m2: Matrix3<f64>,
+    /// The inertia change, if any (see [`SimOutput::inertia_at`]).
+    pub inertia_change: Option<InertiaChange>,
+}
+
+impl SimOutput {
+    /// The true inertia at `t_s`, kg m².
+    #[must_use]
+    pub fn inertia_at(&self, t_s: f64) -> Matrix3<f64> {
+        self.inertia_change.map_or(self.inertia_kg_m2, |c| {
+            c.inertia_at(&self.inertia_kg_m2, t_s)
+        })
+    }
 }
 
 /// Why a simulation could not run.
@@ -196,6 +271,7 @@ pub fn simulate(
     let mut samples = Vec::with_capacity(n);
     let mut truth = Vec::with_capacity(n);
     // One extra interval past the last node so the last sample's rate is defined.
+    let j0 = cfg.inertia_kg_m2;
     for k in 0..n {
         let t_k = cfg.t0_s + k as f64 * h;
         let x_k = x;
@@ -204,9 +280,29 @@ pub fn simulate(
         for s in 0..sub {
             let t = t_k + s as f64 * dt;
             let d = Vector3::from_fn(|_, _| dist.sample(&mut dist_rng));
-            let f =
-                |tt: f64, xx: &GyrostatState| (rho_dot.eval(tt, xx), known_torque.eval(tt, xx) + d);
-            let (next, da) = rk4_step(&j, &j_inv, t, dt, &x, &f);
+            let (jm, jm_inv, jdot) = match &cfg.inertia_change {
+                None => (j, j_inv, Matrix3::zeros()),
+                Some(c) => {
+                    // A step inside this substep: apply it at the substep's start,
+                    // conserving angular momentum Jω.
+                    if let InertiaChange::Step { at_s, to_kg_m2 } = *c {
+                        if at_s > t - 0.5 * dt && at_s <= t + 0.5 * dt {
+                            let inv = to_kg_m2.try_inverse().unwrap_or(j_inv);
+                            x.omega_rad_s = inv * (c.inertia_at(&j0, t - dt) * x.omega_rad_s);
+                        }
+                    }
+                    let jm = c.inertia_at(&j0, t + 0.5 * dt);
+                    let inv = jm.try_inverse().unwrap_or(j_inv);
+                    (jm, inv, c.rate_at(&j0, t + 0.5 * dt))
+                }
+            };
+            let f = |tt: f64, xx: &GyrostatState| {
+                (
+                    rho_dot.eval(tt, xx),
+                    known_torque.eval(tt, xx) + d - jdot * xx.omega_rad_s,
+                )
+            };
+            let (next, da) = rk4_step(&jm, &jm_inv, t, dt, &x, &f);
             x = next;
             angle += da;
         }
@@ -232,5 +328,6 @@ pub fn simulate(
         samples,
         truth,
         inertia_kg_m2: j,
+        inertia_change: cfg.inertia_change,
     })
 }

@@ -41,6 +41,8 @@ pub struct Common {
     pub gyro_noise_deg_s_rthz: f64,
     /// Noise seed.
     pub seed: u64,
+    /// A change of inertia during the run.
+    pub inertia_change: Option<super::InertiaChange>,
 }
 
 impl Common {
@@ -55,6 +57,7 @@ impl Common {
             disturbance_nm_rthz: 1e-8,
             gyro_noise_deg_s_rthz: 1e-5,
             seed: 1,
+            inertia_change: None,
         }
     }
 
@@ -210,6 +213,7 @@ impl Scenario {
             disturbance_nm_rthz: common.disturbance_nm_rthz,
             gyro_noise_deg_s_rthz: common.gyro_noise_deg_s_rthz,
             seed: common.seed,
+            inertia_change: common.inertia_change,
         }
     }
 
