@@ -105,9 +105,9 @@ fn forgetting_tracks_a_ten_percent_step_change() {
 fn settle_time(e: &[(f64, f64)], t0: f64, tol: f64) -> Option<f64> {
     let last_bad = e
         .iter()
-        .filter(|(t, x)| *t > t0 && !(*x < tol))
-        .map(|(t, _)| *t)
-        .last();
+        .rev()
+        .find(|(t, x)| *t > t0 && !(*x < tol))
+        .map(|(t, _)| *t);
     match last_bad {
         None => Some(0.0),
         Some(t) if t < e.last()?.0 => Some(t - t0),
