@@ -128,9 +128,10 @@ pub struct InputArgs {
     /// Largest | |q| − 1 | that is renormalised (beyond it, an error).
     #[arg(long, value_name = "TOL", default_value_t = inertia::telemetry::csv::DEFAULT_UNIT_TOLERANCE)]
     pub unit_tolerance: f64,
-    /// Largest relative deviation of a step from the sample period.
-    #[arg(long, value_name = "TOL", default_value_t = inertia::telemetry::csv::DEFAULT_PERIOD_TOLERANCE)]
-    pub period_tolerance: f64,
+    /// Strict mode: reject any step that differs from the first by more than TOL
+    /// (relative). By default irregular sampling is accepted and gaps are counted.
+    #[arg(long, value_name = "TOL")]
+    pub period_tolerance: Option<f64>,
 }
 
 /// `inertia estimate`.

@@ -148,11 +148,13 @@ pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
         }
     }
     for (name, v) in [
-        ("--unit-tolerance", a.unit_tolerance),
+        ("--unit-tolerance", Some(a.unit_tolerance)),
         ("--period-tolerance", a.period_tolerance),
     ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(input(format!("{name} {v}: must be finite and > 0")));
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(input(format!("{name} {v}: must be finite and > 0")));
+            }
         }
     }
     Ok(CsvOptions {

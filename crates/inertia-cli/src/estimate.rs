@@ -227,6 +227,9 @@ impl Report<'_> {
             "sample_period_s": self.h_s,
             "renormalised": self.stats.renormalised,
             "sign_flips": self.stats.sign_flips,
+            "gaps": self.stats.gaps,
+            "min_step_s": self.stats.min_step_s,
+            "max_step_s": self.stats.max_step_s,
             "t": self.last.t_s,
             "status": self.last.status.code(),
             "reason": self.last.status.reason(),
@@ -254,10 +257,15 @@ impl Report<'_> {
         use std::fmt::Write;
         let mut s = String::new();
         let st = &self.stats;
+        let steps = if (st.max_step_s - st.min_step_s) <= 1e-9 * st.max_step_s {
+            format!("h = {:.6} s", self.h_s)
+        } else {
+            format!("steps {:.6}–{:.6} s", st.min_step_s, st.max_step_s)
+        };
         let _ = writeln!(
             s,
-            "{}: {} samples, h = {:.6} s ({} renormalised, {} sign flips)",
-            self.file, self.samples, self.h_s, st.renormalised, st.sign_flips
+            "{}: {} samples, {steps} ({} renormalised, {} sign flips, {} gaps)",
+            self.file, self.samples, st.renormalised, st.sign_flips, st.gaps
         );
         let _ = writeln!(
             s,

@@ -331,7 +331,14 @@ fn non_increasing_time() {
 fn non_uniform_period() {
     let d = tempfile::tempdir().unwrap();
     let p = bad_file(d.path(), "period", 6, &|l| field(l, 0, "0.43"));
-    assert_bad(&p, &[], &["period.csv:6", "`t`", "sample period"]);
+    // Irregular steps are accepted by default; strict mode rejects them.
+    assert_bad(
+        &p,
+        &["--period-tolerance", "1e-3"],
+        &["period.csv:6", "`t`", "sample period"],
+    );
+    let o = inertia(&["estimate", p.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]
@@ -499,4 +506,75 @@ fn memory_tracks_a_changed_inertia() {
     );
     let o = inertia(&["estimate", csv.to_str().unwrap(), "--memory", "-1"]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// Irregular telemetry: jittered steps, a gap, and ISO-8601 time stamps.
+#[test]
+fn jitter_gaps_and_iso_time_stamps() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "slew", "slew", "300");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header = text.lines().next().unwrap().to_string();
+    let rows: Vec<Vec<String>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    let write = |name: &str, keep: &dyn Fn(usize) -> bool, time: &dyn Fn(usize, f64) -> String| {
+        let mut s = header.clone() + "\n";
+        for (i, r) in rows.iter().enumerate().filter(|(i, _)| keep(*i)) {
+            let mut r = r.clone();
+            r[0] = time(i, r[0].parse().unwrap());
+            s.push_str(&r.join(","));
+            s.push('\n');
+        }
+        let p = dir.path().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    let base = json(&inertia(&["estimate", csv.to_str().unwrap(), "--json"]));
+    // Drop samples irregularly (steps of 0.1, 0.2 s) and one 10 s stretch (a gap).
+    let jittered = write(
+        "jit.csv",
+        &|i| i % 7 != 3 && !(1200..1300).contains(&i),
+        &|_, t| t.to_string(),
+    );
+    let v = json(&inertia(&[
+        "estimate",
+        jittered.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(v["gaps"].as_u64().unwrap(), 1, "{v}");
+    assert!((v["max_step_s"].as_f64().unwrap() - 10.1).abs() < 1e-6);
+    assert_eq!(v["status"], "determined");
+    for k in 0..6 {
+        let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
+        assert!((x - y).abs() < 2e-3 * (1.0 + y.abs()), "{k}: {x} vs {y}");
+    }
+    // ISO-8601 time stamps, 0.1 s apart: the same answer as seconds.
+    let iso = write("iso.csv", &|_| true, &|i, _| {
+        let tenths = 9 * 36000 + 6 * 600 + i; // from 09:06:00.0
+        format!(
+            "2026-11-21T{:02}:{:02}:{:02}.{}Z",
+            tenths / 36000,
+            (tenths / 600) % 60,
+            (tenths / 10) % 60,
+            tenths % 10
+        )
+    });
+    let v = json(&inertia(&["estimate", iso.to_str().unwrap(), "--json"]));
+    for k in 0..6 {
+        let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
+        assert!((x - y).abs() < 1e-9 * (1.0 + y.abs()), "{k}: {x} vs {y}");
+    }
+    assert!((v["t"].as_f64().unwrap() - 300.0).abs() < 1e-9);
+    // Mixed clocks are an error naming the line.
+    let mixed = write("mixed.csv", &|_| true, &|i, t| {
+        if i == 5 {
+            "2026-11-21T09:06:00Z".into()
+        } else {
+            t.to_string()
+        }
+    });
+    assert_bad(&mixed, &[], &["mixed.csv:7", "time stamp"]);
 }

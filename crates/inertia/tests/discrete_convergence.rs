@@ -76,7 +76,7 @@ fn max_residual(samples: &[Sample], variant: Variant) -> f64 {
             }
             let Row { h, mut y } = input.row().expect("row");
             if let Variant::PrintedTorqueSign = variant {
-                y -= input.h_s * input.h_s * w[1].tau_nm;
+                y -= input.h_s * input.h1_s * w[1].tau_nm;
             }
             (h * j - y).norm()
         })
@@ -232,9 +232,131 @@ mod errors {
                 what: "rotor momentum"
             })
         ));
+        // Unequal steps are fine (see the jittered-grid test); repeated times are not.
         let r = RowInput::from_samples([&sample(0.0, q), &sample(0.1, q), &sample(0.25, q)]);
-        assert!(matches!(r, Err(RowError::NonUniformStep { .. })), "{r:?}");
+        assert!(r.is_ok(), "{r:?}");
         let r = RowInput::from_samples([&sample(0.0, q), &sample(0.0, q), &sample(0.1, q)]);
         assert!(r.is_err());
+    }
+}
+
+mod jittered {
+    //! Unequal steps: the same convergence test on a grid whose steps vary by ±20 %.
+    use super::*;
+
+    /// Fine-grid increments between nodes (20 = the nominal step): a fixed seeded pattern
+    /// in 16..=24 (so every h sees the same relative jitter), or all 20.
+    fn pattern(n: usize, jitter: bool) -> Vec<usize> {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        (0..n)
+            .map(|_| {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                if jitter {
+                    16 + (seed % 9) as usize
+                } else {
+                    20
+                }
+            })
+            .collect()
+    }
+
+    fn jittered_samples(
+        h: f64,
+        rho: &dyn InputLaw,
+        tau: &dyn InputLaw,
+        jitter: bool,
+    ) -> Vec<Sample> {
+        let fine = h / 20.0;
+        let cfg = SimConfig {
+            inertia_kg_m2: paper_j_true(),
+            initial: GyrostatState {
+                q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
+                omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
+                rho_nms: Vector3::new(0.1, -0.2, 0.3),
+            },
+            t0_s: 0.0,
+            dt_s: fine,
+            samples: SimConfig::samples_for(DURATION_S, fine),
+            substeps: 4,
+            disturbance_nm_rthz: 0.0,
+            gyro_noise_deg_s_rthz: 0.0,
+            seed: 0,
+            inertia_change: None,
+        };
+        let all = simulate(&cfg, rho, tau).expect("valid config").samples;
+        let mut out = Vec::new();
+        let mut k = 0;
+        for step in pattern(all.len(), jitter) {
+            if k >= all.len() {
+                break;
+            }
+            out.push(all[k]);
+            k += step;
+        }
+        out
+    }
+
+    fn jittered_order(rho: &dyn InputLaw, tau: &dyn InputLaw, jitter: bool) -> f64 {
+        let j = j_from_matrix(&paper_j_true());
+        let pts: Vec<(f64, f64)> = STEPS
+            .iter()
+            .map(|&h| {
+                let s = jittered_samples(h, rho, tau, jitter);
+                // The steps really vary by up to ±20 %.
+                let ratios: Vec<f64> = s.windows(2).map(|w| (w[1].t_s - w[0].t_s) / h).collect();
+                let (lo, hi) = ratios
+                    .iter()
+                    .fold((f64::MAX, 0.0f64), |(a, b), &r| (a.min(r), b.max(r)));
+                assert!(!jitter || (lo < 0.85 && hi > 1.15), "{lo} {hi}");
+                let r = s
+                    .windows(3)
+                    .map(|w| {
+                        let Row { h: hm, y } = RowInput::from_samples([&w[0], &w[1], &w[2]])
+                            .unwrap()
+                            .row()
+                            .unwrap();
+                        (hm * j - y).norm()
+                    })
+                    .fold(0.0, f64::max);
+                (h.ln(), r.ln())
+            })
+            .collect();
+        let n = pts.len() as f64;
+        let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+        let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        sxy / sxx
+    }
+
+    const CASES: [(&str, &dyn InputLaw, &dyn InputLaw); 4] = [
+        ("torque-free", &Zero, &Zero),
+        ("varying rho", &rho_dot, &Zero),
+        ("torque", &Zero, &torque),
+        ("both", &rho_dot, &torque),
+    ];
+
+    /// Control: the same machinery with equal steps reproduces order 4.
+    #[test]
+    fn equal_steps_through_the_general_row_are_fourth_order() {
+        for (name, rho, tau) in CASES {
+            let p = jittered_order(rho, tau, false);
+            assert!((3.8..=4.2).contains(&p), "{name}: {p}");
+        }
+    }
+
+    /// With ±20 % jitter the variable-step discrete Euler–Lagrange equation of this
+    /// second-order discrete Lagrangian is O(h³): its per-interval error terms
+    /// (∝ h³) cancel between the two intervals only when they are equal, leaving a term
+    /// ∝ (h₁² − h₀²). Measured orders 2.96–2.98. Recovering O(h⁴) needs a higher-order
+    /// discrete Lagrangian or resampling to a uniform grid (open work).
+    #[test]
+    fn jittered_steps_are_third_order() {
+        for (name, rho, tau) in CASES {
+            let p = jittered_order(rho, tau, true);
+            assert!((2.8..=3.2).contains(&p), "{name}: {p}");
+        }
     }
 }

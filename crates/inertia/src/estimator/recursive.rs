@@ -176,6 +176,12 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         self.last.as_ref()
     }
 
+    /// Gaps in the time stamps so far (no row spans a gap).
+    #[must_use]
+    pub fn gaps(&self) -> usize {
+        self.source.gaps()
+    }
+
     /// Samples fed so far.
     #[must_use]
     pub fn samples(&self) -> usize {

@@ -6,9 +6,11 @@
 //!   k with `ω̇` differenced from the gyro rates.
 
 use crate::attitude::skew;
-use crate::discrete::{g_matrix, Row, RowError, RowInput, STEP_UNIFORMITY_TOLERANCE};
-use crate::math::abs;
+use crate::discrete::{g_matrix, Row, RowError, RowInput};
 use crate::telemetry::Sample;
+
+/// A step longer than this many times the previous one is a gap: no row spans it.
+pub const GAP_RATIO: f64 = 3.0;
 
 /// A stateful source of rows fed one sample at a time.
 pub trait RowSource {
@@ -16,17 +18,30 @@ pub trait RowSource {
     fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>>;
     /// Forget buffered samples (e.g. across a gap).
     fn reset(&mut self);
+    /// Gaps seen so far (steps longer than [`GAP_RATIO`] times the previous step).
+    fn gaps(&self) -> usize;
 }
 
-/// The last three samples.
+/// The last three samples. A step longer than [`GAP_RATIO`] times the previous one is a
+/// gap (missing samples, a pause): the window restarts after it, so no row spans it.
 #[derive(Debug, Clone, Copy, Default)]
 struct Window {
     a: Option<Sample>,
     b: Option<Sample>,
+    gaps: usize,
 }
 
 impl Window {
     fn push(&mut self, s: &Sample) -> Option<(Sample, Sample)> {
+        if let (Some(a), Some(b)) = (self.a, self.b) {
+            let (h0, h1) = (b.t_s - a.t_s, s.t_s - b.t_s);
+            if h1 > GAP_RATIO * h0 {
+                self.gaps += 1;
+                self.a = None;
+                self.b = Some(*s);
+                return None;
+            }
+        }
         let out = match (self.a, self.b) {
             (Some(a), Some(b)) => Some((a, b)),
             _ => None,
@@ -50,18 +65,28 @@ impl RowSource for VariationalRows {
     }
 
     fn reset(&mut self) {
-        self.w = Window::default();
+        self.w = Window {
+            gaps: self.w.gaps,
+            ..Window::default()
+        };
+    }
+
+    fn gaps(&self) -> usize {
+        self.w.gaps
     }
 }
 
 /// Finite-difference rows of eq. 26 at node k (the middle of three samples):
 ///
 /// ```text
-/// ω_k = (w̄_{k−1} + w̄_k)/2,   ω̇_k = (w̄_k − w̄_{k−1})/h,   ρ̇_k = (ρ_{k+1} − ρ_{k−1})/(2h)
+/// ω_k = (h₁ w̄_{k−1} + h₀ w̄_k)/(h₀ + h₁),   ω̇_k = (w̄_k − w̄_{k−1}) / ((h₀ + h₁)/2)
+/// ρ̇_k = (ρ_{k+1} − ρ_{k−1})/(h₀ + h₁)
 /// [G(ω̇_k) + S(ω_k) G(ω_k)] j = τ_k − ω_k × ρ_k − ρ̇_k
 /// ```
 ///
-/// where `w̄_k` is the gyro rate averaged over `[t_k, t_{k+1}]`.
+/// where `w̄_k` is the gyro rate averaged over `[t_k, t_{k+1}]` (so it belongs to the
+/// interval's midpoint) and `h₀`, `h₁` are the two intervals (equal for uniform
+/// sampling, where these are the usual central differences).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct FiniteDifferenceRows {
     w: Window,
@@ -74,7 +99,14 @@ impl RowSource for FiniteDifferenceRows {
     }
 
     fn reset(&mut self) {
-        self.w = Window::default();
+        self.w = Window {
+            gaps: self.w.gaps,
+            ..Window::default()
+        };
+    }
+
+    fn gaps(&self) -> usize {
+        self.w.gaps
     }
 }
 
@@ -85,9 +117,6 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
         return Err(RowError::NonFinite {
             what: "sample period",
         });
-    }
-    if abs(h1 - h0) > STEP_UNIFORMITY_TOLERANCE * h0 {
-        return Err(RowError::NonUniformStep { h0_s: h0, h1_s: h1 });
     }
     let finite = |v: &nalgebra::Vector3<f64>| v.iter().all(|x| x.is_finite());
     if !(finite(&a.omega_rad_s) && finite(&b.omega_rad_s)) {
@@ -103,8 +132,8 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
             what: "known torque",
         });
     }
-    let w = 0.5 * (a.omega_rad_s + b.omega_rad_s);
-    let wdot = (b.omega_rad_s - a.omega_rad_s) / h0;
+    let w = (a.omega_rad_s * h1 + b.omega_rad_s * h0) / (h0 + h1);
+    let wdot = (b.omega_rad_s - a.omega_rad_s) / (0.5 * (h0 + h1));
     let rho_dot = (c.rho_nms - a.rho_nms) / (h0 + h1);
     Ok(Row {
         h: g_matrix(&wdot) + skew(&w) * g_matrix(&w),

@@ -7,7 +7,7 @@
 //!
 //! | columns | meaning | required |
 //! |---|---|---|
-//! | `t` | time, s | yes |
+//! | `t` | time, s, or ISO-8601/RFC 3339 UTC time stamps (`2026-11-21T09:06:00.1Z`; converted to seconds since the first row) | yes |
 //! | `q_x,q_y,q_z,q_w` | attitude quaternion (see [`QuaternionFormat`]) | yes |
 //! | `rho_x,rho_y,rho_z` | total rotor angular momentum, N m s | yes |
 //! | `tau_x,tau_y,tau_z` | known external torque, N m | no (zero) |
@@ -18,9 +18,14 @@
 //! Every error names the file, the line and the column: unparsable numbers, NaN or
 //! infinite values, missing columns, quaternions whose norm differs from 1 by more than
 //! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
-//! non-increasing time, a sample period that differs from the first one by more than
-//! [`CsvOptions::period_tolerance`] (relative), and steps whose rotation is too large for
-//! `|φ| < 1` ([`crate::discrete::MAX_PHI_NORM`]). Consecutive quaternions of opposite
+//! non-increasing time, steps whose rotation is too large for `|φ| < 1`
+//! ([`crate::discrete::MAX_PHI_NORM`]), and, only when [`CsvOptions::period_tolerance`] is
+//! set, a step that differs from the first one by more than that (relative).
+//!
+//! Irregular sampling is accepted: the variational rows handle unequal steps. A step
+//! longer than [`crate::estimator::rows::GAP_RATIO`] times the previous one is a gap
+//! (missing samples, a pause): it is counted, its rotation is not checked (no row spans
+//! it), and the estimators restart their row window after it. Consecutive quaternions of opposite
 //! sign (`q` and `−q` are the same attitude) are accepted and counted. Nothing is dropped:
 //! a row is either returned or reported as an error, and [`ReadStats`] counts what was
 //! read, renormalised and sign-flipped.
@@ -38,8 +43,6 @@ use std::path::Path;
 
 /// Default tolerance on `| |q| − 1 |` below which quaternions are renormalised.
 pub const DEFAULT_UNIT_TOLERANCE: f64 = 1e-3;
-/// Default relative tolerance on the uniformity of the sample period.
-pub const DEFAULT_PERIOD_TOLERANCE: f64 = 1e-3;
 
 /// Where the scalar part of the quaternion is stored, and what the quaternion means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -122,8 +125,9 @@ pub struct CsvOptions {
     /// Quaternions with `| |q| − 1 |` up to this are renormalised (and counted); beyond it
     /// they are an error. Default [`DEFAULT_UNIT_TOLERANCE`].
     pub unit_tolerance: f64,
-    /// Relative tolerance on the sample period. Default [`DEFAULT_PERIOD_TOLERANCE`].
-    pub period_tolerance: f64,
+    /// When set, the relative tolerance on the uniformity of the sample period (strict
+    /// mode: a deviating step is an error). Default `None`: irregular steps are accepted.
+    pub period_tolerance: Option<f64>,
     /// Field delimiter. Default `,`.
     pub delimiter: u8,
 }
@@ -134,14 +138,14 @@ impl Default for CsvOptions {
             quaternion: QuaternionFormat::default(),
             columns: ColumnNames::default(),
             unit_tolerance: DEFAULT_UNIT_TOLERANCE,
-            period_tolerance: DEFAULT_PERIOD_TOLERANCE,
+            period_tolerance: None,
             delimiter: b',',
         }
     }
 }
 
 /// Counts of what was read.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ReadStats {
     /// Data rows returned.
     pub rows: usize,
@@ -151,6 +155,12 @@ pub struct ReadStats {
     pub sign_flips: usize,
     /// Rows rejected (the reader stops at the first; this is 0 or 1).
     pub rejected: usize,
+    /// Gaps (a step longer than `GAP_RATIO` times the previous one).
+    pub gaps: usize,
+    /// Shortest and longest step, s (0 before two rows).
+    pub min_step_s: f64,
+    /// Longest step, s.
+    pub max_step_s: f64,
 }
 
 /// What is wrong, where.
@@ -184,8 +194,8 @@ pub enum TelemetryError {
         /// The header's columns.
         present: String,
     },
-    /// A field is not a number.
-    #[error("{file}:{line}: column `{column}`: cannot parse {value:?} as a number")]
+    /// A field is not a number (or, in the time column, not a time stamp).
+    #[error("{file}:{line}: column `{column}`: cannot parse {value:?} as a number{hint}")]
     Parse {
         /// File name.
         file: String,
@@ -195,6 +205,8 @@ pub enum TelemetryError {
         column: String,
         /// The field.
         value: String,
+        /// Extra explanation (may be empty).
+        hint: &'static str,
     },
     /// A field is NaN or infinite.
     #[error("{file}:{line}: column `{column}`: value {value} is not finite")]
@@ -303,7 +315,10 @@ pub struct TelemetryReader<R: Read> {
     headers: Vec<String>,
     stats: ReadStats,
     prev: Option<Sample>,
+    prev_step: Option<f64>,
     period: Option<f64>,
+    /// For ISO time stamps: the first row's (unix seconds, nanoseconds).
+    time_origin: Option<(i64, i64)>,
     failed: bool,
 }
 
@@ -370,7 +385,9 @@ impl<R: Read> TelemetryReader<R> {
             headers,
             stats: ReadStats::default(),
             prev: None,
+            prev_step: None,
             period: None,
+            time_origin: None,
             failed: false,
         })
     }
@@ -418,6 +435,7 @@ impl<R: Read> TelemetryReader<R> {
             line,
             column: self.headers[i].clone(),
             value: raw.to_string(),
+            hint: "",
         })?;
         if !v.is_finite() {
             return Err(TelemetryError::NonFinite {
@@ -442,8 +460,48 @@ impl<R: Read> TelemetryReader<R> {
         self.idx.q.map(|i| self.headers[i].clone()).join(",")
     }
 
+    /// The time column: seconds, or an ISO-8601/RFC 3339 time stamp converted to seconds
+    /// since the first row's.
+    fn time(&mut self, line: u64) -> Result<f64, TelemetryError> {
+        let i = self.idx.t;
+        let raw = self.record.get(i).unwrap_or("").trim();
+        if self.time_origin.is_none() {
+            if let Ok(v) = raw.parse::<f64>() {
+                return if v.is_finite() {
+                    Ok(v)
+                } else {
+                    Err(TelemetryError::NonFinite {
+                        file: self.file.clone(),
+                        line,
+                        column: self.headers[i].clone(),
+                        value: v,
+                    })
+                };
+            }
+        }
+        let stamp = parse_time_stamp(raw).ok_or_else(|| TelemetryError::Parse {
+            file: self.file.clone(),
+            line,
+            column: self.headers[i].clone(),
+            value: raw.to_string(),
+            hint: " or an ISO-8601 time stamp (e.g. 2026-11-21T09:06:00.1Z)",
+        })?;
+        if self.prev.is_some() && self.time_origin.is_none() {
+            // Seconds so far, a time stamp now: not the same clock.
+            return Err(TelemetryError::Parse {
+                file: self.file.clone(),
+                line,
+                column: self.headers[i].clone(),
+                value: raw.to_string(),
+                hint: " (earlier rows hold seconds, this one a time stamp)",
+            });
+        }
+        let origin = *self.time_origin.get_or_insert(stamp);
+        Ok((stamp.0 - origin.0) as f64 + (stamp.1 - origin.1) as f64 * 1e-9)
+    }
+
     fn parse_row(&mut self, line: u64) -> Result<Sample, TelemetryError> {
-        let t = self.field(line, self.idx.t)?;
+        let t = self.time(line)?;
         let c = [
             self.field(line, self.idx.q[0])?,
             self.field(line, self.idx.q[1])?,
@@ -494,32 +552,49 @@ impl<R: Read> TelemetryReader<R> {
                     previous: prev.t_s,
                 });
             }
-            match self.period {
-                None => self.period = Some(dt),
-                Some(p) => {
-                    if (dt - p).abs() > self.options.period_tolerance * p {
-                        return Err(TelemetryError::NonUniformPeriod {
-                            file: self.file.clone(),
-                            line,
-                            column: self.headers[self.idx.t].clone(),
-                            dt,
-                            period: p,
-                            tolerance: self.options.period_tolerance,
-                        });
+            if let Some(tol) = self.options.period_tolerance {
+                match self.period {
+                    None => self.period = Some(dt),
+                    Some(p) => {
+                        if (dt - p).abs() > tol * p {
+                            return Err(TelemetryError::NonUniformPeriod {
+                                file: self.file.clone(),
+                                line,
+                                column: self.headers[self.idx.t].clone(),
+                                dt,
+                                period: p,
+                                tolerance: tol,
+                            });
+                        }
                     }
                 }
             }
+            let gap = self
+                .prev_step
+                .is_some_and(|h| dt > crate::estimator::rows::GAP_RATIO * h);
+            if gap {
+                self.stats.gaps += 1;
+            }
+            self.stats.min_step_s = if self.prev_step.is_some() {
+                self.stats.min_step_s.min(dt)
+            } else {
+                dt
+            };
+            self.stats.max_step_s = self.stats.max_step_s.max(dt);
+            self.prev_step = Some(dt);
             if prev.q.v.dot(&q.v) + prev.q.s * q.s < 0.0 {
                 self.stats.sign_flips += 1;
             }
-            check_phi(&incremental_rotation(&prev.q, &q), 0).map_err(|source| {
-                TelemetryError::StepTooLarge {
-                    file: self.file.clone(),
-                    line,
-                    columns: self.q_columns(),
-                    source,
-                }
-            })?;
+            if !gap {
+                check_phi(&incremental_rotation(&prev.q, &q), 0).map_err(|source| {
+                    TelemetryError::StepTooLarge {
+                        file: self.file.clone(),
+                        line,
+                        columns: self.q_columns(),
+                        source,
+                    }
+                })?;
+            }
         }
         Ok(Sample {
             t_s: t,
@@ -529,6 +604,17 @@ impl<R: Read> TelemetryReader<R> {
             omega_rad_s: w,
         })
     }
+}
+
+/// An ISO-8601 / RFC 3339 time stamp as (unix seconds, nanoseconds); without an offset it
+/// is taken as UTC.
+fn parse_time_stamp(raw: &str) -> Option<(i64, i64)> {
+    use time::format_description::well_known::{Iso8601, Rfc3339};
+    let dt = time::OffsetDateTime::parse(raw, &Rfc3339)
+        .or_else(|_| time::OffsetDateTime::parse(raw, &Iso8601::DEFAULT))
+        .or_else(|_| time::PrimitiveDateTime::parse(raw, &Iso8601::DEFAULT).map(|p| p.assume_utc()))
+        .ok()?;
+    Some((dt.unix_timestamp(), i64::from(dt.nanosecond())))
 }
 
 fn csv_error(file: &str, e: &csv::Error) -> TelemetryError {
