@@ -165,6 +165,10 @@ pub struct EstimateArgs {
     /// that changes). Shorter memory tracks faster and is noisier (README).
     #[arg(long, value_name = "S")]
     pub memory: Option<f64>,
+    /// The gyro's rate-noise density, deg/s/√Hz: compensates the errors-in-variables bias
+    /// of the variational estimator (README). Without it, no compensation.
+    #[arg(long, value_name = "DEG_S_RTHZ")]
+    pub gyro_noise: Option<f64>,
     /// True inertia (JSON) to report the relative Frobenius error against.
     #[arg(long, value_name = "J.json")]
     pub truth: Option<PathBuf>,

@@ -32,6 +32,14 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     if a.every == 0 {
         return Err(input("--every 0: must be at least 1"));
     }
+    if let Some(g) = a.gyro_noise {
+        if !(g.is_finite() && g >= 0.0) {
+            return Err(input(format!(
+                "--gyro-noise {g}: must be finite and >= 0 deg/s/√Hz"
+            )));
+        }
+    }
+    let gyro_rad = a.gyro_noise.map(f64::to_radians);
     if let Some(m) = a.memory {
         if !(m.is_finite() && m > 0.0) {
             return Err(input(format!("--memory {m}: must be finite and > 0 s")));
@@ -94,6 +102,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
                 &constraints,
                 &mut backend,
                 &obs,
+                gyro_rad,
             ),
             _ => batch::estimate(
                 &all,
@@ -101,6 +110,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
                 &constraints,
                 &mut backend,
                 &obs,
+                None,
             ),
         };
         let est = est.map_err(|e| match e {
@@ -130,9 +140,14 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             (Some(tau), [s0, s1]) => (-(s1.t_s - s0.t_s) / tau).exp(),
             _ => 1.0,
         };
+        let settings = inertia::estimator::recursive::RecursiveSettings {
+            solve_every: a.every,
+            forgetting,
+            gyro_noise_rad_s_rthz: gyro_rad,
+            ..Default::default()
+        };
         let mut runner =
-            Runner::with_forgetting(a.estimator, constraints, backend, a.every, forgetting)
-                .map_err(input)?;
+            Runner::with_settings(a.estimator, constraints, backend, settings).map_err(input)?;
         let mut pending = head.into_iter();
         loop {
             let s = match pending.next() {

@@ -80,7 +80,7 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
             let out = sc
                 .simulate(&common(a.seed.wrapping_add(i)))
                 .map_err(input)?;
-            let runs = paper_estimators(&sc, &out)?;
+            let runs = paper_estimators(&sc, &out, a.gyro_noise.to_radians())?;
             let errors = runs
                 .iter()
                 .map(|r| {
@@ -117,7 +117,7 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
             })
             .map_err(internal)?;
         times.extend(out.samples.iter().map(|s| s.t_s));
-        for r in paper_estimators(&sc, &out)? {
+        for r in paper_estimators(&sc, &out, a.gyro_noise.to_radians())? {
             labels.push(r.label);
             files.push(r.file);
         }

@@ -47,11 +47,12 @@ pub struct Panel {
 }
 
 /// A palette that stays readable in print.
-pub const COLORS: [RGBColor; 4] = [
+pub const COLORS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
 ];
 
 /// Write `stem.png` and `stem.svg`: panels stacked vertically, sharing the x label.

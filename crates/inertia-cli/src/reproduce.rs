@@ -335,7 +335,7 @@ pub fn run(a: &ReproduceArgs) -> Result<(), CliError> {
             ..Common::paper()
         };
         let out = scenario.simulate(&common).map_err(internal)?;
-        let runs = paper_estimators(&scenario, &out)?;
+        let runs = paper_estimators(&scenario, &out, common.gyro_noise_deg_s_rthz.to_radians())?;
         let constraint_note = if scenario.name() == "spin" {
             "SDP-based estimators: the paper's constraints (J ⪰ εI, eq. 9) and J33 within 10 % of 3 kg m²; the last row uses the exact physical set (Σ ⪰ 0) with the same bound."
         } else {

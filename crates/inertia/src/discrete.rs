@@ -119,6 +119,12 @@ pub struct Row {
     pub h: Matrix3x6<f64>,
     /// `y_k` (3).
     pub y: Vector3<f64>,
+    /// Errors-in-variables coefficient, s: white gyro noise of density σ (rad/s/√Hz)
+    /// perturbs each φ by `δφ ≈ n/2` with per-axis variance `σ² h/4`, so to first order
+    /// it adds `σ² · noise_s · D`, `D = diag(1, 1, 1, 2, 2, 2)`, to `E[H_kᵀ H_k]`;
+    /// `noise_s = (h̄²/h₀ + h̄²/h₁)/4` (`h/2` for equal steps). Zero for rows whose noise
+    /// is not modelled.
+    pub noise_s: f64,
 }
 
 /// The inputs of one row once incremental rotations are known.
@@ -239,6 +245,7 @@ impl RowInput {
         let h = n * g_matrix(&self.phi_k1) * w1 - m * g_matrix(&self.phi_k) * w0;
         let y = (m * self.rho_k_nms - n * self.rho_k1_nms) * (0.5 * hbar)
             + self.tau_k1_nm * (0.5 * hbar * hbar);
-        Ok(Row { h, y })
+        let noise_s = 0.25 * hbar * hbar * (1.0 / self.h_s + 1.0 / self.h1_s);
+        Ok(Row { h, y, noise_s })
     }
 }

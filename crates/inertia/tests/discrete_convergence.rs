@@ -74,7 +74,7 @@ fn max_residual(samples: &[Sample], variant: Variant) -> f64 {
                 input.rho_k_nms = w[0].rho_nms;
                 input.rho_k1_nms = w[1].rho_nms;
             }
-            let Row { h, mut y } = input.row().expect("row");
+            let Row { h, mut y, .. } = input.row().expect("row");
             if let Variant::PrintedTorqueSign = variant {
                 y -= input.h_s * input.h1_s * w[1].tau_nm;
             }
@@ -313,7 +313,7 @@ mod jittered {
                 let r = s
                     .windows(3)
                     .map(|w| {
-                        let Row { h: hm, y } = RowInput::from_samples([&w[0], &w[1], &w[2]])
+                        let Row { h: hm, y, .. } = RowInput::from_samples([&w[0], &w[1], &w[2]])
                             .unwrap()
                             .row()
                             .unwrap();

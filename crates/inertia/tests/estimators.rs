@@ -183,6 +183,7 @@ fn recursive_equals_batch_at_every_step() {
                 &c,
                 &mut NativeSolver::default(),
                 &ObservabilitySettings::default(),
+                None,
             )
             .unwrap();
             // The least-squares states agree.
@@ -406,6 +407,7 @@ fn too_few_samples_and_bad_rows_are_errors() {
         &c,
         &mut NativeSolver::default(),
         &ObservabilitySettings::default(),
+        None,
     );
     assert_eq!(
         r.unwrap_err(),
@@ -486,4 +488,77 @@ fn excitation_diagnostics() {
     let sig = x.element_sigma.unwrap();
     assert!(sig.iter().all(|s| *s > 0.0 && *s < 1e-3), "{sig:?}");
     assert!(x.singular_values.windows(2).all(|w| w[0] >= w[1]));
+}
+
+/// Errors-in-variables bias compensation: given the gyro noise density, the variational
+/// estimate no longer shrinks towards zero as the noise grows (README noise sweep).
+#[test]
+fn bias_compensation_removes_the_errors_in_variables_shrinkage() {
+    let c = ConstraintSet::paper().validate().unwrap();
+    for (gyro_deg, plain_min, compensated_max) in [(1e-4, 1e-3, 3e-4), (1e-3, 0.1, 2.5e-2)] {
+        let out = Scenario::slew()
+            .simulate(&Common {
+                gyro_noise_deg_s_rthz: gyro_deg,
+                ..Common::paper()
+            })
+            .unwrap();
+        let run = |g: Option<f64>| {
+            let mut e = RecursiveEstimator::new(
+                VariationalRows::default(),
+                c,
+                NativeSolver::default(),
+                RecursiveSettings {
+                    gyro_noise_rad_s_rthz: g,
+                    ..RecursiveSettings::default()
+                },
+            )
+            .unwrap();
+            let est: Vec<Estimate> = out
+                .samples
+                .iter()
+                .filter_map(|s| e.push(s).unwrap())
+                .collect();
+            final_error(&est, &out.inertia_kg_m2)
+        };
+        let (plain, comp) = (run(None), run(Some(gyro_deg.to_radians())));
+        assert!(plain > plain_min, "{gyro_deg}: plain {plain:e}");
+        assert!(comp < compensated_max, "{gyro_deg}: compensated {comp:e}");
+        // The batch estimator compensates the same way.
+        let b = batch::estimate(
+            &out.samples,
+            VariationalRows::default(),
+            &c,
+            &mut NativeSolver::default(),
+            &ObservabilitySettings::default(),
+            Some(gyro_deg.to_radians()),
+        )
+        .unwrap();
+        let eb = relative_frobenius_error(&b.inertia().unwrap(), &out.inertia_kg_m2);
+        assert!((eb - comp).abs() < 1e-6, "{eb:e} vs {comp:e}");
+    }
+    // Noise far beyond the excitation: reported, not estimated.
+    let out = Scenario::slew()
+        .simulate(&Common {
+            gyro_noise_deg_s_rthz: 1e-1,
+            duration_s: Some(60.0),
+            ..Common::paper()
+        })
+        .unwrap();
+    let mut e = RecursiveEstimator::new(
+        VariationalRows::default(),
+        c,
+        NativeSolver::default(),
+        RecursiveSettings {
+            gyro_noise_rad_s_rthz: Some(1e-1f64.to_radians()),
+            ..RecursiveSettings::default()
+        },
+    )
+    .unwrap();
+    let last = out
+        .samples
+        .iter()
+        .filter_map(|s| e.push(s).unwrap())
+        .last()
+        .unwrap();
+    assert!(!last.observability.has_answer(), "{:?}", last.observability);
 }

@@ -8,7 +8,7 @@ use super::qr::RecursiveQr;
 use super::rows::RowSource;
 use super::{Estimate, EstimatorError, MIN_SAMPLES};
 use crate::constraints::Constraints;
-use crate::solver::{solve, Backend};
+use crate::solver::Backend;
 use crate::telemetry::Sample;
 use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
 
@@ -23,11 +23,13 @@ pub fn reduce<S: RowSource>(
             got: samples.len(),
         });
     }
+    let mut noise_s = 0.0;
     let mut h = Vec::with_capacity(samples.len() * 18);
     let mut y = Vec::with_capacity(samples.len() * 3);
     for (i, s) in samples.iter().enumerate() {
         if let Some(row) = source.push(s) {
             let row = row.map_err(|source| EstimatorError::Row { sample: i, source })?;
+            noise_s += row.noise_s;
             for r in 0..3 {
                 h.extend(row.h.row(r).iter());
                 y.push(row.y[r]);
@@ -57,6 +59,7 @@ pub fn reduce<S: RowSource>(
         y_energy,
         rows: m,
         weight: m as f64,
+        noise_s,
     })
 }
 
@@ -67,14 +70,18 @@ pub fn estimate<S: RowSource>(
     constraints: &Constraints,
     backend: &mut dyn Backend,
     observability: &ObservabilitySettings,
+    gyro_noise_rad_s_rthz: Option<f64>,
 ) -> Result<Estimate, EstimatorError> {
     let qr = reduce(samples, source)?;
     let observability = assess(&qr, constraints.set().has_bounds(), observability);
-    let solution = if observability.has_answer() {
-        Some(solve(backend, &qr.r, &qr.z, constraints, None)?)
-    } else {
-        None
-    };
+    let (solution, observability) = super::recursive::solve_with(
+        backend,
+        &qr,
+        constraints,
+        observability,
+        gyro_noise_rad_s_rthz,
+        None,
+    )?;
     Ok(Estimate {
         t_s: samples.last().map_or(0.0, |s| s.t_s),
         rows: qr.rows,

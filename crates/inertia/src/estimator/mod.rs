@@ -13,6 +13,7 @@
 
 #[cfg(feature = "std")]
 pub mod batch;
+pub mod compensation;
 #[cfg(feature = "std")]
 pub mod excitation;
 pub mod momentum;

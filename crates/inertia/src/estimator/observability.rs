@@ -70,6 +70,9 @@ pub enum Unobservable {
         /// The threshold it exceeds.
         threshold: f64,
     },
+    /// With errors-in-variables compensation, the gyro noise outweighs the excitation
+    /// (the compensated information matrix is not positive definite).
+    NoiseDominated,
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -106,6 +109,10 @@ impl core::fmt::Display for Unobservable {
                     )
                 }
             }
+            Unobservable::NoiseDominated => write!(
+                f,
+                "the gyro noise outweighs the excitation: the noise-compensated information matrix is not positive definite"
+            ),
             Unobservable::IllConditioned {
                 condition,
                 threshold,

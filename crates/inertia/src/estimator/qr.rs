@@ -26,6 +26,9 @@ pub struct RecursiveQr {
     /// Effective number of rows: the sum of their current weights (equals `rows` without
     /// forgetting). Degrees of freedom of the noise statistics use this.
     pub weight: f64,
+    /// Sum of the rows' errors-in-variables coefficients `noise_s` (weighted like the
+    /// rows), s; see [`crate::discrete::Row::noise_s`].
+    pub noise_s: f64,
 }
 
 impl Default for RecursiveQr {
@@ -45,6 +48,7 @@ impl RecursiveQr {
             y_energy: 0.0,
             rows: 0,
             weight: 0.0,
+            noise_s: 0.0,
         }
     }
 
@@ -64,6 +68,12 @@ impl RecursiveQr {
         }
     }
 
+    /// Fold a row block, including its errors-in-variables coefficient.
+    pub fn add(&mut self, row: &crate::discrete::Row) {
+        self.add_block(&row.h, &row.y);
+        self.noise_s += row.noise_s;
+    }
+
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
     pub fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);
@@ -72,5 +82,6 @@ impl RecursiveQr {
         self.rss *= lambda;
         self.y_energy *= lambda;
         self.weight *= lambda;
+        self.noise_s *= lambda;
     }
 }

@@ -26,6 +26,9 @@ pub struct RecursiveSettings {
     pub observability: ObservabilitySettings,
     /// Exponential forgetting factor per block, `0 < λ ≤ 1` (default 1: no forgetting).
     pub forgetting: f64,
+    /// Gyro rate-noise density, rad/s/√Hz, for errors-in-variables bias compensation
+    /// ([`super::compensation`]); `None` (default): no compensation.
+    pub gyro_noise_rad_s_rthz: Option<f64>,
 }
 
 impl Default for RecursiveSettings {
@@ -34,6 +37,7 @@ impl Default for RecursiveSettings {
             solve_every: 1,
             observability: ObservabilitySettings::default(),
             forgetting: 1.0,
+            gyro_noise_rad_s_rthz: None,
         }
     }
 }
@@ -59,6 +63,14 @@ impl RecursiveSettings {
                 field: "max_relative_sigma",
                 why: "must be > 0",
             });
+        }
+        if let Some(g) = self.gyro_noise_rad_s_rthz {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(EstimatorError::InvalidSetting {
+                    field: "gyro_noise_rad_s_rthz",
+                    why: "must be finite and >= 0",
+                });
+            }
         }
         if !(self.forgetting > 0.0 && self.forgetting <= 1.0) {
             return Err(EstimatorError::InvalidSetting {
@@ -124,7 +136,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         if self.settings.forgetting < 1.0 {
             self.qr.scale(self.settings.forgetting);
         }
-        self.qr.add_block(&row.h, &row.y);
+        self.qr.add(&row);
         self.since_solve += 1;
         if self.since_solve < self.settings.solve_every || self.qr.rows < 6 {
             return Ok(None);
@@ -142,18 +154,14 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             self.constraints.set().has_bounds(),
             &self.settings.observability,
         );
-        let solution = if observability.has_answer() {
-            let warm = self.last.and_then(|e| e.j());
-            Some(solve(
-                &mut self.backend,
-                &self.qr.r,
-                &self.qr.z,
-                &self.constraints,
-                warm.as_ref(),
-            )?)
-        } else {
-            None
-        };
+        let (solution, observability) = solve_with(
+            &mut self.backend,
+            &self.qr,
+            &self.constraints,
+            observability,
+            self.settings.gyro_noise_rad_s_rthz,
+            self.last.and_then(|e| e.j()).as_ref(),
+        )?;
         let e = Estimate {
             t_s,
             rows: self.qr.rows,
@@ -196,5 +204,59 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             self.constraints.set().has_bounds(),
             &self.settings.observability,
         )
+    }
+}
+
+/// Solve (with errors-in-variables compensation when a gyro noise is given) when the
+/// observability allows an answer. Shared by the recursive and batch estimators.
+pub(crate) fn solve_with<B: Backend + ?Sized>(
+    backend: &mut B,
+    qr: &RecursiveQr,
+    constraints: &Constraints,
+    observability: Observability,
+    gyro_noise_rad_s_rthz: Option<f64>,
+    warm: Option<&crate::tensor::InertiaVector>,
+) -> Result<(Option<crate::solver::Solution>, Observability), EstimatorError> {
+    if !observability.has_answer() {
+        return Ok((None, observability));
+    }
+    let (r, z) = match gyro_noise_rad_s_rthz {
+        Some(g) if g > 0.0 && qr.noise_s > 0.0 => {
+            match super::compensation::compensate(qr, g) {
+                Some(rz) => rz,
+                // The open direction is the prior's to fix: solve uncompensated.
+                None if matches!(observability, Observability::FromPrior(_)) => (qr.r, qr.z),
+                None => {
+                    return Ok((
+                        None,
+                        Observability::NotObservable(
+                            super::observability::Unobservable::NoiseDominated,
+                        ),
+                    ))
+                }
+            }
+        }
+        _ => (qr.r, qr.z),
+    };
+    let sol = solve(&mut BackendRef(backend), &r, &z, constraints, warm)?;
+    Ok((Some(sol), observability))
+}
+
+/// Adapter so that `solve` can take an unsized backend.
+struct BackendRef<'a, B: Backend + ?Sized>(&'a mut B);
+
+impl<B: Backend + ?Sized> Backend for BackendRef<'_, B> {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+
+    fn solve_scaled(
+        &mut self,
+        r: &nalgebra::Matrix6<f64>,
+        z: &nalgebra::Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&crate::tensor::InertiaVector>,
+    ) -> Result<crate::solver::Solution, crate::solver::SolveError> {
+        self.0.solve_scaled(r, z, constraints, warm)
     }
 }

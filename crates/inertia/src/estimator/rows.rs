@@ -138,5 +138,7 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
     Ok(Row {
         h: g_matrix(&wdot) + skew(&w) * g_matrix(&w),
         y: b.tau_nm - w.cross(&b.rho_nms) - rho_dot,
+        // The gyro noise of these rows (differenced rates) is not modelled.
+        noise_s: 0.0,
     })
 }
