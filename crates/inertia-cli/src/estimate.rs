@@ -252,6 +252,8 @@ impl Report<'_> {
             "inertia": m.as_ref().map(rows),
             "j": self.last.j.map(|j| j.iter().copied().collect::<Vec<_>>()),
             "principal_moments": pr.map(|(v, _)| v.iter().copied().collect::<Vec<_>>()),
+            "sigma": self.last.uncertainty.map(|u| u.sigma_kg_m2),
+            "principal_moments_sigma": self.last.uncertainty.map(|u| u.principal_sigma_kg_m2),
             "principal_axes": pr.map(|(_, ax)| rows(&ax)),
             "relative_error": match (m, self.truth) {
                 (Some(m), Some(t)) => Some(relative_frobenius_error(&m, t)),
@@ -322,12 +324,31 @@ impl Report<'_> {
                         m[(r, 2)]
                     );
                 }
+                if let Some(u) = self.last.uncertainty {
+                    let _ = writeln!(s, "elements, ± one standard deviation (noise and discretisation bias) [kg m²]:");
+                    let j = self.last.j.unwrap_or_default();
+                    for (k, name) in inertia::tensor::COMPONENT_NAMES.iter().enumerate() {
+                        let _ = writeln!(s, "  {name} = {:>12.6} ± {:.2e}", j[k], u.sigma_kg_m2[k]);
+                    }
+                }
                 let (pm, ax) = principal(&m);
-                let _ = writeln!(
-                    s,
-                    "principal moments [kg m²]: {:.6}  {:.6}  {:.6}",
-                    pm[0], pm[1], pm[2]
-                );
+                match self.last.uncertainty {
+                    Some(u) => {
+                        let ps = u.principal_sigma_kg_m2;
+                        let _ = writeln!(
+                            s,
+                            "principal moments [kg m²]: {:.6} ± {:.1e}  {:.6} ± {:.1e}  {:.6} ± {:.1e}",
+                            pm[0], ps[0], pm[1], ps[1], pm[2], ps[2]
+                        );
+                    }
+                    None => {
+                        let _ = writeln!(
+                            s,
+                            "principal moments [kg m²]: {:.6}  {:.6}  {:.6}",
+                            pm[0], pm[1], pm[2]
+                        );
+                    }
+                }
                 let _ = writeln!(s, "principal axes (columns, body axes):");
                 for r in 0..3 {
                     let _ = writeln!(

@@ -1,4 +1,6 @@
-//! Estimate histories as CSV: `t,J11,J22,J33,J12,J13,J23,status,condition,iterations,reason`.
+//! Estimate histories as CSV:
+//! `t,J11,J22,J33,J12,J13,J23,status,condition,iterations,sJ11,…,sJ23,reason` (the `s`
+//! columns are standard deviations, kg m², of the variational estimator).
 
 use crate::error::{write_failed, CliError};
 use crate::runner::HistoryRow;
@@ -7,7 +9,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// The header.
-pub const HEADER: [&str; 11] = [
+pub const HEADER: [&str; 17] = [
     "t",
     "J11",
     "J22",
@@ -18,6 +20,12 @@ pub const HEADER: [&str; 11] = [
     "status",
     "condition",
     "iterations",
+    "sJ11",
+    "sJ22",
+    "sJ33",
+    "sJ12",
+    "sJ13",
+    "sJ23",
     "reason",
 ];
 
@@ -56,6 +64,9 @@ impl HistoryWriter {
             self.w.write_field(r.status.code())?;
             field(&mut self.w, r.condition)?;
             field(&mut self.w, r.iterations.map(f64::from))?;
+            for k in 0..6 {
+                field(&mut self.w, r.uncertainty.map(|u| u.sigma_kg_m2[k]))?;
+            }
             self.w.write_field(r.status.reason().unwrap_or(""))?;
             self.w.write_record(None::<&[u8]>)
         })();

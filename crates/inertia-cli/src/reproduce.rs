@@ -31,6 +31,32 @@ struct Case {
     constraint_note: &'static str,
 }
 
+/// The variational estimator's 3σ envelope for element `k`, normalised like the errors.
+fn sigma_series(case: &Case, k: usize, truth: &Matrix3<f64>) -> Vec<Series> {
+    let (r, c) = inertia::tensor::COMPONENT_INDEX[k];
+    let scale = if r == c {
+        truth[(r, r)]
+    } else {
+        (truth[(r, r)] * truth[(c, c)]).sqrt()
+    };
+    vec![Series {
+        name: format!("{}: 3σ", case.runs[0].label),
+        points: case.runs[0]
+            .history
+            .iter()
+            .map(|h| {
+                (
+                    h.t_s,
+                    h.uncertainty
+                        .map_or(f64::NAN, |u| 3.0 * u.sigma_kg_m2[k] / scale),
+                )
+            })
+            .collect(),
+        color: COLORS[0],
+        width: 1,
+    }]
+}
+
 /// The paper's estimator (first) drawn thicker than the others.
 fn main_width(n: usize) -> u32 {
     if n == 0 {
@@ -141,6 +167,29 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
             width: main_width(n),
         })
         .collect();
+    // The variational estimator's 3σ envelope: ‖ΔJ‖_F has variance Σ_diag σ² + 2 Σ_off σ².
+    let jt_norm = truth.norm();
+    let mut series = series;
+    series.push(Series {
+        name: format!("{}: 3σ", case.runs[0].label),
+        points: case.runs[0]
+            .history
+            .iter()
+            .map(|h| {
+                let v = h.uncertainty.map_or(f64::NAN, |u| {
+                    let s = u.sigma_kg_m2;
+                    (s[0] * s[0]
+                        + s[1] * s[1]
+                        + s[2] * s[2]
+                        + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
+                        .sqrt()
+                });
+                (h.t_s, 3.0 * v / jt_norm)
+            })
+            .collect(),
+        color: COLORS[0],
+        width: 1,
+    });
     let stem = format!("fig{:02}_{name}_total_error", first_fig);
     plot::figure(
         &dir.join(&stem),
@@ -191,27 +240,32 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                     "|ΔJ_ij| / √(J_ii J_jj)".into()
                 },
                 log_y: true,
-                series: case
-                    .runs
-                    .iter()
-                    .zip(COLORS)
-                    .enumerate()
-                    .map(|(n, (r, color))| Series {
-                        name: r.label.into(),
-                        width: main_width(n),
-                        points: r
-                            .history
-                            .iter()
-                            .map(|h| {
-                                let e = h.j.map_or(f64::NAN, |j| {
-                                    normalized_element_errors(&matrix_from_j(&j), truth)[k].abs()
-                                });
-                                (h.t_s, e)
-                            })
-                            .collect(),
-                        color,
-                    })
-                    .collect(),
+                series: {
+                    let mut v: Vec<Series> = case
+                        .runs
+                        .iter()
+                        .zip(COLORS)
+                        .enumerate()
+                        .map(|(n, (r, color))| Series {
+                            name: r.label.into(),
+                            width: main_width(n),
+                            points: r
+                                .history
+                                .iter()
+                                .map(|h| {
+                                    let e = h.j.map_or(f64::NAN, |j| {
+                                        normalized_element_errors(&matrix_from_j(&j), truth)[k]
+                                            .abs()
+                                    });
+                                    (h.t_s, e)
+                                })
+                                .collect(),
+                            color,
+                        })
+                        .collect();
+                    v.extend(sigma_series(case, k, truth));
+                    v
+                },
             })
             .collect();
         let stem = format!("fig{fig:02}_{name}_{kind}_errors");

@@ -145,6 +145,8 @@ pub struct HistoryRow {
     pub condition: Option<f64>,
     /// Solver iterations (0 on the fast path).
     pub iterations: Option<u32>,
+    /// Standard deviation per element and per principal moment (variational estimator).
+    pub uncertainty: Option<inertia::estimator::uncertainty::Uncertainty>,
 }
 
 impl HistoryRow {
@@ -161,14 +163,20 @@ impl HistoryRow {
             status,
             condition,
             iterations: e.solution.map(|s| s.iterations),
+            uncertainty: None,
         }
     }
 }
 
 /// An estimator of any kind.
 pub enum Runner {
-    /// Variational.
-    Variational(Box<RecursiveEstimator<VariationalRows, AnyBackend>>),
+    /// Variational, with its half-rate shadow (every other sample) for the
+    /// discretisation-bias part of the uncertainty, and a sample counter.
+    Variational(
+        Box<RecursiveEstimator<VariationalRows, AnyBackend>>,
+        Box<RecursiveEstimator<VariationalRows, AnyBackend>>,
+        usize,
+    ),
     /// Finite difference.
     FiniteDifference(Box<RecursiveEstimator<FiniteDifferenceRows, AnyBackend>>),
     /// Momentum.
@@ -199,12 +207,29 @@ impl Runner {
     ) -> Result<Self, EstimatorError> {
         let (every, forgetting) = (settings.solve_every, settings.forgetting);
         Ok(match kind {
-            EstimatorKind::Variational => Runner::Variational(recursive(
-                VariationalRows::default(),
-                constraints,
-                backend,
-                settings,
-            )?),
+            EstimatorKind::Variational => {
+                let half_backend = match &backend {
+                    AnyBackend::Native(b) => AnyBackend::Native(*b),
+                    #[cfg(feature = "clarabel")]
+                    AnyBackend::Clarabel(b) => AnyBackend::Clarabel(b.clone()),
+                };
+                // The shadow sees every other sample: twice the step, the same memory.
+                let half_settings = RecursiveSettings {
+                    forgetting: settings.forgetting * settings.forgetting,
+                    solve_every: settings.solve_every.div_ceil(2),
+                    ..settings
+                };
+                Runner::Variational(
+                    recursive(VariationalRows::default(), constraints, backend, settings)?,
+                    recursive(
+                        VariationalRows::default(),
+                        constraints,
+                        half_backend,
+                        half_settings,
+                    )?,
+                    0,
+                )
+            }
             EstimatorKind::FiniteDifference => Runner::FiniteDifference(recursive(
                 FiniteDifferenceRows::default(),
                 constraints,
@@ -224,7 +249,7 @@ impl Runner {
     /// The least-squares state (the SDP-based estimators only).
     pub fn qr(&self) -> Option<&inertia::estimator::qr::RecursiveQr> {
         match self {
-            Runner::Variational(e) => Some(e.qr()),
+            Runner::Variational(e, ..) => Some(e.qr()),
             Runner::FiniteDifference(e) => Some(e.qr()),
             Runner::Momentum(..) => None,
         }
@@ -233,7 +258,24 @@ impl Runner {
     /// Feed a sample; returns a history row when an estimate was produced.
     pub fn push(&mut self, s: &Sample) -> Result<Option<HistoryRow>, EstimatorError> {
         match self {
-            Runner::Variational(e) => Ok(e.push(s)?.map(|e| HistoryRow::from_estimate(&e))),
+            Runner::Variational(e, half, n) => {
+                if (*n).is_multiple_of(2) {
+                    half.push(s)?;
+                }
+                *n += 1;
+                Ok(e.push(s)?.map(|est| {
+                    let mut row = HistoryRow::from_estimate(&est);
+                    if let (Some(j), Some(noise)) = (est.j(), e.noise_sigma()) {
+                        let j_half = half.last().and_then(|h| h.j());
+                        row.uncertainty = Some(inertia::estimator::uncertainty::combine(
+                            &noise,
+                            &j,
+                            j_half.as_ref(),
+                        ));
+                    }
+                    row
+                }))
+            }
             Runner::FiniteDifference(e) => Ok(e.push(s)?.map(|e| HistoryRow::from_estimate(&e))),
             Runner::Momentum(m, every) => {
                 let Some(j) = m.push(s) else { return Ok(None) };
@@ -244,6 +286,7 @@ impl Runner {
                     status: RowStatus::Rls,
                     condition: None,
                     iterations: None,
+                    uncertainty: None,
                 }))
             }
         }

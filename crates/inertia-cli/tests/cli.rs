@@ -122,6 +122,14 @@ fn json_matches_the_last_history_row() {
         );
     }
     assert_eq!(&last[7], v["status"].as_str().unwrap());
+    // Standard deviations: in the history (sJ11..sJ23) and the JSON, the same numbers.
+    let sj = header.iter().position(|h| h == "sJ11").unwrap();
+    for k in 0..6 {
+        let s_hist: f64 = last[sj + k].parse().unwrap();
+        assert_eq!(s_hist, v["sigma"][k].as_f64().unwrap());
+        assert!(s_hist > 0.0 && s_hist < 0.05, "{s_hist}");
+    }
+    assert_eq!(v["principal_moments_sigma"].as_array().unwrap().len(), 3);
     // Before the pulse the answers lean on the bound, and say so.
     assert!(rows.iter().any(|r| &r[7] == "from_prior"));
 }

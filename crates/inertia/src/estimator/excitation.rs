@@ -50,15 +50,8 @@ pub fn diagnose(qr: &RecursiveQr) -> Excitation {
     let v_t = svd.v_t.unwrap_or_else(nalgebra::Matrix6::identity);
     let weakest = InertiaVector::from_fn(|k, _| v_t[(order[5], k)]);
     // With y ≡ 0 the residual is zero by construction: no variance to report.
-    let element_sigma = (qr.weight > 6.0 && sv[5] > 0.0 && qr.y_energy > 0.0).then(|| {
-        let s2 = qr.rss / (qr.weight - 6.0);
-        core::array::from_fn(|k| {
-            let var: f64 = (0..6)
-                .map(|i| (v_t[(i, k)] / svd.singular_values[i]).powi(2))
-                .sum();
-            (s2 * var).sqrt()
-        })
-    });
+    let v = v_t.transpose();
+    let element_sigma = super::uncertainty::noise_sigma(qr, &svd.singular_values, &v);
     let mut weak_elements = Vec::new();
     let mut advice = Vec::new();
     if qr.y_energy == 0.0 {

@@ -22,6 +22,7 @@ pub mod qr;
 pub mod recursive;
 pub mod rows;
 pub mod svd_tracker;
+pub mod uncertainty;
 
 use crate::discrete::RowError;
 use crate::solver::{Solution, SolveError};

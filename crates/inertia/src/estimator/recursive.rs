@@ -88,6 +88,7 @@ pub struct RecursiveEstimator<S: RowSource, B: Backend> {
     source: S,
     qr: RecursiveQr,
     svd: SvdTracker,
+    sv: nalgebra::Vector6<f64>,
     constraints: Constraints,
     backend: B,
     settings: RecursiveSettings,
@@ -109,6 +110,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             source,
             qr: RecursiveQr::new(),
             svd: SvdTracker::new(),
+            sv: nalgebra::Vector6::zeros(),
             constraints,
             backend,
             settings,
@@ -148,6 +150,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         let sv = self.svd.singular_values(&self.qr.r);
+        self.sv = sv;
         let observability = assess_with(
             &self.qr,
             &sv,
@@ -170,6 +173,13 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         };
         self.last = Some(e);
         Ok(e)
+    }
+
+    /// Least-squares standard deviation per element at the last solve (from the tracked
+    /// SVD; see [`super::uncertainty`]).
+    #[must_use]
+    pub fn noise_sigma(&self) -> Option<[f64; 6]> {
+        super::uncertainty::noise_sigma(&self.qr, &self.sv, self.svd.v())
     }
 
     /// The least-squares state.

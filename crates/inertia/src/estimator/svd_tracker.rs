@@ -40,6 +40,13 @@ impl SvdTracker {
         }
     }
 
+    /// The tracked right singular vectors (columns, in the order of the last
+    /// [`Self::singular_values`]).
+    #[must_use]
+    pub fn v(&self) -> &Matrix6<f64> {
+        &self.v
+    }
+
     /// Singular values of `r` (unordered), updating the tracked `V`.
     pub fn singular_values(&mut self, r: &Matrix6<f64>) -> Vector6<f64> {
         self.updates = self.updates.wrapping_add(1);

@@ -1,0 +1,91 @@
+//! Uncertainty of the variational estimate: a standard deviation per element and per
+//! principal moment (beyond the paper).
+//!
+//! Two parts, added in quadrature per element:
+//!
+//! * **Noise:** the least-squares standard deviation `σ_LS = √(s² diag((RᵀR)⁻¹))`,
+//!   `s² = ρ²/(rows − 6)` (effective rows under forgetting).
+//! * **Discretisation bias:** the rows are exact only to O(h⁴), which biases `ĵ` by
+//!   `c h²`. A shadow estimator on every other sample (step 2h) is biased by `4c h²`, so
+//!   `b̂ = (ĵ(h) − ĵ(2h))/3` measures it from the data (Richardson).
+//!
+//! `σ = √(σ_LS² + b̂²)`. With errors-in-variables compensation
+//! ([`super::compensation`], the gyro noise given), a Monte Carlo of 200 seeds per case
+//! finds the error inside ±3σ for every element in 90–100 % of runs at the paper's noise
+//! and at 100× its gyro noise (`tests/uncertainty.rs`). Without compensation the
+//! errors-in-variables bias (README noise sweep) is not covered at high gyro noise.
+//! Active constraints are not reflected: where a bound or the physical-consistency
+//! condition is active, the constrained estimate is at least as close to the truth in the
+//! constrained directions, so the σ are conservative there. Principal moments use the
+//! first-order perturbation `∂λ_i/∂J = v_i v_iᵀ`, with the elements taken as independent.
+
+use super::qr::RecursiveQr;
+use crate::tensor::{matrix_from_j, InertiaVector, COMPONENT_INDEX};
+use nalgebra::{Matrix6, Vector3, Vector6};
+
+/// Standard deviations of an estimate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Uncertainty {
+    /// Total standard deviation per element (order of eq. 48), kg m².
+    pub sigma_kg_m2: [f64; 6],
+    /// Its noise part, kg m².
+    pub noise_kg_m2: [f64; 6],
+    /// Its discretisation-bias part `|b̂|`, kg m² (zero without the half-rate estimate).
+    pub bias_kg_m2: [f64; 6],
+    /// Standard deviation of the principal moments (ascending, like
+    /// [`crate::tensor::principal`]), kg m².
+    pub principal_sigma_kg_m2: [f64; 3],
+}
+
+/// `σ_LS` per element from singular values `sv` and right singular vectors `v` (columns)
+/// of `R`. `None` without residual degrees of freedom or with a singular `R`.
+#[must_use]
+pub fn noise_sigma(qr: &RecursiveQr, sv: &Vector6<f64>, v: &Matrix6<f64>) -> Option<[f64; 6]> {
+    if !(qr.weight > 6.0 && qr.y_energy > 0.0) || sv.iter().any(|s| !(*s > 0.0)) {
+        return None;
+    }
+    let s2 = qr.rss / (qr.weight - 6.0);
+    Some(core::array::from_fn(|k| {
+        let var: f64 = (0..6)
+            .map(|i| (v[(k, i)] / sv[i]) * (v[(k, i)] / sv[i]))
+            .sum();
+        crate::math::sqrt(s2 * var)
+    }))
+}
+
+/// Combine the noise part with the Richardson bias `(j_full − j_half)/3` (when the
+/// half-rate estimate exists) and propagate to the principal moments of `j_full`.
+#[must_use]
+pub fn combine(
+    noise: &[f64; 6],
+    j_full: &InertiaVector,
+    j_half: Option<&InertiaVector>,
+) -> Uncertainty {
+    let bias: [f64; 6] =
+        core::array::from_fn(|k| j_half.map_or(0.0, |h| crate::math::abs(j_full[k] - h[k]) / 3.0));
+    let sigma: [f64; 6] =
+        core::array::from_fn(|k| crate::math::sqrt(noise[k] * noise[k] + bias[k] * bias[k]));
+    let eig = crate::eigen3::symmetric_eigen3(&matrix_from_j(j_full));
+    let principal = core::array::from_fn(|i| {
+        let v: Vector3<f64> = eig.1[i];
+        let var: f64 = COMPONENT_INDEX
+            .iter()
+            .enumerate()
+            .map(|(k, &(r, c))| {
+                let d = if r == c {
+                    v[r] * v[r]
+                } else {
+                    2.0 * v[r] * v[c]
+                };
+                d * d * sigma[k] * sigma[k]
+            })
+            .sum();
+        crate::math::sqrt(var)
+    });
+    Uncertainty {
+        sigma_kg_m2: sigma,
+        noise_kg_m2: *noise,
+        bias_kg_m2: bias,
+        principal_sigma_kg_m2: principal,
+    }
+}
