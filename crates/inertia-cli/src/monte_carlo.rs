@@ -207,12 +207,7 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
             a.gyro_noise
         ),
         "time [s]",
-        &[Panel {
-            title: String::new(),
-            y_label: "‖J_est − J‖_F / ‖J‖_F".into(),
-            log_y: true,
-            series,
-        }],
+        &[Panel::total_error(series)],
     )?;
     // Summary.
     let mut s = String::new();

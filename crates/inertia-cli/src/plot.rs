@@ -46,6 +46,18 @@ pub struct Panel {
     pub series: Vec<Series>,
 }
 
+impl Panel {
+    /// The relative Frobenius error on a log axis, untitled.
+    pub fn total_error(series: Vec<Series>) -> Self {
+        Self {
+            title: String::new(),
+            y_label: "‖J_est − J‖_F / ‖J‖_F".into(),
+            log_y: true,
+            series,
+        }
+    }
+}
+
 /// A palette that stays readable in print.
 pub const COLORS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),

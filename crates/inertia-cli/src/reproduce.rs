@@ -195,12 +195,7 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
         &dir.join(&stem),
         &format!("Figure {first_fig}. Normalized inertia error, {what}"),
         "time [s]",
-        &[Panel {
-            title: String::new(),
-            y_label: "‖J_est − J‖_F / ‖J‖_F".into(),
-            log_y: true,
-            series,
-        }],
+        &[Panel::total_error(series)],
     )?;
     let mut header = vec!["t".to_string()];
     header.extend(case.runs.iter().map(|r| r.file.to_string()));

@@ -33,8 +33,9 @@ fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
     )
 }
 
-fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
-    let cfg = SimConfig {
+/// A noise-free run from the convergence tests' initial state, sample period `dt`.
+fn config(dt: f64, substeps: usize) -> SimConfig {
+    SimConfig {
         inertia_kg_m2: paper_j_true(),
         initial: GyrostatState {
             q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
@@ -42,15 +43,20 @@ fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> 
             rho_nms: Vector3::new(0.1, -0.2, 0.3),
         },
         t0_s: 0.0,
-        dt_s: h,
-        samples: SimConfig::samples_for(DURATION_S, h),
-        substeps: 64,
+        dt_s: dt,
+        samples: SimConfig::samples_for(DURATION_S, dt),
+        substeps,
         disturbance_nm_rthz: 0.0,
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
         inertia_change: None,
-    };
-    simulate(&cfg, rho, tau).expect("valid config").samples
+    }
+}
+
+fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
+    simulate(&config(h, 64), rho, tau)
+        .expect("valid config")
+        .samples
 }
 
 /// Which variant of the row to evaluate.
@@ -269,22 +275,7 @@ mod jittered {
         jitter: bool,
     ) -> Vec<Sample> {
         let fine = h / 20.0;
-        let cfg = SimConfig {
-            inertia_kg_m2: paper_j_true(),
-            initial: GyrostatState {
-                q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
-                omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
-                rho_nms: Vector3::new(0.1, -0.2, 0.3),
-            },
-            t0_s: 0.0,
-            dt_s: fine,
-            samples: SimConfig::samples_for(DURATION_S, fine),
-            substeps: 4,
-            disturbance_nm_rthz: 0.0,
-            gyro_noise_deg_s_rthz: 0.0,
-            seed: 0,
-            inertia_change: None,
-        };
+        let cfg = config(fine, 4);
         let all = simulate(&cfg, rho, tau).expect("valid config").samples;
         let mut out = Vec::new();
         let mut k = 0;

@@ -32,6 +32,14 @@ struct Window {
 }
 
 impl Window {
+    /// Forget the buffered samples, keep the gap count.
+    fn reset(&mut self) {
+        *self = Window {
+            gaps: self.gaps,
+            ..Window::default()
+        };
+    }
+
     fn push(&mut self, s: &Sample) -> Option<(Sample, Sample)> {
         if let (Some(a), Some(b)) = (self.a, self.b) {
             let (h0, h1) = (b.t_s - a.t_s, s.t_s - b.t_s);
@@ -65,10 +73,7 @@ impl RowSource for VariationalRows {
     }
 
     fn reset(&mut self) {
-        self.w = Window {
-            gaps: self.w.gaps,
-            ..Window::default()
-        };
+        self.w.reset();
     }
 
     fn gaps(&self) -> usize {
@@ -99,10 +104,7 @@ impl RowSource for FiniteDifferenceRows {
     }
 
     fn reset(&mut self) {
-        self.w = Window {
-            gaps: self.w.gaps,
-            ..Window::default()
-        };
+        self.w.reset();
     }
 
     fn gaps(&self) -> usize {
