@@ -98,6 +98,11 @@ fn order(rho: &dyn InputLaw, tau: &dyn InputLaw, variant: Variant) -> f64 {
             (h.ln(), r.ln())
         })
         .collect();
+    slope(&pts)
+}
+
+/// Least-squares slope of `(x, y)` points.
+fn slope(pts: &[(f64, f64)]) -> f64 {
     let n = pts.len() as f64;
     let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
     let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
@@ -314,12 +319,7 @@ mod jittered {
                 (h.ln(), r.ln())
             })
             .collect();
-        let n = pts.len() as f64;
-        let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
-        let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
-        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        sxy / sxx
+        slope(&pts)
     }
 
     const CASES: [(&str, &dyn InputLaw, &dyn InputLaw); 4] = [
