@@ -165,6 +165,10 @@ pub struct EstimateArgs {
     /// that changes). Shorter memory tracks faster and is noisier (README).
     #[arg(long, value_name = "S")]
     pub memory: Option<f64>,
+    /// Resample irregular telemetry to this period, s, by 4-point Lagrange interpolation
+    /// before estimating (keeps the rows' O(h⁴) accuracy on jittered time stamps; README).
+    #[arg(long, value_name = "S")]
+    pub resample: Option<f64>,
     /// The gyro's rate-noise density, deg/s/√Hz: compensates the errors-in-variables bias
     /// of the variational estimator (README). Without it, no compensation.
     #[arg(long, value_name = "DEG_S_RTHZ")]

@@ -40,6 +40,16 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         }
     }
     let gyro_rad = a.gyro_noise.map(f64::to_radians);
+    if let Some(h) = a.resample {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(input(format!("--resample {h}: must be finite and > 0 s")));
+        }
+        if a.batch {
+            return Err(input(
+                "--resample applies to the recursive estimators, not --batch",
+            ));
+        }
+    }
     if let Some(m) = a.memory {
         if !(m.is_finite() && m > 0.0) {
             return Err(input(format!("--memory {m}: must be finite and > 0 s")));
@@ -149,31 +159,40 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         let mut runner =
             Runner::with_settings(a.estimator, constraints, backend, settings).map_err(input)?;
         let mut pending = head.into_iter();
+        let mut resampler = a.resample.map(inertia::estimator::resample::Resampler::new);
+        let mut ready: Vec<inertia::telemetry::Sample> = Vec::with_capacity(4);
         loop {
-            let s = match pending.next() {
+            let input_sample = match pending.next() {
                 Some(s) => s,
                 None => match reader.next() {
                     Some(item) => item.map_err(input)?,
                     None => break,
                 },
             };
-            samples += 1;
-            if samples == 2 {
-                h_s = s.t_s - t_prev;
+            ready.clear();
+            match resampler.as_mut() {
+                Some(r) => r.push(&input_sample, |u| ready.push(u)),
+                None => ready.push(input_sample),
             }
-            t_prev = s.t_s;
-            if let Some(row) = runner
-                .push(&s)
-                .map_err(|e| row_error(e, reader.last_line()))?
-            {
-                if let Some(h) = history.as_mut() {
-                    h.write(&row)?;
+            for s in ready.drain(..) {
+                samples += 1;
+                if samples == 2 {
+                    h_s = s.t_s - t_prev;
                 }
-                last = Some(row);
-            }
-            if let Some(p) = &progress {
-                if samples.is_multiple_of(4096) {
-                    p.set_position(reader.byte_position());
+                t_prev = s.t_s;
+                if let Some(row) = runner
+                    .push(&s)
+                    .map_err(|e| row_error(e, reader.last_line()))?
+                {
+                    if let Some(h) = history.as_mut() {
+                        h.write(&row)?;
+                    }
+                    last = Some(row);
+                }
+                if let Some(p) = &progress {
+                    if samples.is_multiple_of(4096) {
+                        p.set_position(reader.byte_position());
+                    }
                 }
             }
         }

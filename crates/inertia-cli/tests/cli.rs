@@ -559,6 +559,22 @@ fn jitter_gaps_and_iso_time_stamps() {
         let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
         assert!((x - y).abs() < 2e-3 * (1.0 + y.abs()), "{k}: {x} vs {y}");
     }
+    // Resampled to a uniform 0.1 s grid (the gap restarts the grid): the same answer.
+    let v = json(&inertia(&[
+        "estimate",
+        jittered.to_str().unwrap(),
+        "--resample",
+        "0.1",
+        "--json",
+    ]));
+    assert_eq!(v["status"], "determined", "{v}");
+    for k in 0..6 {
+        let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
+        assert!(
+            (x - y).abs() < 2e-3 * (1.0 + y.abs()),
+            "resampled {k}: {x} vs {y}"
+        );
+    }
     // ISO-8601 time stamps, 0.1 s apart: the same answer as seconds.
     let iso = write("iso.csv", &|_| true, &|i, _| {
         let tenths = 9 * 36000 + 6 * 600 + i; // from 09:06:00.0

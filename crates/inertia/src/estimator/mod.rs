@@ -20,6 +20,7 @@ pub mod momentum;
 pub mod observability;
 pub mod qr;
 pub mod recursive;
+pub mod resample;
 pub mod rows;
 pub mod svd_tracker;
 pub mod uncertainty;
