@@ -57,6 +57,21 @@ fn sigma_series(case: &Case, k: usize, truth: &Matrix3<f64>) -> Vec<Series> {
     }]
 }
 
+/// One series per estimator run, plotting `metric` of each history row.
+fn run_series(case: &Case, metric: impl Fn(&HistoryRow) -> f64) -> Vec<Series> {
+    case.runs
+        .iter()
+        .zip(COLORS)
+        .enumerate()
+        .map(|(n, (r, color))| Series {
+            name: r.label.into(),
+            points: r.history.iter().map(|h| (h.t_s, metric(h))).collect(),
+            color,
+            width: main_width(n),
+        })
+        .collect()
+}
+
 /// The paper's estimator (first) drawn thicker than the others.
 fn main_width(n: usize) -> u32 {
     if n == 0 {
@@ -151,22 +166,7 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
         "spinning case"
     };
     // Total error.
-    let series: Vec<Series> = case
-        .runs
-        .iter()
-        .zip(COLORS)
-        .enumerate()
-        .map(|(n, (r, color))| Series {
-            name: r.label.into(),
-            points: r
-                .history
-                .iter()
-                .map(|h| (h.t_s, total_error(h, truth)))
-                .collect(),
-            color,
-            width: main_width(n),
-        })
-        .collect();
+    let series = run_series(case, |h| total_error(h, truth));
     // The variational estimator's 3σ envelope: ‖ΔJ‖_F has variance Σ_diag σ² + 2 Σ_off σ².
     let jt_norm = truth.norm();
     let mut series = series;
@@ -236,28 +236,11 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                 },
                 log_y: true,
                 series: {
-                    let mut v: Vec<Series> = case
-                        .runs
-                        .iter()
-                        .zip(COLORS)
-                        .enumerate()
-                        .map(|(n, (r, color))| Series {
-                            name: r.label.into(),
-                            width: main_width(n),
-                            points: r
-                                .history
-                                .iter()
-                                .map(|h| {
-                                    let e = h.j.map_or(f64::NAN, |j| {
-                                        normalized_element_errors(&matrix_from_j(&j), truth)[k]
-                                            .abs()
-                                    });
-                                    (h.t_s, e)
-                                })
-                                .collect(),
-                            color,
+                    let mut v = run_series(case, |h| {
+                        h.j.map_or(f64::NAN, |j| {
+                            normalized_element_errors(&matrix_from_j(&j), truth)[k].abs()
                         })
-                        .collect();
+                    });
                     v.extend(sigma_series(case, k, truth));
                     v
                 },

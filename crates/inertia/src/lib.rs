@@ -72,10 +72,12 @@
 //! * [`discrete`] — G, M, N and the rows H_k, y_k (eqs. 47–54);
 //! * [`telemetry`] — the sample record;
 //! * [`constraints`] — the feasible set (eqs. 9, 55, 57, ERRATA §4, prior bounds);
-//! * [`solver`] — constrained least squares: native barrier method, Clarabel (feature
-//!   `clarabel`) (eqs. 57, 59);
+//! * [`solver`] — constrained least squares (eqs. 57, 59): the native solver (fast path,
+//!   active set, one-LMI-face Newton, barrier method) and Clarabel (feature `clarabel`);
 //! * [`estimator`] — Algorithm 1 (recursive), eq. 57 (batch), the finite-difference and
-//!   momentum baselines, observability (eqs. 58–61, §VI);
+//!   momentum baselines, observability (eqs. 58–61, §VI); beyond the paper:
+//!   errors-in-variables compensation, uncertainty, excitation diagnostics, resampling of
+//!   irregular telemetry;
 //! * `sim` (feature `sim`) — simulator, sensors and the §VI scenarios.
 
 #![cfg_attr(not(feature = "std"), no_std)]
