@@ -8,10 +8,10 @@
 //! answer is written beside them.
 
 use crate::args::MonteCarloArgs;
-use crate::error::{input, internal, write_failed, CliError};
+use crate::error::{input, write_failed, CliError};
 use crate::plot::{self, Panel, Series, COLORS};
 use crate::reproduce::total_error;
-use crate::runner::paper_estimators;
+use crate::runner::{paper_estimators, PAPER_ESTIMATOR_NAMES};
 use crate::simulate::scenario;
 use inertia::sim::scenario::Common;
 use rayon::prelude::*;
@@ -71,9 +71,6 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
         );
         p
     });
-    let mut labels: Vec<&'static str> = Vec::new();
-    let mut files: Vec<&'static str> = Vec::new();
-    let mut times: Vec<f64> = Vec::new();
     let results: Vec<Result<RunErrors, CliError>> = (0..a.runs)
         .into_par_iter()
         .map(|i| {
@@ -107,21 +104,14 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
         p.finish_and_clear();
     }
     let runs: Vec<RunErrors> = results.into_iter().collect::<Result<_, _>>()?;
-    // Labels and the time grid from one (cheap) reference run.
-    {
-        let out = sc
-            .simulate(&Common {
-                gyro_noise_deg_s_rthz: 0.0,
-                disturbance_nm_rthz: 0.0,
-                ..common(a.seed)
-            })
-            .map_err(internal)?;
-        times.extend(out.samples.iter().map(|s| s.t_s));
-        for r in paper_estimators(&sc, &out, a.gyro_noise.to_radians())? {
-            labels.push(r.label);
-            files.push(r.file);
-        }
-    }
+    // Labels from the plan; the time grid from the configuration (as the simulator
+    // computes it), with no extra run.
+    let labels: Vec<&str> = PAPER_ESTIMATOR_NAMES.iter().map(|n| n.0).collect();
+    let files: Vec<&str> = PAPER_ESTIMATOR_NAMES.iter().map(|n| n.1).collect();
+    let cfg = sc.config(&common(a.seed));
+    let times: Vec<f64> = (0..cfg.samples)
+        .map(|k| cfg.t0_s + k as f64 * cfg.dt_s)
+        .collect();
     let n_est = labels.len();
     let n_t = times.len();
     // Percentiles at each time.

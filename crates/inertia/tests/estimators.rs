@@ -330,6 +330,26 @@ fn baselines_recover_j_true_from_noise_free_data() {
     assert!(e < 2e-4, "momentum {e:e}");
 }
 
+/// 20 s of a pure spin at 0.5 rad/s about body z with a constant wheel bias off the spin
+/// axis (so that y ≠ 0; ρ ∥ φ would make y ≡ 0 instead): φ never changes direction and
+/// the rows have rank < 6.
+fn pure_spin_samples() -> Vec<Sample> {
+    let mut out = Scenario::spin()
+        .simulate(&Common {
+            duration_s: Some(20.0),
+            inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0)),
+            ..Common::noise_free()
+        })
+        .unwrap();
+    let w = Vector3::new(0.0, 0.0, 0.5);
+    for (k, s) in out.samples.iter_mut().enumerate() {
+        s.q = Quaternion::exp(&(w * (k as f64 * 0.1)));
+        s.rho_nms = Vector3::new(0.1, 0.0, 0.0);
+        s.omega_rad_s = w;
+    }
+    out.samples
+}
+
 #[test]
 fn unobservable_data_give_no_answer_and_say_why() {
     // Spin without the J33 bound before the pulse: y ≡ 0, J only up to scale.
@@ -366,21 +386,8 @@ fn unobservable_data_give_no_answer_and_say_why() {
 
     // A pure spin about a principal axis with a constant wheel bias: φ never changes
     // direction, the rows have rank < 6.
-    let mut out = Scenario::spin()
-        .simulate(&Common {
-            duration_s: Some(20.0),
-            inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0)),
-            ..Common::noise_free()
-        })
-        .unwrap();
-    let w = Vector3::new(0.0, 0.0, 0.5);
-    for (k, s) in out.samples.iter_mut().enumerate() {
-        s.q = Quaternion::exp(&(w * (k as f64 * 0.1)));
-        // Off the spin axis, so that y ≠ 0 (ρ ∥ φ would make y ≡ 0 instead).
-        s.rho_nms = Vector3::new(0.1, 0.0, 0.0);
-        s.omega_rad_s = w;
-    }
-    let est = run::<VariationalRows>(&out.samples, ConstraintSet::physical().validate().unwrap());
+    let samples = pure_spin_samples();
+    let est = run::<VariationalRows>(&samples, ConstraintSet::physical().validate().unwrap());
     let last = est.last().unwrap();
     assert!(
         matches!(
@@ -443,18 +450,7 @@ fn excitation_diagnostics() {
     let qr_of = |samples: &[Sample]| batch::reduce(samples, VariationalRows::default()).unwrap();
 
     // Pure spin about body z with a wheel bias off-axis (y ≠ 0, rank-deficient rows).
-    let mut out = Scenario::spin()
-        .simulate(&Common {
-            duration_s: Some(20.0),
-            ..Common::noise_free()
-        })
-        .unwrap();
-    let w = Vector3::new(0.0, 0.0, 0.5);
-    for (k, s) in out.samples.iter_mut().enumerate() {
-        s.q = Quaternion::exp(&(w * (k as f64 * 0.1)));
-        s.rho_nms = Vector3::new(0.1, 0.0, 0.0);
-    }
-    let x = diagnose(&qr_of(&out.samples));
+    let x = diagnose(&qr_of(&pure_spin_samples()));
     for e in ["J11", "J22", "J12"] {
         assert!(x.weak_elements.contains(&e), "{:?}", x.weak_elements);
     }
