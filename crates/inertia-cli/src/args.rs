@@ -1,6 +1,5 @@
 //! Command-line arguments (parsed first; validated into a config by `config`).
 
-use crate::runner::{EstimatorKind, SolverKind};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -101,6 +100,15 @@ pub struct SimulateArgs {
     pub inertia_ramp: Option<String>,
 }
 
+/// Names from the library's registry as clap's possible values, with their help.
+fn registered(
+    entries: impl Iterator<Item = (&'static str, &'static str)>,
+) -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        entries.map(|(name, help)| clap::builder::PossibleValue::new(name).help(help)),
+    )
+}
+
 /// Constraint sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
 pub enum ConstraintArg {
@@ -140,8 +148,8 @@ pub struct EstimateArgs {
     /// Telemetry CSV file (see README: t, q_x..q_w, rho_x..rho_z, optional tau_*, w_*).
     pub file: PathBuf,
     /// Estimator.
-    #[arg(long, value_enum, default_value = "variational")]
-    pub estimator: EstimatorKind,
+    #[arg(long, default_value = "variational", value_parser = registered(inertia::pipeline::registry::ESTIMATORS.iter().map(|e| (e.name, e.summary))))]
+    pub estimator: String,
     /// One batch solve over all samples instead of the recursive estimator.
     #[arg(long)]
     pub batch: bool,
@@ -183,8 +191,8 @@ pub struct EstimateArgs {
     #[arg(long)]
     pub json: bool,
     /// Solver backend.
-    #[arg(long, value_enum, default_value = "native")]
-    pub solver: SolverKind,
+    #[arg(long, default_value = "native", value_parser = registered(inertia::pipeline::registry::BACKENDS.iter().map(|e| (e.name, e.summary))))]
+    pub solver: String,
     /// Input format.
     #[command(flatten)]
     pub input: InputArgs,

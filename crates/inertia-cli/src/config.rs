@@ -1,10 +1,11 @@
 //! Arguments validated into configurations.
 
-use crate::args::{ConstraintArg, InputArgs};
+use crate::args::{ConstraintArg, EstimateArgs, InputArgs};
 use crate::error::{input, CliError};
-use inertia::constraints::{component_by_name, ConstraintSet, Constraints};
+use inertia::constraints::ConstraintSet;
+use inertia::pipeline::{PipelineError, PipelineSettings};
 use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
-use inertia::tensor::{j_from_matrix, InertiaVector, COMPONENT_INDEX};
+use inertia::tensor::{j_from_matrix, Component};
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -58,15 +59,15 @@ impl InertiaFile {
     }
 }
 
-/// Parse `Jij=LO:HI` into `(component, lower, upper)`.
-pub fn parse_bound(s: &str) -> Result<(usize, Option<f64>, Option<f64>), CliError> {
+/// Parse `Jij=LO:HI` into `(component, lower, upper)`. `LO = HI` is an equality.
+pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), CliError> {
     let bad = |why: &str| {
         input(format!(
             "--bound {s:?}: {why} (expected e.g. J33=2.7:3.3, J12=:0.05)"
         ))
     };
     let (name, range) = s.split_once('=').ok_or_else(|| bad("missing `=`"))?;
-    let k = component_by_name(name.trim()).ok_or_else(|| bad("unknown element"))?;
+    let k = Component::from_name(name.trim()).ok_or_else(|| bad("unknown element"))?;
     let (lo, hi) = range.split_once(':').ok_or_else(|| bad("missing `:`"))?;
     let num = |t: &str| -> Result<Option<f64>, CliError> {
         let t = t.trim();
@@ -102,34 +103,75 @@ pub fn parse_fraction(s: &str) -> Result<f64, CliError> {
     }
 }
 
-/// Build and validate a constraint set.
-pub fn constraints(
+/// The constraint set of the arguments (validated with the rest of the settings).
+pub fn constraint_set(
     kind: ConstraintArg,
     bounds: &[String],
     nominal: Option<(&Matrix3<f64>, f64)>,
-) -> Result<Constraints, CliError> {
+) -> Result<ConstraintSet, CliError> {
     let mut set = match kind {
         ConstraintArg::Physical => ConstraintSet::physical(),
         ConstraintArg::Paper => ConstraintSet::paper(),
         ConstraintArg::PositiveDefinite => ConstraintSet::positive_definite(),
     };
     if let Some((n, p)) = nominal {
-        let j: InertiaVector = j_from_matrix(n);
-        for (k, &(r, c)) in COMPONENT_INDEX.iter().enumerate() {
-            let w = if r == c {
-                p * n[(r, r)].abs()
-            } else {
-                p * (n[(r, r)] * n[(c, c)]).abs().sqrt()
-            };
-            set = set.with_bounds(k, Some(j[k] - w), Some(j[k] + w));
-        }
+        set = set.with_nominal_inertia(n, p);
     }
     for b in bounds {
         let (k, l, h) = parse_bound(b)?;
         set = set.with_bounds(k, l, h);
     }
-    set.validate()
-        .map_err(|e| input(format!("constraints: {e}")))
+    Ok(set)
+}
+
+/// The pipeline settings of `inertia estimate`.
+pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError> {
+    let nominal = match (&a.nominal, &a.tolerance) {
+        (Some(p), Some(t)) => Some((InertiaFile::read(p)?, parse_fraction(t)?)),
+        _ => None,
+    };
+    Ok(PipelineSettings {
+        estimator: a.estimator.clone(),
+        solver: a.solver.clone(),
+        constraints: constraint_set(
+            a.constraints,
+            &a.bounds,
+            nominal.as_ref().map(|(m, p)| (m, *p)),
+        )?,
+        solve_every: a.every,
+        memory_s: a.memory,
+        resample_s: a.resample,
+        gyro_noise_deg_s_rthz: a.gyro_noise,
+        ..PipelineSettings::default()
+    })
+}
+
+/// The command-line option behind a pipeline setting.
+fn option_of(field: &str) -> &str {
+    match field {
+        "solve_every" => "--every",
+        "memory_s" => "--memory",
+        "resample_s" => "--resample",
+        "gyro_noise_deg_s_rthz" => "--gyro-noise",
+        "constraints" => "--constraints/--bound/--nominal",
+        other => other,
+    }
+}
+
+/// A settings error in the command line's words.
+pub fn settings_error(e: PipelineError) -> CliError {
+    match e {
+        PipelineError::InvalidSetting {
+            field,
+            value,
+            expected,
+        } => input(format!("{} {value}: expected {expected}", option_of(field))),
+        PipelineError::NotApplicable { setting, estimator } => input(format!(
+            "{} does not apply to the {estimator} estimator",
+            option_of(setting)
+        )),
+        other => input(other),
+    }
 }
 
 /// CSV options from the input arguments.

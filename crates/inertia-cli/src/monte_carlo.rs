@@ -77,7 +77,7 @@ pub fn run(a: &MonteCarloArgs) -> Result<(), CliError> {
             let out = sc
                 .simulate(&common(a.seed.wrapping_add(i)))
                 .map_err(input)?;
-            let runs = paper_estimators(&sc, &out, a.gyro_noise.to_radians())?;
+            let runs = paper_estimators(&sc, &out, a.gyro_noise)?;
             let errors = runs
                 .iter()
                 .map(|r| {

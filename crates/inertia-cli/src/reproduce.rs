@@ -8,9 +8,10 @@
 
 use crate::args::ReproduceArgs;
 use crate::error::{internal, write_failed, CliError};
-use crate::history::HistoryWriter;
+use crate::history::HistoryFile;
 use crate::plot::{self, Panel, Series, COLORS};
-use crate::runner::{paper_estimators, HistoryRow, Run};
+use crate::runner::{paper_estimators, Run};
+use inertia::estimator::Estimate;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::sim::SimOutput;
 use inertia::tensor::{
@@ -58,7 +59,7 @@ fn sigma_series(case: &Case, k: usize, truth: &Matrix3<f64>) -> Vec<Series> {
 }
 
 /// One series per estimator run, plotting `metric` of each history row.
-fn run_series(case: &Case, metric: impl Fn(&HistoryRow) -> f64) -> Vec<Series> {
+fn run_series(case: &Case, metric: impl Fn(&Estimate) -> f64) -> Vec<Series> {
     case.runs
         .iter()
         .zip(COLORS)
@@ -82,14 +83,14 @@ fn main_width(n: usize) -> u32 {
 }
 
 /// Relative Frobenius error of a history row (`NaN` without an answer).
-pub fn total_error(r: &HistoryRow, truth: &Matrix3<f64>) -> f64 {
-    r.j.map_or(f64::NAN, |j| {
+pub fn total_error(r: &Estimate, truth: &Matrix3<f64>) -> f64 {
+    r.j().map_or(f64::NAN, |j| {
         relative_frobenius_error(&matrix_from_j(&j), truth)
     })
 }
 
 /// The row at time `t` (the last at or before it).
-fn at(history: &[HistoryRow], t: f64) -> Option<&HistoryRow> {
+fn at(history: &[Estimate], t: f64) -> Option<&Estimate> {
     history.iter().take_while(|r| r.t_s <= t + 1e-9).last()
 }
 
@@ -176,14 +177,9 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
             .history
             .iter()
             .map(|h| {
-                let v = h.uncertainty.map_or(f64::NAN, |u| {
-                    let s = u.sigma_kg_m2;
-                    (s[0] * s[0]
-                        + s[1] * s[1]
-                        + s[2] * s[2]
-                        + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
-                        .sqrt()
-                });
+                let v = h
+                    .uncertainty
+                    .map_or(f64::NAN, |u| u.frobenius_sigma_kg_m2());
                 (h.t_s, 3.0 * v / jt_norm)
             })
             .collect(),
@@ -237,7 +233,7 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                 log_y: true,
                 series: {
                     let mut v = run_series(case, |h| {
-                        h.j.map_or(f64::NAN, |j| {
+                        h.j().map_or(f64::NAN, |j| {
                             normalized_element_errors(&matrix_from_j(&j), truth)[k].abs()
                         })
                     });
@@ -268,7 +264,7 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
                 for r in &case.runs {
                     let h = r.history.iter().find(|h| (h.t_s - s.t_s).abs() < 1e-9);
                     for k in offset..offset + 3 {
-                        row.push(h.and_then(|h| h.j).map_or(f64::NAN, |j| {
+                        row.push(h.and_then(|h| h.j()).map_or(f64::NAN, |j| {
                             normalized_element_errors(&matrix_from_j(&j), truth)[k]
                         }));
                     }
@@ -314,9 +310,9 @@ fn summary(cases: &[Case], seed: u64, elapsed_s: f64) -> String {
             let mut line = format!("| {} |", r.label);
             for t in REPORT_TIMES.iter().filter(|t| **t < end).chain([&end]) {
                 let cell = match at(&r.history, *t) {
-                    Some(h) if h.j.is_some() => {
+                    Some(h) if h.j().is_some() => {
                         let e = total_error(h, truth);
-                        if h.status.code() == "from_prior" {
+                        if h.observability.code() == "from_prior" {
                             format!("{e:.2e} (prior)")
                         } else {
                             format!("{e:.2e}")
@@ -342,7 +338,7 @@ fn summary(cases: &[Case], seed: u64, elapsed_s: f64) -> String {
                 .join(" | ")
         );
         for r in &case.runs {
-            let cells = r.history.last().and_then(|h| h.j).map_or_else(
+            let cells = r.history.last().and_then(|h| h.j()).map_or_else(
                 || vec!["n/a".to_string(); 6],
                 |j| j.iter().map(|v| format!("{v:.5}")).collect(),
             );
@@ -367,7 +363,7 @@ pub fn run(a: &ReproduceArgs) -> Result<(), CliError> {
             ..Common::paper()
         };
         let out = scenario.simulate(&common).map_err(internal)?;
-        let runs = paper_estimators(&scenario, &out, common.gyro_noise_deg_s_rthz.to_radians())?;
+        let runs = paper_estimators(&scenario, &out, common.gyro_noise_deg_s_rthz)?;
         let constraint_note = if scenario.name() == "spin" {
             "SDP-based estimators: the paper's constraints (J ⪰ εI, eq. 9) and J33 within 10 % of 3 kg m²; the last row uses the exact physical set (Σ ⪰ 0) with the same bound."
         } else {
@@ -392,7 +388,7 @@ pub fn run(a: &ReproduceArgs) -> Result<(), CliError> {
             .out
             .samples
             .iter()
-            .map(|s| (s.t_s, [s.omega_rad_s.x, s.omega_rad_s.y, s.omega_rad_s.z]))
+            .filter_map(|s| s.omega_rad_s.map(|w| (s.t_s, [w.x, w.y, w.z])))
             .collect();
         let (rho_fig, w_fig, err_fig) = if name == "slew" { (1, 2, 3) } else { (7, 6, 8) };
         let what = if name == "slew" {
@@ -419,7 +415,7 @@ pub fn run(a: &ReproduceArgs) -> Result<(), CliError> {
         error_figures(dir, case, err_fig)?;
         for r in &case.runs {
             let path = dir.join(format!("history_{name}_{}.csv", r.file));
-            let mut h = HistoryWriter::create(&path)?;
+            let mut h = HistoryFile::create(&path)?;
             for row in &r.history {
                 h.write(row)?;
             }

@@ -12,10 +12,11 @@ use inertia::constraints::ConstraintSet;
 use inertia::estimator::qr::RecursiveQr;
 use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use inertia::estimator::rows::{RowSource, VariationalRows};
+use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::solver::native::NativeSolver;
 use inertia::solver::Backend;
-use inertia::telemetry::Sample;
+use inertia::tensor::Component;
 use std::hint::black_box;
 
 type Est<B> = RecursiveEstimator<VariationalRows, B>;
@@ -91,7 +92,7 @@ fn scenario_data(sc: &Scenario, physical: bool) -> (Vec<Sample>, ConstraintSet) 
         ConstraintSet::paper()
     };
     let set = if sc.name() == "spin" {
-        base.with_nominal(2, 3.0, 0.1)
+        base.with_nominal(Component::J33, 3.0, 0.1)
     } else {
         base
     };

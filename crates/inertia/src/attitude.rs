@@ -44,6 +44,7 @@ use nalgebra::{Matrix3, Vector3};
 ///
 /// Attitude quaternions map body to inertial (`x_I = q x_B q†`). See the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Quaternion {
     /// Vector part `v = [x, y, z]`.
     pub v: Vector3<f64>,

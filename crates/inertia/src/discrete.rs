@@ -36,7 +36,7 @@
 
 use crate::attitude::{incremental_rotation, skew, Quaternion};
 use crate::math::{abs, sqrt};
-use crate::telemetry::Sample;
+use crate::sample::Sample;
 use nalgebra::{Matrix3, Matrix3x6, Vector3};
 
 /// Largest accepted `|φ|`. `|φ| = sin(θ/2)` for a step rotation θ, so `|φ| → 1` as the
@@ -62,15 +62,20 @@ pub enum RowError {
         norm: f64,
     },
     /// The rotation over one step is too large for eq. 37 (`|φ| < 1`).
-    #[error("rotation over interval {interval} gives |φ| = {phi_norm:.6} ≥ {MAX_PHI_NORM} (step of {angle_deg:.1}°): the sample period is too long for the motion")]
+    #[error("the rotation over the step from t = {t0_s} s to t = {t1_s} s gives |φ| = {phi_norm:.6} ≥ {MAX_PHI_NORM} (a step of {angle_deg:.1}°): the sample period is too long for the motion")]
     StepTooLarge {
-        /// Which interval (0 or 1 relative to k).
-        interval: usize,
+        /// Start of the step, s.
+        t0_s: f64,
+        /// End of the step, s.
+        t1_s: f64,
         /// `|φ|`.
         phi_norm: f64,
         /// The step rotation angle, degrees.
         angle_deg: f64,
     },
+    /// The row needs gyro rates and the sample has none.
+    #[error("this row model needs gyro rates (w_x, w_y, w_z) and the sample has none")]
+    MissingGyroRate,
     /// A non-finite rotor momentum, torque or step.
     #[error("non-finite input: {what}")]
     NonFinite {
@@ -130,6 +135,8 @@ pub struct Row {
 /// The inputs of one row once incremental rotations are known.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RowInput {
+    /// Time of node k, s (names the steps in errors).
+    pub t_k_s: f64,
     /// `φ_k`, the incremental rotation of interval `[t_k, t_{k+1}]`.
     pub phi_k: Vector3<f64>,
     /// `φ_{k+1}`, of interval `[t_{k+1}, t_{k+2}]`.
@@ -146,8 +153,8 @@ pub struct RowInput {
     pub h1_s: f64,
 }
 
-/// Check one incremental rotation against [`MAX_PHI_NORM`].
-pub fn check_phi(phi: &Vector3<f64>, interval: usize) -> Result<(), RowError> {
+/// Check the incremental rotation of the step `[t0_s, t1_s]` against [`MAX_PHI_NORM`].
+pub fn check_phi(phi: &Vector3<f64>, t0_s: f64, t1_s: f64) -> Result<(), RowError> {
     let n = phi.norm();
     if !n.is_finite() {
         return Err(RowError::NonFinite {
@@ -157,7 +164,8 @@ pub fn check_phi(phi: &Vector3<f64>, interval: usize) -> Result<(), RowError> {
     if n >= MAX_PHI_NORM {
         let angle_deg = 2.0 * libm::asin(n.min(1.0)) * 180.0 / core::f64::consts::PI;
         return Err(RowError::StepTooLarge {
-            interval,
+            t0_s,
+            t1_s,
             phi_norm: n,
             angle_deg,
         });
@@ -179,6 +187,7 @@ impl RowInput {
     /// at the same nodes (averaged to interval values by the trapezoid rule, ERRATA §2),
     /// the known torque at node k+1, and the two interval lengths.
     pub fn from_nodes(
+        t_k_s: f64,
         q: [&Quaternion; 3],
         rho_nodes_nms: [&Vector3<f64>; 3],
         tau_k1_nm: &Vector3<f64>,
@@ -189,6 +198,7 @@ impl RowInput {
             check_unit(qi, node)?;
         }
         Ok(RowInput {
+            t_k_s,
             phi_k: incremental_rotation(q[0], q[1]),
             phi_k1: incremental_rotation(q[1], q[2]),
             rho_k_nms: 0.5 * (rho_nodes_nms[0] + rho_nodes_nms[1]),
@@ -210,6 +220,7 @@ impl RowInput {
             });
         }
         Self::from_nodes(
+            s[0].t_s,
             [&s[0].q, &s[1].q, &s[2].q],
             [&s[0].rho_nms, &s[1].rho_nms, &s[2].rho_nms],
             &s[1].tau_nm,
@@ -220,8 +231,15 @@ impl RowInput {
 
     /// The row `H_k`, `y_k` (eqs. 53 and 54, torque sign per ERRATA §1).
     pub fn row(&self) -> Result<Row, RowError> {
-        check_phi(&self.phi_k, 0)?;
-        check_phi(&self.phi_k1, 1)?;
+        let (t1, t2) = (self.t_k_s + self.h_s, self.t_k_s + self.h_s + self.h1_s);
+        check_phi(&self.phi_k, self.t_k_s, t1)?;
+        check_phi(&self.phi_k1, t1, t2)?;
+        self.row_checked_phi()
+    }
+
+    /// [`Self::row`] for incremental rotations already checked by the caller (the row
+    /// sources check each φ once, when its interval arrives).
+    pub(crate) fn row_checked_phi(&self) -> Result<Row, RowError> {
         if !(self.h_s.is_finite() && self.h_s > 0.0 && self.h1_s.is_finite() && self.h1_s > 0.0) {
             return Err(RowError::NonFinite {
                 what: "sample period",

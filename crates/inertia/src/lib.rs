@@ -84,6 +84,7 @@
 #![warn(missing_docs)]
 
 pub mod attitude;
+mod barrier;
 pub mod constraints;
 pub mod discrete;
 pub mod dynamics;
@@ -91,6 +92,9 @@ mod eigen3;
 pub mod estimator;
 mod givens;
 mod math;
+#[cfg(feature = "std")]
+pub mod pipeline;
+pub mod sample;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod solver;

@@ -5,6 +5,13 @@
 //! semidefinite second-moment matrix `Σ = ½ tr(J) I − J` (ERRATA §4), which implies both
 //! `J ⪰ 0` and the triangle inequalities on the principal moments; the paper's eq. 9 tests
 //! only the diagonal in body axes, which is necessary but not sufficient.
+//!
+//! # Sign of the products of inertia
+//!
+//! `J12`, `J13`, `J23` are the **tensor entries**, `J12 = −Σ m x y` (so that `H = J ω`).
+//! Many CAD tools report the *product of inertia* `P_xy = +Σ m x y`; their tensor entry is
+//! `−P_xy`. Every input of prior knowledge here (bounds, nominal J) takes tensor entries:
+//! negate a CAD tool's products first (`docs/conventions.md` §6).
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3, Vector6};
 
@@ -16,6 +23,84 @@ pub const COMPONENT_NAMES: [&str; 6] = ["J11", "J22", "J33", "J12", "J13", "J23"
 
 /// `(row, col)` of each component of `j` in `J`.
 pub const COMPONENT_INDEX: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
+
+/// One of the six components of `j`, in the order of eq. 48. Products are tensor
+/// entries (`J12 = −Σ m x y`; see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Component {
+    /// `J11 = Σ m (y² + z²)`.
+    J11,
+    /// `J22 = Σ m (x² + z²)`.
+    J22,
+    /// `J33 = Σ m (x² + y²)`.
+    J33,
+    /// `J12 = −Σ m x y`.
+    J12,
+    /// `J13 = −Σ m x z`.
+    J13,
+    /// `J23 = −Σ m y z`.
+    J23,
+}
+
+impl Component {
+    /// All six, in the order of eq. 48.
+    pub const ALL: [Component; 6] = [
+        Component::J11,
+        Component::J22,
+        Component::J33,
+        Component::J12,
+        Component::J13,
+        Component::J23,
+    ];
+
+    /// Position in `j`.
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Name, e.g. `J12`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        COMPONENT_NAMES[self as usize]
+    }
+
+    /// `(row, col)` in `J`.
+    #[must_use]
+    pub const fn position(self) -> (usize, usize) {
+        COMPONENT_INDEX[self as usize]
+    }
+
+    /// Whether this is a product of inertia.
+    #[must_use]
+    pub const fn is_product(self) -> bool {
+        self.index() >= 3
+    }
+
+    /// By name, case-insensitive; `J21` is `J12` and so on.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        let b = name.as_bytes();
+        if b.len() != 3 || !(b[0] == b'J' || b[0] == b'j') {
+            return None;
+        }
+        let (r, c) = (
+            b[1].wrapping_sub(b'1') as usize,
+            b[2].wrapping_sub(b'1') as usize,
+        );
+        Self::ALL.into_iter().find(|k| {
+            let (i, j) = k.position();
+            (i, j) == (r, c) || (i, j) == (c, r)
+        })
+    }
+}
+
+impl core::fmt::Display for Component {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Symmetric 3×3 matrix from `j` (eq. 48).
 #[must_use]

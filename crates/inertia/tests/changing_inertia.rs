@@ -37,9 +37,8 @@ fn simulate(change: Option<InertiaChange>) -> SimOutput {
 /// Error history (t, error against the true J at t) with forgetting time constant `tau_s`
 /// (`None`: no forgetting).
 fn errors(out: &SimOutput, tau_s: Option<f64>) -> Vec<(f64, f64)> {
-    let h = out.samples[1].t_s - out.samples[0].t_s;
     let settings = RecursiveSettings {
-        forgetting: tau_s.map_or(1.0, |tau| (-h / tau).exp()),
+        memory_s: tau_s,
         ..RecursiveSettings::default()
     };
     let mut e = RecursiveEstimator::new(

@@ -1,10 +1,10 @@
 //! Constraint sets (paper eqs. 9, 55, 57; ERRATA §4) and the solver front end.
 
-use inertia::constraints::{component_by_name, ConstraintError, ConstraintSet};
+use inertia::constraints::{ConstraintError, ConstraintSet};
 use inertia::solver::native::NativeSolver;
 use inertia::solver::{solve, SolveStatus};
 use inertia::tensor::{
-    diagonal_triangle_slacks, j_from_matrix, matrix_from_j, principal, second_moment,
+    diagonal_triangle_slacks, j_from_matrix, matrix_from_j, principal, second_moment, Component,
 };
 use nalgebra::{Matrix3, Matrix6, Vector6};
 
@@ -29,12 +29,12 @@ fn default_set_is_physical_and_has_an_interior_point() {
         ConstraintSet::default(),
         ConstraintSet::paper(),
         ConstraintSet::positive_definite(),
-        ConstraintSet::physical().with_nominal(2, 3.0, 0.1),
-        ConstraintSet::paper().with_nominal(2, 3.0, 0.1),
+        ConstraintSet::physical().with_nominal(Component::J33, 3.0, 0.1),
+        ConstraintSet::paper().with_nominal(Component::J33, 3.0, 0.1),
         ConstraintSet::physical()
-            .with_bounds(0, Some(0.9), Some(1.1))
-            .with_bounds(3, Some(0.03), Some(0.04))
-            .with_bounds(5, None, Some(-0.07)),
+            .with_bounds(Component::J11, Some(0.9), Some(1.1))
+            .with_bounds(Component::J12, Some(0.03), Some(0.04))
+            .with_bounds(Component::J23, None, Some(-0.07)),
     ] {
         let c = set.validate().unwrap();
         assert!(c.strictly_feasible(c.interior()), "{set:?}");
@@ -48,7 +48,7 @@ fn default_set_is_physical_and_has_an_interior_point() {
 
 #[test]
 fn crossed_and_contradictory_bounds_are_errors_before_any_data() {
-    let crossed = ConstraintSet::physical().with_bounds(1, Some(2.0), Some(1.0));
+    let crossed = ConstraintSet::physical().with_bounds(Component::J22, Some(2.0), Some(1.0));
     assert!(matches!(
         crossed.validate(),
         Err(ConstraintError::CrossedBounds {
@@ -59,20 +59,20 @@ fn crossed_and_contradictory_bounds_are_errors_before_any_data() {
     // Diagonal bounds that violate the triangle inequality: J11, J22 ≤ 1 and J33 ≥ 3.
     for set in [ConstraintSet::physical(), ConstraintSet::paper()] {
         let bad = set
-            .with_bounds(0, None, Some(1.0))
-            .with_bounds(1, None, Some(1.0))
-            .with_bounds(2, Some(3.0), None);
+            .with_bounds(Component::J11, None, Some(1.0))
+            .with_bounds(Component::J22, None, Some(1.0))
+            .with_bounds(Component::J33, Some(3.0), None);
         let err = bad.validate().unwrap_err();
         assert!(matches!(err, ConstraintError::Infeasible { .. }), "{err}");
         assert!(err.to_string().contains("no inertia satisfies"));
     }
     // A negative upper bound on a moment contradicts J ⪰ εI.
-    let neg = ConstraintSet::positive_definite().with_bounds(0, None, Some(-0.1));
+    let neg = ConstraintSet::positive_definite().with_bounds(Component::J11, None, Some(-0.1));
     assert!(matches!(
         neg.validate(),
         Err(ConstraintError::Infeasible { .. })
     ));
-    let nan = ConstraintSet::physical().with_bounds(4, Some(f64::NAN), None);
+    let nan = ConstraintSet::physical().with_bounds(Component::J13, Some(f64::NAN), None);
     assert!(matches!(
         nan.validate(),
         Err(ConstraintError::NonFinite { .. })
@@ -89,11 +89,16 @@ fn crossed_and_contradictory_bounds_are_errors_before_any_data() {
 
 #[test]
 fn component_names() {
-    assert_eq!(component_by_name("J33"), Some(2));
-    assert_eq!(component_by_name("j12"), Some(3));
-    assert_eq!(component_by_name("J21"), Some(3));
-    assert_eq!(component_by_name("J32"), Some(5));
-    assert_eq!(component_by_name("J44"), None);
+    assert_eq!(Component::from_name("J33"), Some(Component::J33));
+    assert_eq!(Component::from_name("j12"), Some(Component::J12));
+    assert_eq!(Component::from_name("J21"), Some(Component::J12));
+    assert_eq!(Component::from_name("J32"), Some(Component::J23));
+    assert_eq!(Component::from_name("J44"), None);
+    assert_eq!(Component::from_name("J123"), None);
+    for (k, c) in Component::ALL.into_iter().enumerate() {
+        assert_eq!(c.index(), k);
+        assert_eq!(Component::from_name(c.name()), Some(c));
+    }
 }
 
 /// When the unconstrained minimiser is the ERRATA counterexample, the default set returns

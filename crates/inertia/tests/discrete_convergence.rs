@@ -9,8 +9,8 @@
 use inertia::attitude::Quaternion;
 use inertia::discrete::{Row, RowInput};
 use inertia::dynamics::GyrostatState;
+use inertia::sample::Sample;
 use inertia::sim::{simulate, InputLaw, SimConfig, Zero};
-use inertia::telemetry::Sample;
 use inertia::tensor::{j_from_matrix, paper_j_true};
 use nalgebra::Vector3;
 
@@ -191,7 +191,7 @@ mod errors {
             q,
             rho_nms: Vector3::zeros(),
             tau_nm: Vector3::zeros(),
-            omega_rad_s: Vector3::zeros(),
+            omega_rad_s: Some(Vector3::zeros()),
         }
     }
 
@@ -204,10 +204,13 @@ mod errors {
             RowInput::from_samples([&sample(0.0, q0), &sample(0.1, q1), &sample(0.2, q2)]).unwrap();
         match input.row() {
             Err(RowError::StepTooLarge {
-                interval: 0,
+                t0_s,
+                t1_s,
                 phi_norm,
                 angle_deg,
             }) => {
+                // The first step, named by its time stamps.
+                assert_eq!((t0_s, t1_s), (0.0, 0.1));
                 assert!(phi_norm > 0.999 && (angle_deg - 180.0).abs() < 0.1);
             }
             other => panic!("expected StepTooLarge, got {other:?}"),
@@ -310,7 +313,8 @@ mod jittered {
             .map(|&h| {
                 let raw = jittered_samples(h, rho, tau, jitter);
                 let s = if resample {
-                    let mut r = inertia::estimator::resample::Resampler::new(h);
+                    let mut r =
+                        inertia::estimator::resample::Resampler::new(h).expect("a valid period");
                     let mut out = Vec::new();
                     for x in &raw {
                         r.push(x, |u| out.push(u));

@@ -146,6 +146,6 @@ fn scenario_shapes() {
     let after = out.samples.last().unwrap().rho_nms;
     assert_eq!(before, Vector3::zeros());
     assert_relative_eq!(after, Vector3::new(0.05, 0.0, 0.0), epsilon = 1e-12);
-    let w = out.samples[0].omega_rad_s;
+    let w = out.samples[0].omega_rad_s.expect("simulated rates");
     assert!((w.z - 0.5).abs() < 0.01 && w.xy().norm() > 0.01);
 }

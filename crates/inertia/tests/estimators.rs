@@ -8,19 +8,19 @@ use inertia::estimator::observability::{Observability, ObservabilitySettings, Un
 use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use inertia::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
 use inertia::estimator::{Estimate, EstimatorError};
+use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario, SPIN_J33_NOMINAL, SPIN_J33_TOLERANCE};
 use inertia::sim::SimOutput;
 use inertia::solver::native::NativeSolver;
 use inertia::solver::SolveStatus;
-use inertia::telemetry::Sample;
 use inertia::tensor::{
-    matrix_from_j, normalized_element_errors, relative_frobenius_error, second_moment,
+    matrix_from_j, normalized_element_errors, relative_frobenius_error, second_moment, Component,
     COMPONENT_NAMES,
 };
 use nalgebra::{Matrix3, Vector3};
 
 fn spin_set() -> ConstraintSet {
-    ConstraintSet::paper().with_nominal(2, SPIN_J33_NOMINAL, SPIN_J33_TOLERANCE)
+    ConstraintSet::paper().with_nominal(Component::J33, SPIN_J33_NOMINAL, SPIN_J33_TOLERANCE)
 }
 
 /// Run the recursive estimator over every sample; returns all estimates.
@@ -56,7 +56,12 @@ fn momentum_history(samples: &[Sample]) -> Vec<(f64, Matrix3<f64>)> {
     let mut m = MomentumRls::default();
     samples
         .iter()
-        .filter_map(|s| m.push(s).map(|j| (s.t_s, matrix_from_j(&j))))
+        .filter_map(|s| {
+            m.push(s)
+                .expect("valid samples")
+                .and_then(|e| e.j())
+                .map(|j| (s.t_s, matrix_from_j(&j)))
+        })
         .collect()
 }
 
@@ -153,7 +158,7 @@ fn recursive_equals_batch_at_every_step() {
         (Scenario::spin(), spin_set()),
         (
             Scenario::spin(),
-            ConstraintSet::physical().with_nominal(2, 3.0, 0.1),
+            ConstraintSet::physical().with_nominal(Component::J33, 3.0, 0.1),
         ),
     ] {
         let common = Common {
@@ -235,7 +240,7 @@ fn estimates_satisfy_their_constraints() {
     let out = Scenario::spin().simulate(&Common::paper()).unwrap();
     for set in [
         spin_set(),
-        ConstraintSet::physical().with_nominal(2, 3.0, 0.1),
+        ConstraintSet::physical().with_nominal(Component::J33, 3.0, 0.1),
     ] {
         let c = set.validate().unwrap();
         for e in run::<VariationalRows>(&out.samples, c) {
@@ -262,7 +267,7 @@ fn rotate_body(out: &SimOutput, c: &Matrix3<f64>) -> Vec<Sample> {
             q: s.q.mul(&qc),
             rho_nms: c * s.rho_nms,
             tau_nm: c * s.tau_nm,
-            omega_rad_s: c * s.omega_rad_s,
+            omega_rad_s: s.omega_rad_s.map(|w| c * w),
         })
         .collect()
 }
@@ -323,9 +328,9 @@ fn baselines_recover_j_true_from_noise_free_data() {
     let e = final_error(&fd, &jt);
     assert!(e < 2e-4, "finite difference {e:e}");
     let mut m = MomentumRls::default();
-    out.samples.iter().for_each(|s| {
-        m.push(s);
-    });
+    for s in &out.samples {
+        m.push(s).expect("valid samples");
+    }
     let e = relative_frobenius_error(&m.inertia(), &jt);
     assert!(e < 2e-4, "momentum {e:e}");
 }
@@ -345,7 +350,7 @@ fn pure_spin_samples() -> Vec<Sample> {
     for (k, s) in out.samples.iter_mut().enumerate() {
         s.q = Quaternion::exp(&(w * (k as f64 * 0.1)));
         s.rho_nms = Vector3::new(0.1, 0.0, 0.0);
-        s.omega_rad_s = w;
+        s.omega_rad_s = Some(w);
     }
     out.samples
 }
@@ -447,10 +452,12 @@ fn too_few_samples_and_bad_rows_are_errors() {
 #[test]
 fn excitation_diagnostics() {
     use inertia::estimator::excitation::diagnose;
+    use inertia::estimator::observability::ObservabilitySettings;
+    let diagnose_default = |qr: &_| diagnose(qr, &ObservabilitySettings::default());
     let qr_of = |samples: &[Sample]| batch::reduce(samples, VariationalRows::default()).unwrap();
 
     // Pure spin about body z with a wheel bias off-axis (y ≠ 0, rank-deficient rows).
-    let x = diagnose(&qr_of(&pure_spin_samples()));
+    let x = diagnose_default(&qr_of(&pure_spin_samples()));
     for e in ["J11", "J22", "J12"] {
         assert!(x.weak_elements.contains(&e), "{:?}", x.weak_elements);
     }
@@ -468,7 +475,7 @@ fn excitation_diagnostics() {
             ..Common::paper()
         })
         .unwrap();
-    let x = diagnose(&qr_of(&out.samples));
+    let x = diagnose_default(&qr_of(&out.samples));
     assert!(
         x.advice[0].contains("reaction-wheel momentum change"),
         "{:?}",
@@ -479,7 +486,7 @@ fn excitation_diagnostics() {
     // The full slew: well excited, a standard deviation per element, no warnings. The
     // standard deviations are of the order of the actual errors (paper noise).
     let out = Scenario::slew().simulate(&Common::paper()).unwrap();
-    let x = diagnose(&qr_of(&out.samples));
+    let x = diagnose_default(&qr_of(&out.samples));
     assert!(x.advice.is_empty(), "{:?}", x.advice);
     let sig = x.element_sigma.unwrap();
     assert!(sig.iter().all(|s| *s > 0.0 && *s < 1e-3), "{sig:?}");

@@ -7,13 +7,14 @@ use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use inertia::estimator::rows::{FiniteDifferenceRows, VariationalRows};
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::solver::native::NativeSolver;
+use inertia::tensor::Component;
 
 #[test]
 fn recursive_update_and_native_solve_do_not_allocate() {
     for (sc, set) in [
         (
             Scenario::spin(),
-            ConstraintSet::paper().with_nominal(2, 3.0, 0.1),
+            ConstraintSet::paper().with_nominal(Component::J33, 3.0, 0.1),
         ),
         (Scenario::slew(), ConstraintSet::physical()),
     ] {

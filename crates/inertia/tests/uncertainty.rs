@@ -8,10 +8,11 @@ use inertia::estimator::excitation::diagnose;
 use inertia::estimator::observability::ObservabilitySettings;
 use inertia::estimator::rows::VariationalRows;
 use inertia::estimator::uncertainty::combine;
+use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::solver::native::NativeSolver;
-use inertia::telemetry::Sample;
 use inertia::tensor::j_from_matrix;
+use inertia::tensor::Component;
 
 const RUNS: u64 = 200;
 
@@ -25,7 +26,7 @@ fn one_run(sc: &Scenario, gyro_deg: f64, seed: u64) -> [f64; 6] {
         })
         .unwrap();
     let set = if sc.name() == "spin" {
-        ConstraintSet::paper().with_nominal(2, 3.0, 0.1)
+        ConstraintSet::paper().with_nominal(Component::J33, 3.0, 0.1)
     } else {
         ConstraintSet::paper()
     };
@@ -47,9 +48,12 @@ fn one_run(sc: &Scenario, gyro_deg: f64, seed: u64) -> [f64; 6] {
     let full = estimate(&out.samples);
     let half: Vec<Sample> = out.samples.iter().step_by(2).copied().collect();
     let j_half = estimate(&half);
-    let noise = diagnose(&batch::reduce(&out.samples, VariationalRows::default()).unwrap())
-        .element_sigma
-        .unwrap();
+    let noise = diagnose(
+        &batch::reduce(&out.samples, VariationalRows::default()).unwrap(),
+        &ObservabilitySettings::default(),
+    )
+    .element_sigma
+    .unwrap();
     let u = combine(&noise, &full, Some(&j_half));
     let truth = j_from_matrix(&out.inertia_kg_m2);
     core::array::from_fn(|k| (full[k] - truth[k]).abs() / u.sigma_kg_m2[k])

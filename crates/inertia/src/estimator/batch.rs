@@ -8,8 +8,8 @@ use super::qr::RecursiveQr;
 use super::rows::RowSource;
 use super::{Estimate, EstimatorError, MIN_SAMPLES};
 use crate::constraints::Constraints;
+use crate::sample::Sample;
 use crate::solver::Backend;
-use crate::telemetry::Sample;
 use nalgebra::{DMatrix, DVector, Matrix6, Vector6};
 
 /// The stacked system reduced to `(R, z, ρ²)` by a dense QR.
@@ -73,19 +73,39 @@ pub fn estimate<S: RowSource>(
     gyro_noise_rad_s_rthz: Option<f64>,
 ) -> Result<Estimate, EstimatorError> {
     let qr = reduce(samples, source)?;
-    let observability = assess(&qr, constraints.set().has_bounds(), observability);
+    solve_reduced(
+        &qr,
+        samples.last().map_or(0.0, |s| s.t_s),
+        constraints,
+        backend,
+        observability,
+        gyro_noise_rad_s_rthz,
+    )
+}
+
+/// The estimate (stamped `t_s`) from a reduced least-squares state.
+pub fn solve_reduced(
+    qr: &RecursiveQr,
+    t_s: f64,
+    constraints: &Constraints,
+    backend: &mut dyn Backend,
+    observability: &ObservabilitySettings,
+    gyro_noise_rad_s_rthz: Option<f64>,
+) -> Result<Estimate, EstimatorError> {
+    let observability = assess(qr, constraints.set().has_bounds(), observability);
     let (solution, observability) = super::recursive::solve_with(
         backend,
-        &qr,
+        qr,
         constraints,
         observability,
         gyro_noise_rad_s_rthz,
         None,
     )?;
     Ok(Estimate {
-        t_s: samples.last().map_or(0.0, |s| s.t_s),
+        t_s,
         rows: qr.rows,
         observability,
         solution,
+        uncertainty: None,
     })
 }

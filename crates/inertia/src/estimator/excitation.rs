@@ -14,15 +14,14 @@
 //! any rotor momentum change or known torque (`y ≡ 0`) only the ratios of the elements
 //! are seen, whatever the motion.
 
+use super::observability::ObservabilitySettings;
 use super::qr::RecursiveQr;
 use crate::tensor::{InertiaVector, COMPONENT_INDEX, COMPONENT_NAMES};
 use nalgebra::SVD;
 
-/// Directions weaker than this fraction of the strongest count as poorly excited.
-pub const WEAK_RATIO: f64 = 1e-3;
-
 /// The excitation report.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Excitation {
     /// Singular values of `R`, descending.
     pub singular_values: [f64; 6],
@@ -31,6 +30,7 @@ pub struct Excitation {
     pub weakest_direction: InertiaVector,
     /// Least-squares standard deviation of each element, kg m² (`None` without enough
     /// rows or with a singular `R`).
+    #[cfg_attr(feature = "serde", serde(rename = "element_sigma_kg_m2"))]
     pub element_sigma: Option<[f64; 6]>,
     /// Elements dominating the weakest direction, when it is poorly excited.
     pub weak_elements: Vec<&'static str>,
@@ -40,9 +40,12 @@ pub struct Excitation {
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
-/// Diagnose the excitation of a least-squares state.
+/// Diagnose the excitation of a least-squares state. A direction is poorly excited when
+/// its singular value is below `σ_1 / condition_threshold`: the same test by which the
+/// observability check refuses to call J determined, so the report never says
+/// "determined" and "barely separate" at once.
 #[must_use]
-pub fn diagnose(qr: &RecursiveQr) -> Excitation {
+pub fn diagnose(qr: &RecursiveQr, settings: &ObservabilitySettings) -> Excitation {
     let svd = SVD::new(qr.r, false, true);
     let mut order = [0usize, 1, 2, 3, 4, 5];
     order.sort_unstable_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
@@ -63,7 +66,7 @@ pub fn diagnose(qr: &RecursiveQr) -> Excitation {
     // itself and is left out: the motion question is about the others).
     let skip_scale = usize::from(qr.y_energy == 0.0);
     let weak: Vec<usize> = (0..6 - skip_scale)
-        .filter(|&i| sv[0] > 0.0 && sv[i] < WEAK_RATIO * sv[0])
+        .filter(|&i| sv[0] > 0.0 && sv[i] * settings.condition_threshold < sv[0])
         .collect();
     if let Some(&first_weak) = weak.first() {
         let mut axes = [false; 3];

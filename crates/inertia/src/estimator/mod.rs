@@ -31,17 +31,21 @@ use crate::tensor::{matrix_from_j, InertiaVector};
 use nalgebra::Matrix3;
 use observability::Observability;
 
-/// One estimate at a time stamp.
+/// One estimate at a time stamp: the same type for every estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Estimate {
     /// Time of the newest sample used, s.
     pub t_s: f64,
     /// Scalar rows used.
     pub rows: usize,
-    /// Whether the data determine J.
+    /// Whether the data determine J, and if not, why.
     pub observability: Observability,
-    /// The constrained least-squares answer (`None` when not observable).
+    /// The answer with its solver diagnostics (`None` when there is no answer).
     pub solution: Option<Solution>,
+    /// Standard deviations per element and principal moment, when the estimator has an
+    /// uncertainty model ([`uncertainty`]).
+    pub uncertainty: Option<uncertainty::Uncertainty>,
 }
 
 impl Estimate {
@@ -56,10 +60,26 @@ impl Estimate {
     pub fn inertia(&self) -> Option<Matrix3<f64>> {
         self.j().map(|j| matrix_from_j(&j))
     }
+
+    /// Standard deviation per element, kg m², when known.
+    #[must_use]
+    pub fn sigma_kg_m2(&self) -> Option<[f64; 6]> {
+        self.uncertainty.map(|u| u.sigma_kg_m2)
+    }
+
+    /// Whether `truth` lies within ±3σ of the estimate in every element (`None` without
+    /// an answer or a σ).
+    #[must_use]
+    pub fn within_3sigma(&self, truth: &Matrix3<f64>) -> Option<bool> {
+        let (j, sigma) = (self.j()?, self.sigma_kg_m2()?);
+        let t = crate::tensor::j_from_matrix(truth);
+        Some((0..6).all(|k| crate::math::abs(j[k] - t[k]) <= 3.0 * sigma[k]))
+    }
 }
 
 /// Why an estimator stopped.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum EstimatorError {
     /// Not enough samples for even two row blocks.
     #[error("too few samples: need at least {need}, got {got}")]
@@ -93,3 +113,15 @@ pub enum EstimatorError {
 /// Minimum number of samples for one estimate from 3-row blocks over three nodes (two
 /// blocks, six scalar rows).
 pub const MIN_SAMPLES: usize = 4;
+
+/// A constructor argument out of its documented range.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("argument `{name}` = {value} is invalid: expected {expected}")]
+pub struct InvalidArgument {
+    /// The argument's name.
+    pub name: &'static str,
+    /// The value given.
+    pub value: f64,
+    /// What it must be.
+    pub expected: &'static str,
+}

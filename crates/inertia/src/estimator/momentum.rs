@@ -11,86 +11,170 @@
 //! with unknowns `j` and the initial inertial momentum `h_N`, the node rate `ω_k` the mean
 //! of the gyro rates of the two adjacent intervals, and the torque integral by the
 //! trapezoid rule. Standard covariance-form RLS from `x = 0` with a large initial
-//! covariance `P_0 = p0 I`, optional forgetting, no constraints.
+//! covariance `P_0 = p0 I`, optional forgetting with a memory in seconds (each update
+//! weighs the past by `exp(−Δt/memory)`, `Δt` the actual step), no constraints.
+//!
+//! The baseline makes no observability test: its estimates carry
+//! [`Observability::Unchecked`]. A non-finite state is reported as
+//! [`Unobservable::Diverged`], never as an answer.
 
-use crate::attitude::Quaternion;
-use crate::discrete::g_matrix;
-use crate::telemetry::Sample;
+use super::observability::{Observability, Unobservable};
+use super::{Estimate, EstimatorError, InvalidArgument};
+use crate::discrete::{g_matrix, RowError};
+use crate::sample::Sample;
+use crate::solver::{Residuals, Solution, SolveStatus};
 use crate::tensor::{matrix_from_j, InertiaVector};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-/// Initial covariance scale (default 1e6; units of the unknowns squared).
+/// Default initial covariance scale (units of the unknowns squared).
 pub const DEFAULT_P0: f64 = 1e6;
+
+/// Settings of the momentum RLS.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MomentumSettings {
+    /// Initial covariance `P_0 = p0 I` (default [`DEFAULT_P0`]); finite and > 0.
+    pub p0: f64,
+    /// Memory time constant, s (`None`, the default: no forgetting); finite and > 0.
+    pub memory_s: Option<f64>,
+}
+
+impl Default for MomentumSettings {
+    fn default() -> Self {
+        Self {
+            p0: DEFAULT_P0,
+            memory_s: None,
+        }
+    }
+}
 
 /// The RLS state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MomentumRls {
     x: SVector<f64, 9>,
     p: SMatrix<f64, 9, 9>,
-    forgetting: f64,
-    prev: Option<Sample>,
-    prev_rate: Option<Vector3<f64>>,
+    memory_s: Option<f64>,
+    prev: Option<(Sample, Vector3<f64>)>,
     torque_integral: Vector3<f64>,
     samples: usize,
+    updates: usize,
 }
 
 impl Default for MomentumRls {
     fn default() -> Self {
-        Self::new(DEFAULT_P0, 1.0)
+        Self::from_valid(MomentumSettings::default())
     }
 }
 
 impl MomentumRls {
-    /// A new estimator with `P_0 = p0 I` and forgetting factor `forgetting` (1: none).
-    #[must_use]
-    pub fn new(p0: f64, forgetting: f64) -> Self {
+    /// A new estimator; rejects a non-positive or non-finite `p0` or memory.
+    pub fn new(settings: MomentumSettings) -> Result<Self, InvalidArgument> {
+        if !(settings.p0.is_finite() && settings.p0 > 0.0) {
+            return Err(InvalidArgument {
+                name: "p0",
+                value: settings.p0,
+                expected: "a finite initial covariance > 0",
+            });
+        }
+        if let Some(m) = settings.memory_s {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(InvalidArgument {
+                    name: "memory_s",
+                    value: m,
+                    expected: "a finite memory > 0 s",
+                });
+            }
+        }
+        Ok(Self::from_valid(settings))
+    }
+
+    fn from_valid(settings: MomentumSettings) -> Self {
         Self {
             x: SVector::zeros(),
-            p: SMatrix::identity() * p0,
-            forgetting,
+            p: SMatrix::identity() * settings.p0,
+            memory_s: settings.memory_s,
             prev: None,
-            prev_rate: None,
             torque_integral: Vector3::zeros(),
             samples: 0,
+            updates: 0,
         }
     }
 
-    /// Feed a sample; returns the current `j` once a row has been used.
+    /// Feed a sample; returns the current estimate once a row has been used.
     ///
     /// The row at node k needs the gyro rate of interval k−1, so the first sample only
-    /// primes the state.
-    pub fn push(&mut self, s: &Sample) -> Option<InertiaVector> {
+    /// primes the state. A sample without a gyro rate is an error
+    /// ([`RowError::MissingGyroRate`]).
+    pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+        let index = self.samples;
         self.samples += 1;
+        let row_error = |source| EstimatorError::Row {
+            sample: index,
+            source,
+        };
+        let rate = s.omega_rad_s.ok_or(row_error(RowError::MissingGyroRate))?;
+        if !rate
+            .iter()
+            .chain(s.rho_nms.iter())
+            .chain(s.tau_nm.iter())
+            .all(|v| v.is_finite())
+        {
+            return Err(row_error(RowError::NonFinite {
+                what: "gyro rate, rotor momentum or torque",
+            }));
+        }
         let c = s.q.to_matrix();
-        let out = if let (Some(prev), Some(prev_rate)) = (self.prev, self.prev_rate) {
+        let out = if let Some((prev, prev_rate)) = self.prev {
             let dt = s.t_s - prev.t_s;
-            self.torque_integral += 0.5 * dt * (rotate(&prev.q, &prev.tau_nm) + c * s.tau_nm);
-            let w = 0.5 * (prev_rate + s.omega_rad_s);
+            self.torque_integral += 0.5 * dt * (prev.q.rotate(&prev.tau_nm) + c * s.tau_nm);
+            let w = 0.5 * (prev_rate + rate);
             let mut a = SMatrix::<f64, 3, 9>::zeros();
             a.fixed_view_mut::<3, 6>(0, 0)
                 .copy_from(&(c * g_matrix(&w)));
             a.fixed_view_mut::<3, 3>(0, 6)
                 .copy_from(&(-Matrix3::identity()));
             let b = self.torque_integral - c * s.rho_nms;
-            self.update(&a, &b);
-            Some(self.j())
+            let lambda = self.memory_s.map_or(1.0, |m| libm::exp(-dt / m));
+            self.update(&a, &b, lambda);
+            self.updates += 1;
+            Some(self.estimate(s.t_s))
         } else {
             None
         };
-        self.prev = Some(*s);
-        self.prev_rate = Some(s.omega_rad_s);
-        out
+        self.prev = Some((*s, rate));
+        Ok(out)
     }
 
-    fn update(&mut self, a: &SMatrix<f64, 3, 9>, b: &Vector3<f64>) {
+    fn estimate(&self, t_s: f64) -> Estimate {
+        let j = self.j();
+        let finite = j.iter().all(|v| v.is_finite());
+        Estimate {
+            t_s,
+            rows: 3 * self.updates,
+            observability: if finite {
+                Observability::Unchecked
+            } else {
+                Observability::NotObservable(Unobservable::Diverged)
+            },
+            solution: finite.then_some(Solution {
+                j,
+                objective: 0.0,
+                status: SolveStatus::RecursiveLeastSquares,
+                iterations: 0,
+                residuals: Residuals::default(),
+            }),
+            uncertainty: None,
+        }
+    }
+
+    fn update(&mut self, a: &SMatrix<f64, 3, 9>, b: &Vector3<f64>, lambda: f64) {
         let pa = self.p * a.transpose();
-        let s = Matrix3::identity() * self.forgetting + a * pa;
+        let s = Matrix3::identity() * lambda + a * pa;
         let Some(s_inv) = s.try_inverse() else {
             return;
         };
         let k = pa * s_inv;
         self.x += k * (b - a * self.x);
-        self.p = (self.p - k * a * self.p) / self.forgetting;
+        self.p = (self.p - k * a * self.p) / lambda;
         self.p = (self.p + self.p.transpose()) * 0.5;
     }
 
@@ -109,7 +193,7 @@ impl MomentumRls {
     /// Row blocks used so far.
     #[must_use]
     pub fn updates(&self) -> usize {
-        self.samples.saturating_sub(1)
+        self.updates
     }
 
     /// Estimated initial inertial momentum `h_N`, N m s.
@@ -117,8 +201,4 @@ impl MomentumRls {
     pub fn initial_momentum(&self) -> Vector3<f64> {
         Vector3::new(self.x[6], self.x[7], self.x[8])
     }
-}
-
-fn rotate(q: &Quaternion, v: &Vector3<f64>) -> Vector3<f64> {
-    q.rotate(v)
 }

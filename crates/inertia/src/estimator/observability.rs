@@ -5,7 +5,8 @@
 //! test here looks at the singular values `σ_1 ≥ … ≥ σ_6` of `R` and at `Σ‖y_k‖²`:
 //!
 //! * `y ≡ 0` → [`Unobservable::NoExcitation`];
-//! * `σ_6 = 0` or fewer than six rows → [`Unobservable::RankDeficient`];
+//! * `σ_6` below [`crate::solver::SINGULAR_RATIO`] of `σ_1`, or fewer than six rows →
+//!   [`Unobservable::RankDeficient`];
 //! * `σ_1/σ_6` above the threshold ([`DEFAULT_CONDITION_THRESHOLD`]) →
 //!   [`Unobservable::IllConditioned`];
 //! * the least-squares standard deviation of `j`, `‖σ_j‖/‖ĵ‖` with
@@ -54,6 +55,9 @@ impl Default for ObservabilitySettings {
 
 /// Why the data alone cannot determine J.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(tag = "kind", rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Unobservable {
     /// No rotor momentum and no known torque: `y ≡ 0`, J fixed only up to scale.
     NoExcitation,
@@ -73,6 +77,8 @@ pub enum Unobservable {
     /// With errors-in-variables compensation, the gyro noise outweighs the excitation
     /// (the compensated information matrix is not positive definite).
     NoiseDominated,
+    /// The estimate is not finite: the estimator diverged on these data.
+    Diverged,
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -113,6 +119,10 @@ impl core::fmt::Display for Unobservable {
                 f,
                 "the gyro noise outweighs the excitation: the noise-compensated information matrix is not positive definite"
             ),
+            Unobservable::Diverged => write!(
+                f,
+                "the estimate is not finite: the estimator diverged on these data"
+            ),
             Unobservable::IllConditioned {
                 condition,
                 threshold,
@@ -126,6 +136,9 @@ impl core::fmt::Display for Unobservable {
 
 /// Whether and how an estimate is determined.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(tag = "status", rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum Observability {
     /// The data determine J.
     Determined {
@@ -136,6 +149,9 @@ pub enum Observability {
     FromPrior(Unobservable),
     /// Nothing determines J: no answer.
     NotObservable(Unobservable),
+    /// The estimator makes no observability test (the momentum RLS baseline): an answer,
+    /// with no claim about how well the data determine it.
+    Unchecked,
 }
 
 impl Observability {
@@ -143,6 +159,53 @@ impl Observability {
     #[must_use]
     pub fn has_answer(&self) -> bool {
         !matches!(self, Observability::NotObservable(_))
+    }
+
+    /// Short code for files: `determined`, `from_prior`, `not_observable`, `unchecked`.
+    #[must_use]
+    pub fn code(&self) -> &'static str {
+        match self {
+            Observability::Determined { .. } => "determined",
+            Observability::FromPrior(_) => "from_prior",
+            Observability::NotObservable(_) => "not_observable",
+            Observability::Unchecked => "unchecked",
+        }
+    }
+
+    /// Why the data fall short, when they do.
+    #[must_use]
+    pub fn reason(&self) -> Option<Unobservable> {
+        match self {
+            Observability::FromPrior(r) | Observability::NotObservable(r) => Some(*r),
+            _ => None,
+        }
+    }
+
+    /// `σ_1/σ_6` of `R` when the data determine J.
+    #[must_use]
+    pub fn condition(&self) -> Option<f64> {
+        match self {
+            Observability::Determined { condition } => Some(*condition),
+            _ => None,
+        }
+    }
+}
+
+impl core::fmt::Display for Observability {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Observability::Determined { condition } => {
+                write!(
+                    f,
+                    "determined by the data (condition number {condition:.3e})"
+                )
+            }
+            Observability::FromPrior(r) => write!(f, "answer leans on the prior bounds: {r}"),
+            Observability::NotObservable(r) => write!(f, "NOT OBSERVABLE: {r}"),
+            Observability::Unchecked => {
+                f.write_str("recursive least squares (no observability test, unconstrained)")
+            }
+        }
     }
 }
 
@@ -208,7 +271,7 @@ pub fn assess_with(
     let threshold = settings.condition_threshold;
     let sv = *sv;
     let smax = sv.max();
-    let tiny = smax * 1e-13;
+    let tiny = smax * crate::solver::SINGULAR_RATIO;
     let rank = if qr.rows == 0 || !(smax > 0.0) {
         0
     } else {

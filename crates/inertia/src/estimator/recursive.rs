@@ -24,8 +24,11 @@ pub struct RecursiveSettings {
     pub solve_every: usize,
     /// Thresholds of the observability test.
     pub observability: ObservabilitySettings,
-    /// Exponential forgetting factor per block, `0 < λ ≤ 1` (default 1: no forgetting).
-    pub forgetting: f64,
+    /// Memory time constant, s: before each row block the state is weighed by
+    /// `exp(−Δt/memory)`, with `Δt` the time since the previous block from the samples'
+    /// own time stamps (so jitter, gaps and resampling are weighed by the time that
+    /// passed). `None` (default): no forgetting.
+    pub memory_s: Option<f64>,
     /// Gyro rate-noise density, rad/s/√Hz, for errors-in-variables bias compensation
     /// ([`super::compensation`]); `None` (default): no compensation.
     pub gyro_noise_rad_s_rthz: Option<f64>,
@@ -36,7 +39,7 @@ impl Default for RecursiveSettings {
         Self {
             solve_every: 1,
             observability: ObservabilitySettings::default(),
-            forgetting: 1.0,
+            memory_s: None,
             gyro_noise_rad_s_rthz: None,
         }
     }
@@ -72,11 +75,13 @@ impl RecursiveSettings {
                 });
             }
         }
-        if !(self.forgetting > 0.0 && self.forgetting <= 1.0) {
-            return Err(EstimatorError::InvalidSetting {
-                field: "forgetting",
-                why: "must be in (0, 1]",
-            });
+        if let Some(m) = self.memory_s {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(EstimatorError::InvalidSetting {
+                    field: "memory_s",
+                    why: "must be finite and > 0 s",
+                });
+            }
         }
         Ok(())
     }
@@ -94,6 +99,7 @@ pub struct RecursiveEstimator<S: RowSource, B: Backend> {
     settings: RecursiveSettings,
     samples: usize,
     since_solve: usize,
+    last_block_t_s: Option<f64>,
     last: Option<Estimate>,
 }
 
@@ -116,16 +122,14 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             settings,
             samples: 0,
             since_solve: 0,
+            last_block_t_s: None,
             last: None,
         })
     }
 
     /// Feed one sample. Returns an estimate when this sample completed a block and a solve
     /// was due.
-    pub fn push(
-        &mut self,
-        s: &crate::telemetry::Sample,
-    ) -> Result<Option<Estimate>, EstimatorError> {
+    pub fn push(&mut self, s: &crate::sample::Sample) -> Result<Option<Estimate>, EstimatorError> {
         let index = self.samples;
         self.samples += 1;
         let Some(row) = self.source.push(s) else {
@@ -135,9 +139,10 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             sample: index,
             source,
         })?;
-        if self.settings.forgetting < 1.0 {
-            self.qr.scale(self.settings.forgetting);
+        if let (Some(m), Some(t0)) = (self.settings.memory_s, self.last_block_t_s) {
+            self.qr.scale(libm::exp(-(s.t_s - t0) / m));
         }
+        self.last_block_t_s = Some(s.t_s);
         self.qr.add(&row);
         self.since_solve += 1;
         if self.since_solve < self.settings.solve_every || self.qr.rows < 6 {
@@ -170,6 +175,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             rows: self.qr.rows,
             observability,
             solution,
+            uncertainty: None,
         };
         self.last = Some(e);
         Ok(e)

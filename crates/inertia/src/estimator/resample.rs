@@ -8,12 +8,12 @@
 //! second of the four nodes, then `q = q_ref exp(r(t))`; rotor momentum, torque and gyro
 //! rate component by component. Output time `t` is produced once the input brackets it
 //! with two nodes on each side; gaps (a step longer than
-//! [`super::rows::GAP_RATIO`] times the previous) restart the grid after the gap.
+//! [`crate::sample::GAP_RATIO`] times the previous) restart the grid after the gap.
 //! Streaming, fixed size, no allocation.
 
-use super::rows::GAP_RATIO;
+use super::InvalidArgument;
 use crate::attitude::Quaternion;
-use crate::telemetry::Sample;
+use crate::sample::{is_gap, Sample};
 use nalgebra::Vector3;
 
 /// Streaming resampler to period `h`.
@@ -37,21 +37,34 @@ fn lagrange_weights(t: &[f64; 4], x: f64) -> [f64; 4] {
 }
 
 impl Resampler {
-    /// Resample to period `h_s` (> 0), starting at the first input time.
-    #[must_use]
-    pub fn new(h_s: f64) -> Self {
-        Self {
+    /// Resample to period `h_s`, starting at the first input time. `h_s` must be finite
+    /// and positive.
+    pub fn new(h_s: f64) -> Result<Self, InvalidArgument> {
+        if !(h_s.is_finite() && h_s > 0.0) {
+            return Err(InvalidArgument {
+                name: "h_s",
+                value: h_s,
+                expected: "a finite period > 0 s",
+            });
+        }
+        Ok(Self {
             h_s,
             nodes: [None; 4],
             next_t: None,
-        }
+        })
+    }
+
+    /// The output period, s.
+    #[must_use]
+    pub fn period_s(&self) -> f64 {
+        self.h_s
     }
 
     /// Feed an input sample (times increasing); `out` receives each output sample that
     /// became available, in time order.
     pub fn push(&mut self, s: &Sample, mut out: impl FnMut(Sample)) {
         if let (Some(a), Some(b)) = (self.nodes[2], self.nodes[3]) {
-            if s.t_s - b.t_s > GAP_RATIO * (b.t_s - a.t_s) {
+            if is_gap(b.t_s - a.t_s, s.t_s - b.t_s) {
                 // A gap: flush nothing across it, restart the grid at this sample.
                 self.nodes = [None; 4];
                 self.next_t = None;
@@ -75,7 +88,10 @@ impl Resampler {
                 break;
             }
             out(interpolate(&[n0, n1, n2, n3], &t, x));
-            self.next_t = Some(x + self.h_s);
+            let next = x + self.h_s;
+            // A period below the resolution of t (x + h = x) cannot advance the grid:
+            // move on to the next interval rather than loop.
+            self.next_t = Some(if next > x { next } else { t[2] });
         }
     }
 }
@@ -86,12 +102,12 @@ fn interpolate(n: &[Sample; 4], t: &[f64; 4], x: f64) -> Sample {
     let mut r = Vector3::zeros();
     let mut rho = Vector3::zeros();
     let mut tau = Vector3::zeros();
-    let mut omega = Vector3::zeros();
+    let mut omega = Some(Vector3::zeros());
     for i in 0..4 {
         r += q_ref.conjugate().mul(&n[i].q).log() * w[i];
         rho += n[i].rho_nms * w[i];
         tau += n[i].tau_nm * w[i];
-        omega += n[i].omega_rad_s * w[i];
+        omega = omega.zip(n[i].omega_rad_s).map(|(o, w_i)| o + w_i * w[i]);
     }
     Sample {
         t_s: x,

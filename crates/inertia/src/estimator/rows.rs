@@ -5,12 +5,10 @@
 //! * [`FiniteDifferenceRows`]: the paper's finite-difference baseline (§VI), eq. 26 at node
 //!   k with `ω̇` differenced from the gyro rates.
 
-use crate::attitude::skew;
-use crate::discrete::{g_matrix, Row, RowError, RowInput};
-use crate::telemetry::Sample;
-
-/// A step longer than this many times the previous one is a gap: no row spans it.
-pub const GAP_RATIO: f64 = 3.0;
+use crate::attitude::{incremental_rotation, skew};
+use crate::discrete::{check_phi, check_unit, g_matrix, Row, RowError, RowInput};
+use crate::sample::{is_gap, Sample};
+use nalgebra::Vector3;
 
 /// A stateful source of rows fed one sample at a time.
 pub trait RowSource {
@@ -18,45 +16,90 @@ pub trait RowSource {
     fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>>;
     /// Forget buffered samples (e.g. across a gap).
     fn reset(&mut self);
-    /// Gaps seen so far (steps longer than [`GAP_RATIO`] times the previous step).
+    /// Gaps seen so far ([`crate::sample::is_gap`]).
     fn gaps(&self) -> usize;
 }
 
-/// The last three samples. A step longer than [`GAP_RATIO`] times the previous one is a
-/// gap (missing samples, a pause): the window restarts after it, so no row spans it.
+#[cfg(feature = "std")]
+impl<S: RowSource + ?Sized> RowSource for std::boxed::Box<S> {
+    fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>> {
+        (**self).push(s)
+    }
+    fn reset(&mut self) {
+        (**self).reset();
+    }
+    fn gaps(&self) -> usize {
+        (**self).gaps()
+    }
+}
+
+/// Three consecutive nodes and the incremental rotations of their two intervals.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Stencil {
+    /// Nodes k, k+1, k+2.
+    pub nodes: [Sample; 3],
+    /// `φ_k`, `φ_{k+1}`.
+    pub phi: [Vector3<f64>; 2],
+}
+
+/// The last two samples and the φ of the interval between them. A step longer than
+/// [`crate::sample::GAP_RATIO`] times the previous one is a gap: the window restarts after
+/// it, so no row spans it. Each φ is computed and checked once, when its interval arrives.
 #[derive(Debug, Clone, Copy, Default)]
-struct Window {
+pub(crate) struct Window {
     a: Option<Sample>,
     b: Option<Sample>,
+    phi_ab: Vector3<f64>,
     gaps: usize,
 }
 
 impl Window {
     /// Forget the buffered samples, keep the gap count.
-    fn reset(&mut self) {
+    pub fn reset(&mut self) {
         *self = Window {
             gaps: self.gaps,
             ..Window::default()
         };
     }
 
-    fn push(&mut self, s: &Sample) -> Option<(Sample, Sample)> {
-        if let (Some(a), Some(b)) = (self.a, self.b) {
-            let (h0, h1) = (b.t_s - a.t_s, s.t_s - b.t_s);
-            if h1 > GAP_RATIO * h0 {
+    /// Gaps seen so far.
+    pub fn gaps(&self) -> usize {
+        self.gaps
+    }
+
+    /// Feed a sample; the stencil it completes, if any.
+    pub fn push(&mut self, s: &Sample) -> Option<Result<Stencil, RowError>> {
+        // Each sample's attitude is checked once, as it arrives (node 2 of its first row).
+        if let Err(e) = check_unit(&s.q, 2) {
+            return Some(Err(e));
+        }
+        let Some(b) = self.b else {
+            self.b = Some(*s);
+            return None;
+        };
+        if let Some(a) = self.a {
+            if is_gap(b.t_s - a.t_s, s.t_s - b.t_s) {
                 self.gaps += 1;
                 self.a = None;
                 self.b = Some(*s);
                 return None;
             }
         }
-        let out = match (self.a, self.b) {
-            (Some(a), Some(b)) => Some((a, b)),
-            _ => None,
-        };
-        self.a = self.b;
+        let phi = incremental_rotation(&b.q, &s.q);
+        if let Err(e) = check_phi(&phi, b.t_s, s.t_s) {
+            // Restart after the bad step so that later rows do not span it.
+            self.a = None;
+            self.b = Some(*s);
+            return Some(Err(e));
+        }
+        let out = self.a.map(|a| Stencil {
+            nodes: [a, b, *s],
+            phi: [self.phi_ab, phi],
+        });
+        self.a = Some(b);
         self.b = Some(*s);
-        out
+        self.phi_ab = phi;
+        out.map(Ok)
     }
 }
 
@@ -68,8 +111,20 @@ pub struct VariationalRows {
 
 impl RowSource for VariationalRows {
     fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>> {
-        let (a, b) = self.w.push(s)?;
-        Some(RowInput::from_samples([&a, &b, s]).and_then(|r| r.row()))
+        Some(self.w.push(s)?.and_then(|st| {
+            let [a, b, c] = st.nodes;
+            RowInput {
+                t_k_s: a.t_s,
+                phi_k: st.phi[0],
+                phi_k1: st.phi[1],
+                rho_k_nms: 0.5 * (a.rho_nms + b.rho_nms),
+                rho_k1_nms: 0.5 * (b.rho_nms + c.rho_nms),
+                tau_k1_nm: b.tau_nm,
+                h_s: b.t_s - a.t_s,
+                h1_s: c.t_s - b.t_s,
+            }
+            .row_checked_phi()
+        }))
     }
 
     fn reset(&mut self) {
@@ -77,7 +132,7 @@ impl RowSource for VariationalRows {
     }
 
     fn gaps(&self) -> usize {
-        self.w.gaps
+        self.w.gaps()
     }
 }
 
@@ -99,8 +154,10 @@ pub struct FiniteDifferenceRows {
 
 impl RowSource for FiniteDifferenceRows {
     fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>> {
-        let (a, b) = self.w.push(s)?;
-        Some(fd_row(&a, &b, s))
+        Some(self.w.push(s)?.and_then(|st| {
+            let [a, b, c] = st.nodes;
+            fd_row(&a, &b, &c)
+        }))
     }
 
     fn reset(&mut self) {
@@ -108,7 +165,7 @@ impl RowSource for FiniteDifferenceRows {
     }
 
     fn gaps(&self) -> usize {
-        self.w.gaps
+        self.w.gaps()
     }
 }
 
@@ -120,8 +177,11 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
             what: "sample period",
         });
     }
-    let finite = |v: &nalgebra::Vector3<f64>| v.iter().all(|x| x.is_finite());
-    if !(finite(&a.omega_rad_s) && finite(&b.omega_rad_s)) {
+    let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
+    let (Some(wa), Some(wb)) = (a.omega_rad_s, b.omega_rad_s) else {
+        return Err(RowError::MissingGyroRate);
+    };
+    if !(finite(&wa) && finite(&wb)) {
         return Err(RowError::NonFinite { what: "gyro rate" });
     }
     if !(finite(&a.rho_nms) && finite(&b.rho_nms) && finite(&c.rho_nms)) {
@@ -134,8 +194,8 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
             what: "known torque",
         });
     }
-    let w = (a.omega_rad_s * h1 + b.omega_rad_s * h0) / (h0 + h1);
-    let wdot = (b.omega_rad_s - a.omega_rad_s) / (0.5 * (h0 + h1));
+    let w = (wa * h1 + wb * h0) / (h0 + h1);
+    let wdot = (wb - wa) / (0.5 * (h0 + h1));
     let rho_dot = (c.rho_nms - a.rho_nms) / (h0 + h1);
     Ok(Row {
         h: g_matrix(&wdot) + skew(&w) * g_matrix(&w),
@@ -143,4 +203,16 @@ fn fd_row(a: &Sample, b: &Sample, c: &Sample) -> Result<Row, RowError> {
         // The gyro noise of these rows (differenced rates) is not modelled.
         noise_s: 0.0,
     })
+}
+
+impl<S: RowSource + ?Sized> RowSource for &mut S {
+    fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>> {
+        (**self).push(s)
+    }
+    fn reset(&mut self) {
+        (**self).reset();
+    }
+    fn gaps(&self) -> usize {
+        (**self).gaps()
+    }
 }

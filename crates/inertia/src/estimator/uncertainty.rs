@@ -25,6 +25,7 @@ use nalgebra::{Matrix6, Vector3, Vector6};
 
 /// Standard deviations of an estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Uncertainty {
     /// Total standard deviation per element (order of eq. 48), kg m².
     pub sigma_kg_m2: [f64; 6],
@@ -35,6 +36,21 @@ pub struct Uncertainty {
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
     pub principal_sigma_kg_m2: [f64; 3],
+}
+
+impl Uncertainty {
+    /// Standard deviation of `‖Ĵ − J‖_F`, kg m², with the elements independent: each
+    /// product of inertia appears twice in J.
+    #[must_use]
+    pub fn frobenius_sigma_kg_m2(&self) -> f64 {
+        let s = &self.sigma_kg_m2;
+        crate::math::sqrt(
+            s[0] * s[0]
+                + s[1] * s[1]
+                + s[2] * s[2]
+                + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]),
+        )
+    }
 }
 
 /// `σ_LS` per element from singular values `sv` and right singular vectors `v` (columns)

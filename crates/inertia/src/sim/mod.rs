@@ -21,7 +21,7 @@ pub mod sensors;
 
 use crate::attitude::Quaternion;
 use crate::dynamics::{rk4_step, GyrostatState};
-use crate::telemetry::Sample;
+use crate::sample::Sample;
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -313,7 +313,7 @@ pub fn simulate(
             q: q_meas,
             rho_nms: x_k.rho_nms,
             tau_nm: tau_k,
-            omega_rad_s: rate,
+            omega_rad_s: Some(rate),
         });
         truth.push(TruthSample {
             t_s: t_k,

@@ -18,7 +18,7 @@
 //! Starting point: the constraint set's interior point (all slacks positive), W = ∅
 //! (Nocedal & Wright, Algorithm 16.3). Fixed sizes, no allocation.
 
-use super::barrier::{Lin, MAX_LIN};
+use crate::constraints::description::{Lin, MAX_LIN};
 use crate::constraints::Constraints;
 use nalgebra::{Matrix6, Vector6};
 

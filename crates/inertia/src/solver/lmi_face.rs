@@ -23,7 +23,7 @@
 //! estimation) or from a barrier answer (which it polishes to round-off accuracy), it
 //! converges in a few steps. Fixed sizes, no allocation.
 
-use super::barrier::Lmi;
+use crate::constraints::description::Lmi;
 use crate::constraints::Constraints;
 use crate::givens::{fold_row, solve_normal};
 use crate::math::sqrt;

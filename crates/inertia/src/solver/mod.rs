@@ -20,11 +20,10 @@
 //! Backends: [`native::NativeSolver`] (pure Rust, default) and, with the `clarabel`
 //! feature, `clarabel_backend::ClarabelSolver` (the reference conic solver).
 
-pub mod active_set;
-pub mod barrier;
+mod active_set;
 #[cfg(feature = "clarabel")]
 pub mod clarabel_backend;
-pub mod lmi_face;
+mod lmi_face;
 pub mod native;
 
 use crate::constraints::Constraints;
@@ -33,6 +32,9 @@ use nalgebra::{Matrix6, Vector6};
 
 /// How a solution was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
 pub enum SolveStatus {
     /// The unconstrained minimiser is strictly feasible and was returned exactly.
     Unconstrained,
@@ -40,10 +42,14 @@ pub enum SolveStatus {
     Optimal,
     /// Stopped at an iteration limit; the point is feasible but less accurate.
     Inaccurate,
+    /// A recursive least-squares update with no constraints and no solve (the momentum
+    /// RLS baseline).
+    RecursiveLeastSquares,
 }
 
 /// Optimality residuals of an answer, in the scaled problem's units (objective O(1)).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Residuals {
     /// Largest constraint violation, kg m² (0 for strictly feasible answers).
     pub primal: f64,
@@ -56,10 +62,11 @@ pub struct Residuals {
 
 /// A solver's answer.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Solution {
     /// The estimate `j`, kg m².
     pub j: InertiaVector,
-    /// `‖R j − z‖²` in the original units.
+    /// `‖R j − z‖²` in the original units (0 for the momentum RLS, which has no `R`).
     pub objective: f64,
     /// How it was obtained.
     pub status: SolveStatus,
@@ -71,6 +78,7 @@ pub struct Solution {
 
 /// Why a solve failed.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SolveError {
     /// `R` or `z` has NaN or infinite entries.
     #[error("the least-squares data contain NaN or infinite values")]
@@ -101,11 +109,15 @@ pub trait Backend {
     ) -> Result<Solution, SolveError>;
 }
 
-/// Smallest `|R_ii| / max|R_jj|` for which the fast path trusts a triangular solve.
-pub const FAST_PATH_PIVOT_RATIO: f64 = 1e-10;
+/// The one definition of "singular" in this crate: a triangular pivot `|R_ii|` or a
+/// singular value of `R` below this fraction of the largest counts as absent. The fast
+/// path refuses a triangular solve past it, and the observability test counts the rank
+/// with it. (How *weak* a present direction may be before J counts as undetermined is
+/// the observability test's condition threshold, which the excitation report shares.)
+pub const SINGULAR_RATIO: f64 = 1e-10;
 
 /// The unconstrained minimiser `R⁻¹ z` of an upper-triangular `R` by back substitution,
-/// or `None` when a pivot is below [`FAST_PATH_PIVOT_RATIO`] of the largest.
+/// or `None` when a pivot is below [`SINGULAR_RATIO`] of the largest.
 #[must_use]
 pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<InertiaVector> {
     let dmax = r.diagonal().amax();
@@ -115,7 +127,7 @@ pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<Ine
     let mut x = Vector6::zeros();
     for i in (0..6).rev() {
         let d = r[(i, i)];
-        if d.abs() <= FAST_PATH_PIVOT_RATIO * dmax {
+        if d.abs() <= SINGULAR_RATIO * dmax {
             return None;
         }
         let mut s = z[i];
@@ -163,4 +175,21 @@ pub fn solve(
     let mut sol = backend.solve_scaled(&(r / sigma), &(z / sigma), constraints, warm)?;
     sol.objective = (r * sol.j - z).norm_squared();
     Ok(sol)
+}
+
+#[cfg(feature = "std")]
+impl<B: Backend + ?Sized> Backend for std::boxed::Box<B> {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+
+    fn solve_scaled(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<Solution, SolveError> {
+        (**self).solve_scaled(r, z, constraints, warm)
+    }
 }

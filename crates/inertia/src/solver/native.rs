@@ -1,4 +1,4 @@
-//! The native backend: [`barrier`](super::barrier) on the 6-variable problem.
+//! The native backend: a log-barrier method on the 6-variable problem.
 //!
 //! First an exact active-set solve of the linear constraints alone
 //! ([`super::active_set`]); when its answer satisfies the LMIs strictly it is optimal
@@ -9,8 +9,9 @@
 //! convexity) when warm starting is on, else the interior point itself. Pure Rust, no
 //! allocation, `no_std`-capable.
 
-use super::barrier::{self, BarrierSettings, Problem};
 use super::{Backend, Residuals, Solution, SolveError, SolveStatus};
+pub use crate::barrier::BarrierSettings;
+use crate::barrier::{self, Problem};
 use crate::constraints::Constraints;
 use crate::tensor::InertiaVector;
 use nalgebra::{Matrix6, Vector6};

@@ -18,14 +18,12 @@
 //! Every error names the file, the line and the column: unparsable numbers, NaN or
 //! infinite values, missing columns, quaternions whose norm differs from 1 by more than
 //! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
-//! non-increasing time, steps whose rotation is too large for `|φ| < 1`
-//! ([`crate::discrete::MAX_PHI_NORM`]), and, only when [`CsvOptions::period_tolerance`] is
-//! set, a step that differs from the first one by more than that (relative).
+//! non-increasing time, and, only when [`CsvOptions::period_tolerance`] is set, a step
+//! that differs from the first one by more than that (relative). What concerns pairs of
+//! samples as rows (the rotation of a step, gaps) is the estimators' to check and count,
+//! once ([`crate::estimator::rows`]).
 //!
-//! Irregular sampling is accepted: the variational rows handle unequal steps. A step
-//! longer than [`crate::estimator::rows::GAP_RATIO`] times the previous one is a gap
-//! (missing samples, a pause): it is counted, its rotation is not checked (no row spans
-//! it), and the estimators restart their row window after it. Consecutive quaternions of opposite
+//! Irregular sampling is accepted: the variational rows handle unequal steps. Consecutive quaternions of opposite
 //! sign (`q` and `−q` are the same attitude) are accepted and counted. Nothing is dropped:
 //! a row is either returned or reported as an error, and [`ReadStats`] counts what was
 //! read, renormalised and sign-flipped.
@@ -33,9 +31,8 @@
 //! The reader is an iterator and holds one row at a time: memory does not grow with the
 //! file.
 
-use super::Sample;
-use crate::attitude::{incremental_rotation, Quaternion};
-use crate::discrete::{check_phi, RowError};
+use crate::attitude::Quaternion;
+use crate::sample::Sample;
 use nalgebra::Vector3;
 use std::fs::File;
 use std::io::Read;
@@ -155,8 +152,6 @@ pub struct ReadStats {
     pub sign_flips: usize,
     /// Rows rejected (the reader stops at the first; this is 0 or 1).
     pub rejected: usize,
-    /// Gaps (a step longer than `GAP_RATIO` times the previous one).
-    pub gaps: usize,
     /// Shortest and longest step, s (0 before two rows).
     pub min_step_s: f64,
     /// Longest step, s.
@@ -264,18 +259,6 @@ pub enum TelemetryError {
         /// The tolerance.
         tolerance: f64,
     },
-    /// The rotation since the previous row is too large.
-    #[error("{file}:{line}: columns `{columns}`: {source}")]
-    StepTooLarge {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// The quaternion columns.
-        columns: String,
-        /// The row error.
-        source: RowError,
-    },
 }
 
 impl TelemetryError {
@@ -290,8 +273,7 @@ impl TelemetryError {
             | TelemetryError::NonFinite { line, .. }
             | TelemetryError::NonUnitQuaternion { line, .. }
             | TelemetryError::NonIncreasingTime { line, .. }
-            | TelemetryError::NonUniformPeriod { line, .. }
-            | TelemetryError::StepTooLarge { line, .. } => Some(*line),
+            | TelemetryError::NonUniformPeriod { line, .. } => Some(*line),
         }
     }
 }
@@ -456,7 +438,9 @@ impl<R: Read> TelemetryReader<R> {
         ))
     }
 
-    fn q_columns(&self) -> String {
+    /// The names of the quaternion columns, comma-separated (for messages).
+    #[must_use]
+    pub fn quaternion_columns(&self) -> String {
         self.idx.q.map(|i| self.headers[i].clone()).join(",")
     }
 
@@ -518,7 +502,7 @@ impl<R: Read> TelemetryReader<R> {
             return Err(TelemetryError::NonUnitQuaternion {
                 file: self.file.clone(),
                 line,
-                columns: self.q_columns(),
+                columns: self.quaternion_columns(),
                 norm,
                 tolerance: self.options.unit_tolerance,
             });
@@ -538,8 +522,8 @@ impl<R: Read> TelemetryReader<R> {
             None => Vector3::zeros(),
         };
         let w = match self.idx.w {
-            Some(i) => self.vec3(line, &i)?,
-            None => Vector3::repeat(f64::NAN),
+            Some(i) => Some(self.vec3(line, &i)?),
+            None => None,
         };
         if let Some(prev) = self.prev {
             let dt = t - prev.t_s;
@@ -569,12 +553,6 @@ impl<R: Read> TelemetryReader<R> {
                     }
                 }
             }
-            let gap = self
-                .prev_step
-                .is_some_and(|h| dt > crate::estimator::rows::GAP_RATIO * h);
-            if gap {
-                self.stats.gaps += 1;
-            }
             self.stats.min_step_s = if self.prev_step.is_some() {
                 self.stats.min_step_s.min(dt)
             } else {
@@ -584,16 +562,6 @@ impl<R: Read> TelemetryReader<R> {
             self.prev_step = Some(dt);
             if prev.q.v.dot(&q.v) + prev.q.s * q.s < 0.0 {
                 self.stats.sign_flips += 1;
-            }
-            if !gap {
-                check_phi(&incremental_rotation(&prev.q, &q), 0).map_err(|source| {
-                    TelemetryError::StepTooLarge {
-                        file: self.file.clone(),
-                        line,
-                        columns: self.q_columns(),
-                        source,
-                    }
-                })?;
             }
         }
         Ok(Sample {
@@ -664,15 +632,19 @@ impl<R: Read> Iterator for TelemetryReader<R> {
     }
 }
 
-/// Write samples as CSV in the default format (scalar-last Hamilton quaternion, all
-/// columns). Used by the simulator's command-line front end and by tests.
+/// Write samples as CSV in the default format (scalar-last Hamilton quaternion; the gyro
+/// columns `w_*` only when every sample has a rate). Used by the simulator's command-line
+/// front end and by tests.
 pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    w.write_record([
+    let with_rates = samples.iter().all(|s| s.omega_rad_s.is_some());
+    let header = [
         "t", "q_x", "q_y", "q_z", "q_w", "rho_x", "rho_y", "rho_z", "tau_x", "tau_y", "tau_z",
         "w_x", "w_y", "w_z",
-    ])?;
+    ];
+    w.write_record(&header[..if with_rates { 14 } else { 11 }])?;
     for s in samples {
+        let rate = s.omega_rad_s.unwrap_or_default();
         let v = [
             s.t_s,
             s.q.v.x,
@@ -685,11 +657,12 @@ pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::
             s.tau_nm.x,
             s.tau_nm.y,
             s.tau_nm.z,
-            s.omega_rad_s.x,
-            s.omega_rad_s.y,
-            s.omega_rad_s.z,
+            rate.x,
+            rate.y,
+            rate.z,
         ];
-        w.write_record(v.iter().map(|x| format!("{x:?}")))?;
+        let n = if with_rates { 14 } else { 11 };
+        w.write_record(v[..n].iter().map(|x| format!("{x:?}")))?;
     }
     w.flush()
 }

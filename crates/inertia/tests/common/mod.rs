@@ -75,7 +75,7 @@ fn random_set(rng: &mut ChaCha8Rng, anchor: &InertiaVector) -> ConstraintSet {
             let hi = rng
                 .random_bool(0.8)
                 .then(|| anchor[k] + w * rng.random_range(0.0..1.0));
-            set = set.with_bounds(k, lo, hi);
+            set = set.with_bounds(inertia::tensor::Component::ALL[k], lo, hi);
         }
     }
     set

@@ -25,70 +25,10 @@
 //! once per constraint set, see `constraints`), which removes the main weakness of
 //! barrier methods, and the central-path dual point gives honest optimality residuals.
 
+use crate::constraints::description::{Lin, Lmi};
 use crate::givens::{fold_row, solve_normal};
 use crate::math::{ln, sqrt};
 use nalgebra::{Matrix3, SMatrix, SVector};
-
-/// Most linear inequalities in a validated constraint set (3 triangle + 12 bounds).
-pub const MAX_LIN: usize = 16;
-
-/// A 3×3 LMI `F0 + Σ_k x_k F_k ⪰ 0` in `N` variables.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lmi<const N: usize> {
-    /// Constant term.
-    pub f0: Matrix3<f64>,
-    /// Coefficient of each variable.
-    pub fk: [Matrix3<f64>; N],
-}
-
-impl<const N: usize> Lmi<N> {
-    /// The zero LMI.
-    #[must_use]
-    pub fn zero() -> Self {
-        Self {
-            f0: Matrix3::zeros(),
-            fk: [Matrix3::zeros(); N],
-        }
-    }
-
-    /// `F0 + Σ x_k F_k`.
-    #[must_use]
-    #[inline]
-    pub fn eval(&self, x: &SVector<f64, N>) -> Matrix3<f64> {
-        let mut m = self.f0;
-        for k in 0..N {
-            m += self.fk[k] * x[k];
-        }
-        m
-    }
-}
-
-/// A linear inequality `aᵀ x ≥ b` in `N` variables.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lin<const N: usize> {
-    /// Coefficients.
-    pub a: SVector<f64, N>,
-    /// Right-hand side.
-    pub b: f64,
-}
-
-impl<const N: usize> Lin<N> {
-    /// The zero inequality `0 ≥ 0`.
-    #[must_use]
-    pub fn zero() -> Self {
-        Self {
-            a: SVector::zeros(),
-            b: 0.0,
-        }
-    }
-
-    /// The slack `aᵀ x − b` (≥ 0 when satisfied).
-    #[must_use]
-    #[inline]
-    pub fn eval(&self, x: &SVector<f64, N>) -> f64 {
-        self.a.dot(x) - self.b
-    }
-}
 
 /// A problem instance (borrowed constraint arrays): objective `‖A x − b‖² + cᵀx`.
 #[derive(Debug, Clone, Copy)]

@@ -20,8 +20,11 @@
 //! constraints and validation fails with the best margin achievable. The interior point
 //! also starts every interior-point solve.
 
-use crate::solver::barrier::{self, BarrierSettings, Lin, Lmi, Problem, MAX_LIN};
-use crate::tensor::{InertiaVector, COMPONENT_INDEX, COMPONENT_NAMES};
+pub mod description;
+
+use crate::barrier::{self, BarrierSettings, Problem};
+use crate::tensor::{Component, InertiaVector, COMPONENT_INDEX, COMPONENT_NAMES};
+use description::{Lin, Lmi, MAX_LIN};
 use nalgebra::{Matrix3, SMatrix, SVector};
 
 /// Default ε of `J ⪰ εI`, kg m². Above the solvers' tolerances after scaling.
@@ -29,6 +32,7 @@ pub const DEFAULT_EPSILON_KG_M2: f64 = 1e-6;
 
 /// Which physical-consistency condition to impose besides `J ⪰ εI`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Consistency {
     /// `Σ = ½ tr(J) I − J ⪰ 0` (ERRATA §4). The default.
     #[default]
@@ -50,6 +54,18 @@ pub struct ConstraintSet {
     pub lower_kg_m2: [Option<f64>; 6],
     /// Upper bounds per component of `j`, kg m².
     pub upper_kg_m2: [Option<f64>; 6],
+}
+
+impl Consistency {
+    /// Short name: `physical`, `paper` or `positive-definite` (as on the command line).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Consistency::Physical => "physical",
+            Consistency::PaperTriangle => "paper",
+            Consistency::PositiveDefiniteOnly => "positive-definite",
+        }
+    }
 }
 
 impl Default for ConstraintSet {
@@ -92,26 +108,6 @@ pub enum ConstraintError {
     },
 }
 
-/// A component of `j` by name.
-#[must_use]
-pub fn component_by_name(name: &str) -> Option<usize> {
-    COMPONENT_NAMES
-        .iter()
-        .position(|n| n.eq_ignore_ascii_case(name))
-        .or_else(|| {
-            // J21 = J12 and so on.
-            let b = name.as_bytes();
-            if b.len() == 3 && (b[0] == b'J' || b[0] == b'j') {
-                let (r, c) = (b[1].wrapping_sub(b'1'), b[2].wrapping_sub(b'1'));
-                COMPONENT_INDEX
-                    .iter()
-                    .position(|&(i, k)| (i, k) == (c as usize, r as usize))
-            } else {
-                None
-            }
-        })
-}
-
 impl ConstraintSet {
     /// `J ⪰ εI` and `Σ ⪰ 0`: the default.
     #[must_use]
@@ -143,10 +139,16 @@ impl ConstraintSet {
     }
 
     /// Add `lower ≤ j[component] ≤ upper` (either side optional), intersecting with any
-    /// bound already present.
+    /// bound already present. Products are tensor entries (`J12 = −Σ m x y`; negate a CAD
+    /// tool's products of inertia). Bad values are caught by [`Self::validate`].
     #[must_use]
-    pub fn with_bounds(mut self, component: usize, lower: Option<f64>, upper: Option<f64>) -> Self {
-        let c = component.min(5);
+    pub fn with_bounds(
+        mut self,
+        component: Component,
+        lower: Option<f64>,
+        upper: Option<f64>,
+    ) -> Self {
+        let c = component.index();
         if let Some(l) = lower {
             self.lower_kg_m2[c] = Some(self.lower_kg_m2[c].map_or(l, |o| o.max(l)));
         }
@@ -157,11 +159,29 @@ impl ConstraintSet {
     }
 
     /// Add `|j[component] − nominal| ≤ fraction · |nominal|` (the paper's spin case bounds
-    /// J33 within 10 % of 3 kg m²: `with_nominal(2, 3.0, 0.10)`).
+    /// J33 within 10 % of 3 kg m²: `with_nominal(Component::J33, 3.0, 0.10)`).
     #[must_use]
-    pub fn with_nominal(self, component: usize, nominal: f64, fraction: f64) -> Self {
+    pub fn with_nominal(self, component: Component, nominal: f64, fraction: f64) -> Self {
         let w = (fraction * nominal).abs();
         self.with_bounds(component, Some(nominal - w), Some(nominal + w))
+    }
+
+    /// Bound every element to a nominal J (e.g. from CAD) within `fraction`: a moment
+    /// `J_ii` within `fraction · |J_ii|`, a product `J_ik` within
+    /// `fraction · √(J_ii J_kk)`. `nominal` holds tensor entries (`J12 = −Σ m x y`).
+    #[must_use]
+    pub fn with_nominal_inertia(mut self, nominal: &Matrix3<f64>, fraction: f64) -> Self {
+        let j: InertiaVector = crate::tensor::j_from_matrix(nominal);
+        for k in Component::ALL {
+            let (r, c) = k.position();
+            let w = if k.is_product() {
+                fraction * crate::math::sqrt(crate::math::abs(nominal[(r, r)] * nominal[(c, c)]))
+            } else {
+                fraction * crate::math::abs(nominal[(r, r)])
+            };
+            self = self.with_bounds(k, Some(j[k.index()] - w), Some(j[k.index()] + w));
+        }
+        self
     }
 
     /// `true` when any element bound is set (a prior that can fix the scale of J).

@@ -1,0 +1,281 @@
+//! The estimation pipeline: everything an estimate needs, behind one type. The command
+//! line tool, and the Python and C bindings, call only this.
+//!
+//! ```text
+//! PipelineSettings ──validate──▶ PipelineConfig ──▶ Pipeline
+//!   estimator (by name)            registry entries      samples ─▶ [resample] ─▶ estimator ─▶ Estimate
+//!   solver backend (by name)       validated constraints                                       (J, status, σ,
+//!   constraints, memory_s, …       gyro noise in rad/s/√Hz                                     solver diagnostics)
+//! ```
+//!
+//! * The estimator and the solver backend are chosen at run time by name from
+//!   [`registry::ESTIMATORS`] and [`registry::BACKENDS`].
+//! * Memory is a time constant in seconds; each row block is weighed by the time that
+//!   actually passed ([`crate::estimator::recursive::RecursiveSettings::memory_s`]), so
+//!   jitter, gaps and resampling need no conversion.
+//! * Every estimator returns the same [`Estimate`]: J, status with its reason, σ where the
+//!   estimator has an uncertainty model, and the solver's diagnostics.
+//!
+//! ```
+//! use inertia::pipeline::{Pipeline, PipelineSettings};
+//! use inertia::sim::scenario::{Common, Scenario};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let run = Scenario::slew().simulate(&Common { duration_s: Some(120.0), ..Common::paper() })?;
+//! let mut pipeline = Pipeline::new(&PipelineSettings {
+//!     memory_s: Some(600.0),
+//!     ..PipelineSettings::default()
+//! })?;
+//! for s in &run.samples {
+//!     pipeline.push(s)?;
+//! }
+//! let e = pipeline.last().expect("an estimate");
+//! assert!(e.observability.has_answer());
+//! assert_eq!(e.within_3sigma(&run.inertia_kg_m2), Some(true));
+//! # Ok(())
+//! # }
+//! ```
+
+mod momentum;
+pub mod registry;
+mod sdp;
+mod settings;
+
+#[cfg(feature = "csv")]
+pub mod history;
+#[cfg(feature = "serde")]
+pub mod report;
+
+pub use registry::{BatchOutput, Capabilities, Estimator};
+pub use settings::{PipelineConfig, PipelineSettings};
+
+use crate::constraints::ConstraintError;
+use crate::estimator::excitation::Excitation;
+use crate::estimator::resample::Resampler;
+use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
+use crate::sample::Sample;
+use std::boxed::Box;
+use std::string::String;
+
+/// Why a pipeline cannot be built or cannot go on.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PipelineError {
+    /// No estimator of that name.
+    #[error("unknown estimator `{name}` (known: {})", registry::estimator_names())]
+    UnknownEstimator {
+        /// The name given.
+        name: String,
+    },
+    /// No solver backend of that name.
+    #[error("unknown solver `{name}` (known: {})", registry::backend_names())]
+    UnknownSolver {
+        /// The name given.
+        name: String,
+    },
+    /// The backend exists but not in this build.
+    #[error("solver `{name}`: {why}")]
+    SolverUnavailable {
+        /// Backend name.
+        name: &'static str,
+        /// Why.
+        why: &'static str,
+    },
+    /// A setting is out of range.
+    #[error("setting `{field}` = {value} is invalid: expected {expected}")]
+    InvalidSetting {
+        /// The setting.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// A setting the chosen estimator does not use (rather than ignore it silently).
+    #[error("setting `{setting}` does not apply to the {estimator} estimator")]
+    NotApplicable {
+        /// The setting.
+        setting: &'static str,
+        /// The estimator.
+        estimator: &'static str,
+    },
+    /// The estimator has no batch form.
+    #[error("the {estimator} estimator has no batch form")]
+    NoBatch {
+        /// The estimator.
+        estimator: &'static str,
+    },
+    /// The constraint set is unusable.
+    #[error("constraints: {0}")]
+    Constraints(#[from] ConstraintError),
+    /// The estimator stopped on the data.
+    #[error("{}{source}", sample.map(|s| std::format!("input sample {s}: ")).unwrap_or_default())]
+    Estimator {
+        /// 0-based index of the input sample that stopped it, when one did.
+        sample: Option<usize>,
+        /// What went wrong.
+        source: EstimatorError,
+    },
+}
+
+impl PipelineError {
+    pub(crate) fn from_argument(a: InvalidArgument) -> Self {
+        PipelineError::InvalidSetting {
+            field: a.name,
+            value: a.value,
+            expected: a.expected,
+        }
+    }
+}
+
+/// An estimator fed sample by sample, with optional resampling in front.
+pub struct Pipeline {
+    config: PipelineConfig,
+    resampler: Option<Resampler>,
+    estimator: Box<dyn Estimator>,
+    input_samples: usize,
+    estimator_samples: usize,
+    last: Option<Estimate>,
+}
+
+impl core::fmt::Debug for Pipeline {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Pipeline")
+            .field("config", &self.config)
+            .field("input_samples", &self.input_samples)
+            .field("last", &self.last)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Pipeline {
+    /// Validate `settings` and build the pipeline.
+    pub fn new(settings: &PipelineSettings) -> Result<Self, PipelineError> {
+        Self::from_config(settings.validate()?)
+    }
+
+    /// Build from an already validated configuration.
+    pub fn from_config(config: PipelineConfig) -> Result<Self, PipelineError> {
+        let resampler = config
+            .resample_s
+            .map(Resampler::new)
+            .transpose()
+            .map_err(PipelineError::from_argument)?;
+        Ok(Self {
+            estimator: (config.estimator.build)(&config)?,
+            config,
+            resampler,
+            input_samples: 0,
+            estimator_samples: 0,
+            last: None,
+        })
+    }
+
+    /// Feed one input sample. Returns the newest estimate it produced (resampling can
+    /// produce several, or none; [`Self::push_each`] sees every one).
+    pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, PipelineError> {
+        let mut newest = None;
+        self.push_each(s, |e| newest = Some(*e))?;
+        Ok(newest)
+    }
+
+    /// Feed one input sample; `on_estimate` receives every estimate it produced, in time
+    /// order.
+    pub fn push_each(
+        &mut self,
+        s: &Sample,
+        mut on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), PipelineError> {
+        let index = self.input_samples;
+        self.input_samples += 1;
+        let Self {
+            resampler,
+            estimator,
+            estimator_samples,
+            last,
+            ..
+        } = self;
+        let mut feed = |u: &Sample| -> Result<(), PipelineError> {
+            *estimator_samples += 1;
+            let e = estimator
+                .push(u)
+                .map_err(|source| PipelineError::Estimator {
+                    sample: Some(index),
+                    source,
+                })?;
+            if let Some(e) = e {
+                *last = Some(e);
+                on_estimate(&e);
+            }
+            Ok(())
+        };
+        match resampler {
+            None => feed(s),
+            Some(r) => {
+                let mut result = Ok(());
+                r.push(s, |u| {
+                    if result.is_ok() {
+                        result = feed(&u);
+                    }
+                });
+                result
+            }
+        }
+    }
+
+    /// The newest estimate.
+    #[must_use]
+    pub fn last(&self) -> Option<&Estimate> {
+        self.last.as_ref()
+    }
+
+    /// The excitation report of the data so far (estimators with a least-squares state).
+    #[must_use]
+    pub fn excitation(&self) -> Option<Excitation> {
+        self.estimator.excitation()
+    }
+
+    /// Gaps in the time stamps seen by the estimator.
+    #[must_use]
+    pub fn gaps(&self) -> usize {
+        self.estimator.gaps()
+    }
+
+    /// Input samples fed.
+    #[must_use]
+    pub fn input_samples(&self) -> usize {
+        self.input_samples
+    }
+
+    /// Samples the estimator saw (after resampling).
+    #[must_use]
+    pub fn estimator_samples(&self) -> usize {
+        self.estimator_samples
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &PipelineConfig {
+        &self.config
+    }
+}
+
+/// Estimate from all samples at once (eq. 57) with the configured estimator, which must
+/// have a batch form. Memory and resampling do not apply.
+pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    let entry = config.estimator;
+    for (setting, set) in [
+        ("memory_s", config.memory_s.is_some()),
+        ("resample_s", config.resample_s.is_some()),
+    ] {
+        if set {
+            return Err(PipelineError::NotApplicable {
+                setting,
+                estimator: "batch",
+            });
+        }
+    }
+    let run = entry.batch.ok_or(PipelineError::NoBatch {
+        estimator: entry.name,
+    })?;
+    run(samples, config)
+}

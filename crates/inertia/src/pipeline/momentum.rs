@@ -1,0 +1,47 @@
+//! The momentum RLS baseline ([`crate::estimator::momentum`]) in the pipeline.
+
+use super::registry::{Capabilities, Estimator, EstimatorEntry};
+use super::settings::PipelineConfig;
+use super::PipelineError;
+use crate::estimator::momentum::{MomentumRls, MomentumSettings};
+use crate::estimator::{Estimate, EstimatorError};
+use crate::sample::Sample;
+use std::boxed::Box;
+
+/// Registry entry.
+pub(crate) const MOMENTUM: EstimatorEntry = EstimatorEntry {
+    name: "momentum",
+    summary: "momentum-based RLS baseline (Norman, Peck & O'Shaughnessy 2011), unconstrained, needs gyro rates",
+    capabilities: Capabilities {
+        needs_gyro: true,
+        constraints: false,
+        compensation: false,
+        uncertainty: false,
+    },
+    build,
+    batch: None,
+};
+
+struct Momentum {
+    rls: MomentumRls,
+    every: usize,
+}
+
+fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
+    let rls = MomentumRls::new(MomentumSettings {
+        memory_s: c.memory_s,
+        ..MomentumSettings::default()
+    })
+    .map_err(PipelineError::from_argument)?;
+    Ok(Box::new(Momentum {
+        rls,
+        every: c.solve_every,
+    }))
+}
+
+impl Estimator for Momentum {
+    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+        let e = self.rls.push(s)?;
+        Ok(e.filter(|_| self.rls.updates().is_multiple_of(self.every)))
+    }
+}

@@ -1,0 +1,166 @@
+//! The estimators and solver backends the pipeline can run, by name.
+//!
+//! Adding a row model, an estimator or a backend is its own file plus one line in
+//! [`ESTIMATORS`] or [`BACKENDS`].
+
+use super::settings::PipelineConfig;
+use super::PipelineError;
+use crate::estimator::excitation::Excitation;
+use crate::estimator::{Estimate, EstimatorError};
+use crate::sample::Sample;
+use crate::solver::Backend;
+use std::boxed::Box;
+
+/// A streaming estimator as the pipeline drives it.
+pub trait Estimator: Send {
+    /// Feed one sample; an estimate when one is due.
+    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError>;
+    /// Gaps in the time stamps seen so far (no row spans a gap).
+    fn gaps(&self) -> usize {
+        0
+    }
+    /// How well the data so far excite each direction of `j`, where the estimator can
+    /// say.
+    fn excitation(&self) -> Option<Excitation> {
+        None
+    }
+}
+
+/// The answer of a batch run.
+#[derive(Debug, Clone)]
+pub struct BatchOutput {
+    /// The estimate from all samples.
+    pub estimate: Estimate,
+    /// The excitation report of the same least-squares state.
+    pub excitation: Option<Excitation>,
+    /// Gaps in the time stamps.
+    pub gaps: usize,
+}
+
+/// What an estimator uses and needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capabilities {
+    /// It needs gyro rates in the telemetry.
+    pub needs_gyro: bool,
+    /// It keeps J in the constraint set.
+    pub constraints: bool,
+    /// It compensates errors-in-variables given the gyro noise density.
+    pub compensation: bool,
+    /// It has an uncertainty model.
+    pub uncertainty: bool,
+}
+
+/// Build a streaming estimator from a validated configuration.
+pub type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
+/// Estimate from all samples at once.
+pub type BatchFn = fn(&[Sample], &PipelineConfig) -> Result<BatchOutput, PipelineError>;
+
+/// A registered estimator.
+#[derive(Debug)]
+pub struct EstimatorEntry {
+    /// Name, as given in settings and on the command line.
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// What it uses and needs.
+    pub capabilities: Capabilities,
+    pub(crate) build: BuildFn,
+    pub(crate) batch: Option<BatchFn>,
+}
+
+impl EstimatorEntry {
+    /// Whether it can estimate from all samples at once.
+    #[must_use]
+    pub fn has_batch(&self) -> bool {
+        self.batch.is_some()
+    }
+}
+
+/// A registered solver backend.
+#[derive(Debug)]
+pub struct BackendEntry {
+    /// Name, as given in settings and on the command line.
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    pub(crate) build: fn() -> Result<Box<dyn Backend + Send>, PipelineError>,
+}
+
+/// Every estimator, the default first.
+pub static ESTIMATORS: &[EstimatorEntry] = &[
+    super::sdp::VARIATIONAL,
+    super::sdp::FINITE_DIFFERENCE,
+    super::momentum::MOMENTUM,
+];
+
+/// Every solver backend, the default first.
+pub static BACKENDS: &[BackendEntry] = &[NATIVE, CLARABEL];
+
+const NATIVE: BackendEntry = BackendEntry {
+    name: "native",
+    summary: "pure-Rust active-set, LMI-face Newton and barrier paths (default)",
+    build: || Ok(Box::new(crate::solver::native::NativeSolver::default())),
+};
+
+const CLARABEL: BackendEntry = BackendEntry {
+    name: "clarabel",
+    summary: "Clarabel interior-point conic solver (builds with the `clarabel` feature)",
+    build: || {
+        #[cfg(feature = "clarabel")]
+        {
+            Ok(Box::new(
+                crate::solver::clarabel_backend::ClarabelSolver::default(),
+            ))
+        }
+        #[cfg(not(feature = "clarabel"))]
+        {
+            Err(PipelineError::SolverUnavailable {
+                name: "clarabel",
+                why: "this build has no Clarabel backend (rebuild with the `clarabel` feature, which needs system OpenBLAS)",
+            })
+        }
+    },
+};
+
+fn names<T>(entries: &[T], name: impl Fn(&T) -> &'static str) -> std::string::String {
+    entries
+        .iter()
+        .map(name)
+        .collect::<std::vec::Vec<_>>()
+        .join(", ")
+}
+
+/// Names of the registered estimators, comma-separated.
+#[must_use]
+pub fn estimator_names() -> std::string::String {
+    names(ESTIMATORS, |e| e.name)
+}
+
+/// Names of the registered backends, comma-separated.
+#[must_use]
+pub fn backend_names() -> std::string::String {
+    names(BACKENDS, |e| e.name)
+}
+
+/// The estimator called `name`.
+pub fn estimator(name: &str) -> Result<&'static EstimatorEntry, PipelineError> {
+    ESTIMATORS
+        .iter()
+        .find(|e| e.name == name)
+        .ok_or_else(|| PipelineError::UnknownEstimator { name: name.into() })
+}
+
+/// The backend called `name`.
+pub fn backend(name: &str) -> Result<&'static BackendEntry, PipelineError> {
+    BACKENDS
+        .iter()
+        .find(|e| e.name == name)
+        .ok_or_else(|| PipelineError::UnknownSolver { name: name.into() })
+}
+
+/// A fresh backend for `entry`.
+pub(crate) fn build_backend(
+    entry: &BackendEntry,
+) -> Result<Box<dyn Backend + Send>, PipelineError> {
+    (entry.build)()
+}

@@ -1,0 +1,251 @@
+//! The end-of-run report (feature `serde`): one [`Report`] serialises to the versioned
+//! JSON schema of `inertia estimate --json` and displays as its text report.
+//!
+//! Schema version [`SCHEMA_VERSION`]. Keys (units in the README's conventions; products
+//! of inertia are tensor entries, `J12 = −Σ m x y`): `schema_version`, the input summary
+//! (`file`, `sample_period_s`, `renormalised`, `sign_flips`, `min_step_s`, `max_step_s`,
+//! when the samples came from a file), `estimator`, `solver`, `constraints`, `batch`,
+//! `samples`, `gaps`, `t`, `status` ([`Observability::code`]), `reason`, `condition`,
+//! `inertia` (3×3, kg m²), `j`, `sigma`, `principal_moments`, `principal_moments_sigma`,
+//! `principal_axes` (columns), `solver_status`, `iterations`, `relative_error` (against a
+//! given truth), `excitation`. Absent values are `null`.
+//!
+//! [`Observability::code`]: crate::estimator::observability::Observability::code
+
+use super::settings::PipelineConfig;
+use crate::estimator::excitation::Excitation;
+use crate::estimator::observability::Observability;
+use crate::estimator::Estimate;
+use crate::solver::SolveStatus;
+use crate::tensor::{principal, relative_frobenius_error, COMPONENT_NAMES};
+use core::fmt::{self, Write};
+use nalgebra::Matrix3;
+use std::string::{String, ToString};
+
+/// Version of the JSON report; it changes whenever a key is removed or changes meaning.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// Where the samples came from (a telemetry file).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct InputSummary {
+    /// File name.
+    pub file: String,
+    /// The first step, s.
+    pub sample_period_s: f64,
+    /// Quaternions renormalised on reading.
+    pub renormalised: usize,
+    /// Quaternion sign flips accepted on reading.
+    pub sign_flips: usize,
+    /// Shortest step, s.
+    pub min_step_s: f64,
+    /// Longest step, s.
+    pub max_step_s: f64,
+}
+
+/// The report of one run.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Report {
+    /// [`SCHEMA_VERSION`].
+    pub schema_version: u32,
+    /// Where the samples came from.
+    #[serde(flatten)]
+    pub input: Option<InputSummary>,
+    /// Estimator name.
+    pub estimator: &'static str,
+    /// Solver backend name.
+    pub solver: &'static str,
+    /// Consistency condition (`physical`, `paper`, `positive-definite`).
+    pub constraints: &'static str,
+    /// Whether all samples were used at once (eq. 57).
+    pub batch: bool,
+    /// Samples the estimator saw (after resampling).
+    pub samples: usize,
+    /// Gaps in the time stamps.
+    pub gaps: usize,
+    /// Time of the estimate, s.
+    pub t: f64,
+    /// Status code.
+    pub status: &'static str,
+    /// Why the data fall short, when they do.
+    pub reason: Option<String>,
+    /// `σ_1/σ_6` of `R` when determined.
+    pub condition: Option<f64>,
+    /// J, kg m², rows.
+    pub inertia: Option<[[f64; 3]; 3]>,
+    /// `[J11, J22, J33, J12, J13, J23]`, kg m².
+    pub j: Option<[f64; 6]>,
+    /// Standard deviation per element, kg m².
+    pub sigma: Option<[f64; 6]>,
+    /// Principal moments, ascending, kg m².
+    pub principal_moments: Option<[f64; 3]>,
+    /// Their standard deviations, kg m².
+    pub principal_moments_sigma: Option<[f64; 3]>,
+    /// Principal axes (columns, body axes), rows of the matrix.
+    pub principal_axes: Option<[[f64; 3]; 3]>,
+    /// How the solver obtained the answer.
+    pub solver_status: Option<SolveStatus>,
+    /// Solver iterations.
+    pub iterations: Option<u32>,
+    /// Relative Frobenius error against a given truth.
+    pub relative_error: Option<f64>,
+    /// The excitation report.
+    pub excitation: Option<Excitation>,
+    #[serde(skip)]
+    observability: Observability,
+}
+
+fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    core::array::from_fn(|r| core::array::from_fn(|c| m[(r, c)]))
+}
+
+impl Report {
+    /// The report of `estimate`, produced by a pipeline with `config` from `samples`
+    /// samples with `gaps` gaps.
+    #[must_use]
+    pub fn new(
+        estimate: &Estimate,
+        config: &PipelineConfig,
+        batch: bool,
+        samples: usize,
+        gaps: usize,
+    ) -> Self {
+        let m = estimate.inertia();
+        let pr = m.map(|m| principal(&m));
+        Self {
+            schema_version: SCHEMA_VERSION,
+            input: None,
+            estimator: config.estimator().name,
+            solver: config.backend().name,
+            constraints: config.constraints().set().consistency.name(),
+            batch,
+            samples,
+            gaps,
+            t: estimate.t_s,
+            status: estimate.observability.code(),
+            reason: estimate.observability.reason().map(|r| r.to_string()),
+            condition: estimate.observability.condition(),
+            inertia: m.as_ref().map(rows),
+            j: estimate.j().map(|j| core::array::from_fn(|k| j[k])),
+            sigma: estimate.sigma_kg_m2(),
+            principal_moments: pr.map(|(v, _)| [v[0], v[1], v[2]]),
+            principal_moments_sigma: estimate.uncertainty.map(|u| u.principal_sigma_kg_m2),
+            principal_axes: pr.map(|(_, ax)| rows(&ax)),
+            solver_status: estimate.solution.map(|s| s.status),
+            iterations: estimate.solution.map(|s| s.iterations),
+            relative_error: None,
+            excitation: None,
+            observability: estimate.observability,
+        }
+    }
+
+    /// With the input summary.
+    #[must_use]
+    pub fn with_input(mut self, input: InputSummary) -> Self {
+        self.input = Some(input);
+        self
+    }
+
+    /// With the excitation report.
+    #[must_use]
+    pub fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
+        self.excitation = excitation;
+        self
+    }
+
+    /// With the error against a known J (kg m²).
+    #[must_use]
+    pub fn with_truth(mut self, truth: Option<&Matrix3<f64>>) -> Self {
+        self.relative_error = match (self.inertia, truth) {
+            (Some(m), Some(t)) => Some(relative_frobenius_error(
+                &Matrix3::from_fn(|r, c| m[r][c]),
+                t,
+            )),
+            _ => None,
+        };
+        self
+    }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, s: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(i) = &self.input {
+            let steps = if (i.max_step_s - i.min_step_s) <= 1e-9 * i.max_step_s {
+                std::format!("h = {:.6} s", i.sample_period_s)
+            } else {
+                std::format!("steps {:.6}–{:.6} s", i.min_step_s, i.max_step_s)
+            };
+            writeln!(
+                s,
+                "{}: {} samples, {steps} ({} renormalised, {} sign flips, {} gaps)",
+                i.file, self.samples, i.renormalised, i.sign_flips, self.gaps
+            )?;
+        }
+        writeln!(
+            s,
+            "estimator: {} ({}), solver: {}, constraints: {}, t = {} s",
+            self.estimator,
+            if self.batch { "batch" } else { "recursive" },
+            self.solver,
+            self.constraints,
+            self.t
+        )?;
+        writeln!(s, "status: {}", self.observability)?;
+        let (Some(m), Some(j)) = (self.inertia, self.j) else {
+            return writeln!(s, "no estimate: the data cannot determine J");
+        };
+        writeln!(s, "J [kg m²] =")?;
+        for r in m {
+            writeln!(s, "  [ {:>12.6} {:>12.6} {:>12.6} ]", r[0], r[1], r[2])?;
+        }
+        if let Some(sig) = self.sigma {
+            writeln!(
+                s,
+                "elements, ± one standard deviation (noise and discretisation bias) [kg m²]:"
+            )?;
+            for (k, name) in COMPONENT_NAMES.iter().enumerate() {
+                writeln!(s, "  {name} = {:>12.6} ± {:.2e}", j[k], sig[k])?;
+            }
+        }
+        if let Some(pm) = self.principal_moments {
+            match self.principal_moments_sigma {
+                Some(ps) => writeln!(
+                    s,
+                    "principal moments [kg m²]: {:.6} ± {:.1e}  {:.6} ± {:.1e}  {:.6} ± {:.1e}",
+                    pm[0], ps[0], pm[1], ps[1], pm[2], ps[2]
+                )?,
+                None => writeln!(
+                    s,
+                    "principal moments [kg m²]: {:.6}  {:.6}  {:.6}",
+                    pm[0], pm[1], pm[2]
+                )?,
+            }
+        }
+        if let Some(ax) = self.principal_axes {
+            writeln!(s, "principal axes (columns, body axes):")?;
+            for r in ax {
+                writeln!(s, "  [ {:>9.5} {:>9.5} {:>9.5} ]", r[0], r[1], r[2])?;
+            }
+        }
+        if let Some(e) = self.relative_error {
+            writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;
+        }
+        if let Some(x) = &self.excitation {
+            let mut line = String::from("excitation: singular values of R");
+            for v in x.singular_values {
+                let _ = write!(line, " {v:.2e}");
+            }
+            writeln!(s, "{line}")?;
+            if let Some(sig) = x.element_sigma {
+                let mut line = String::from("  1-sigma per element (sensor noise only) [kg m²]:");
+                for (k, (n, v)) in COMPONENT_NAMES.iter().zip(sig).enumerate() {
+                    let _ = write!(line, "{} {n} {v:.1e}", if k == 0 { "" } else { "," });
+                }
+                writeln!(s, "{line}")?;
+            }
+            for a in &x.advice {
+                writeln!(s, "  warning: {a}")?;
+            }
+        }
+        Ok(())
+    }
+}

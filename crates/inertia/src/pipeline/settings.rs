@@ -1,0 +1,203 @@
+//! What a user asks of the pipeline ([`PipelineSettings`], with documented defaults) and
+//! what it runs with after validation ([`PipelineConfig`]).
+
+use super::registry::{self, BackendEntry, EstimatorEntry};
+use super::PipelineError;
+use crate::constraints::{ConstraintSet, Constraints};
+use crate::estimator::observability::ObservabilitySettings;
+
+/// Settings of an estimation run. Every field has a documented default
+/// ([`Default`]); [`PipelineSettings::validate`] checks them all before any data is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PipelineSettings {
+    /// Estimator, by its registered name ([`registry::ESTIMATORS`]). Default
+    /// `"variational"`.
+    pub estimator: String,
+    /// Solver backend, by its registered name ([`registry::BACKENDS`]). Default
+    /// `"native"`.
+    pub solver: String,
+    /// The feasible set of J. Default [`ConstraintSet::physical`]. Estimators without
+    /// constraints (the momentum RLS) accept only the default.
+    pub constraints: ConstraintSet,
+    /// Solve every this many row blocks (default 1: every sample).
+    pub solve_every: usize,
+    /// Memory time constant, s: data older by Δt weigh `exp(−Δt/memory)`, with Δt from
+    /// the samples' own time stamps. `None` (default): no forgetting.
+    pub memory_s: Option<f64>,
+    /// Resample irregular telemetry onto a uniform grid of this period, s, before
+    /// estimation ([`crate::estimator::resample`]). `None` (default): as it comes.
+    pub resample_s: Option<f64>,
+    /// Gyro rate-noise density from the datasheet, deg/s/√Hz, for errors-in-variables
+    /// compensation ([`crate::estimator::compensation`]). `None` (default): none.
+    pub gyro_noise_deg_s_rthz: Option<f64>,
+    /// Attach a standard deviation to each estimate where the estimator has an
+    /// uncertainty model (default `true`; costs about 10 % of throughput).
+    pub uncertainty: bool,
+    /// Thresholds of the observability test.
+    pub observability: ObservabilitySettings,
+}
+
+impl Default for PipelineSettings {
+    fn default() -> Self {
+        Self {
+            estimator: "variational".into(),
+            solver: "native".into(),
+            constraints: ConstraintSet::physical(),
+            solve_every: 1,
+            memory_s: None,
+            resample_s: None,
+            gyro_noise_deg_s_rthz: None,
+            uncertainty: true,
+            observability: ObservabilitySettings::default(),
+        }
+    }
+}
+
+/// Validated settings: what a [`super::Pipeline`] runs with.
+#[derive(Debug, Clone, Copy)]
+pub struct PipelineConfig {
+    pub(crate) estimator: &'static EstimatorEntry,
+    pub(crate) backend: &'static BackendEntry,
+    pub(crate) constraints: Constraints,
+    pub(crate) solve_every: usize,
+    pub(crate) memory_s: Option<f64>,
+    pub(crate) resample_s: Option<f64>,
+    pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
+    pub(crate) uncertainty: bool,
+    pub(crate) observability: ObservabilitySettings,
+}
+
+fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
+    match v {
+        Some(x) if !(x.is_finite() && x > 0.0) => Err(PipelineError::InvalidSetting {
+            field,
+            value: x,
+            expected: unit,
+        }),
+        _ => Ok(()),
+    }
+}
+
+impl PipelineSettings {
+    /// Check every setting and the combination, and validate the constraint set (a
+    /// phase-I search for a strictly feasible J).
+    pub fn validate(&self) -> Result<PipelineConfig, PipelineError> {
+        let estimator = registry::estimator(&self.estimator)?;
+        let backend = registry::backend(&self.solver)?;
+        if self.solve_every == 0 {
+            return Err(PipelineError::InvalidSetting {
+                field: "solve_every",
+                value: 0.0,
+                expected: "at least 1",
+            });
+        }
+        positive("memory_s", self.memory_s, "a finite memory > 0 s")?;
+        positive("resample_s", self.resample_s, "a finite period > 0 s")?;
+        if let Some(g) = self.gyro_noise_deg_s_rthz {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(PipelineError::InvalidSetting {
+                    field: "gyro_noise_deg_s_rthz",
+                    value: g,
+                    expected: "a finite density >= 0 deg/s/√Hz",
+                });
+            }
+            if !estimator.capabilities.compensation {
+                return Err(PipelineError::NotApplicable {
+                    setting: "gyro_noise_deg_s_rthz",
+                    estimator: estimator.name,
+                });
+            }
+        }
+        if !estimator.capabilities.constraints && self.constraints != ConstraintSet::physical() {
+            return Err(PipelineError::NotApplicable {
+                setting: "constraints",
+                estimator: estimator.name,
+            });
+        }
+        let constraints = self.constraints.validate()?;
+        // The observability thresholds are checked by the estimators' own settings.
+        let o = &self.observability;
+        if !(o.condition_threshold.is_finite() && o.condition_threshold > 1.0) {
+            return Err(PipelineError::InvalidSetting {
+                field: "observability.condition_threshold",
+                value: o.condition_threshold,
+                expected: "finite and > 1",
+            });
+        }
+        if !(o.max_relative_sigma.is_finite() && o.max_relative_sigma > 0.0) {
+            return Err(PipelineError::InvalidSetting {
+                field: "observability.max_relative_sigma",
+                value: o.max_relative_sigma,
+                expected: "finite and > 0",
+            });
+        }
+        Ok(PipelineConfig {
+            estimator,
+            backend,
+            constraints,
+            solve_every: self.solve_every,
+            memory_s: self.memory_s,
+            resample_s: self.resample_s,
+            gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
+            uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
+            observability: self.observability,
+        })
+    }
+}
+
+impl PipelineConfig {
+    /// The estimator's registry entry.
+    #[must_use]
+    pub fn estimator(&self) -> &'static EstimatorEntry {
+        self.estimator
+    }
+
+    /// The backend's registry entry.
+    #[must_use]
+    pub fn backend(&self) -> &'static BackendEntry {
+        self.backend
+    }
+
+    /// The validated constraints.
+    #[must_use]
+    pub fn constraints(&self) -> &Constraints {
+        &self.constraints
+    }
+
+    /// Solve every this many row blocks.
+    #[must_use]
+    pub fn solve_every(&self) -> usize {
+        self.solve_every
+    }
+
+    /// Memory time constant, s.
+    #[must_use]
+    pub fn memory_s(&self) -> Option<f64> {
+        self.memory_s
+    }
+
+    /// Resampling period, s.
+    #[must_use]
+    pub fn resample_s(&self) -> Option<f64> {
+        self.resample_s
+    }
+
+    /// Gyro rate-noise density, rad/s/√Hz (converted once, here, from the settings'
+    /// deg/s/√Hz).
+    #[must_use]
+    pub fn gyro_noise_rad_s_rthz(&self) -> Option<f64> {
+        self.gyro_noise_rad_s_rthz
+    }
+
+    /// Whether estimates carry a standard deviation.
+    #[must_use]
+    pub fn uncertainty(&self) -> bool {
+        self.uncertainty
+    }
+
+    /// Observability thresholds.
+    #[must_use]
+    pub fn observability(&self) -> &ObservabilitySettings {
+        &self.observability
+    }
+}
