@@ -9,6 +9,42 @@
 use crate::math::sqrt;
 use nalgebra::{SMatrix, SVector};
 
+/// Remove the row `wᵀ` (right-hand side 0) from `[R | z]` by hyperbolic rotations: afterwards
+/// `RᵀR` has lost `w wᵀ` and `Rᵀz` is unchanged. Returns `false`, leaving `r` and `z`
+/// partly updated, when `RᵀR − w wᵀ` is not positive definite. Never forms `RᵀR`.
+pub fn downdate_row<const N: usize>(
+    r: &mut SMatrix<f64, N, N>,
+    z: &mut SVector<f64, N>,
+    w: &SVector<f64, N>,
+) -> bool {
+    let mut w = *w;
+    let mut v = 0.0;
+    for i in 0..N {
+        let wi = w[i];
+        if wi == 0.0 {
+            continue;
+        }
+        let rii = r[(i, i)];
+        let t = wi / rii;
+        if !(t.abs() < 1.0) {
+            return false;
+        }
+        let c = 1.0 / sqrt((1.0 - t) * (1.0 + t));
+        let s = c * t;
+        r[(i, i)] = rii * sqrt((1.0 - t) * (1.0 + t));
+        w[i] = 0.0;
+        for k in i + 1..N {
+            let (rk, wk) = (r[(i, k)], w[k]);
+            r[(i, k)] = c * rk - s * wk;
+            w[k] = -s * rk + c * wk;
+        }
+        let zi = z[i];
+        z[i] = c * zi - s * v;
+        v = -s * zi + c * v;
+    }
+    true
+}
+
 /// Fold `a` (and optionally the right-hand side `(z, β)`) into `r`. Returns the leftover
 /// of `β` (0 without a right-hand side).
 pub fn fold_row<const N: usize>(

@@ -9,8 +9,10 @@
 //!
 //! Given the gyro's rate-noise density σ (a datasheet number), the compensated normal
 //! equations `(RᵀR − σ² c D) j = Rᵀ z` are solved as the least-squares problem
-//! `‖R' j − z'‖²` with `R'ᵀR' = RᵀR − σ² c D` (Cholesky) and `z' = R'⁻ᵀ Rᵀ z`, under
-//! the same constraints. When `RᵀR − σ² c D` is not positive definite the noise dominates
+//! `‖R' j − z'‖²` with `R'ᵀR' = RᵀR − σ² c D` and `R'ᵀz' = Rᵀ z`, under the same
+//! constraints. `(R', z')` come from six hyperbolic downdates of `[R | z]` by the rows
+//! `√(σ² c D_ii) e_iᵀ` (right-hand side 0), so `RᵀR` is never formed and the condition
+//! number of `R`, not its square, sets the accuracy. When `RᵀR − σ² c D` is not positive definite the noise dominates
 //! the excitation and there is no answer, unless a-priori bounds already fix the open
 //! direction (`FromPrior`), in which case the uncompensated problem is solved. The cross term `E[δHᵀ δy]` is O(h² σ²) and is
 //! neglected. Rows whose noise is not modelled (`noise_s = 0`, e.g. finite differences)
@@ -29,14 +31,44 @@ pub fn compensate(
     gyro_noise_rad_s_rthz: f64,
 ) -> Option<(Matrix6<f64>, Vector6<f64>)> {
     let k = gyro_noise_rad_s_rthz * gyro_noise_rad_s_rthz * qr.noise_s;
-    let mut a = qr.r.transpose() * qr.r;
+    let (mut r, mut z) = (qr.r, qr.z);
     for (i, d) in NOISE_GRAM_DIAGONAL.iter().enumerate() {
-        a[(i, i)] -= k * d;
+        let mut w = Vector6::zeros();
+        w[i] = crate::math::sqrt(k * d);
+        if !crate::givens::downdate_row(&mut r, &mut z, &w) {
+            return None;
+        }
     }
-    let chol = a.cholesky()?;
-    let u = chol.l().transpose();
-    let b = qr.r.transpose() * qr.z;
-    // z' = U⁻ᵀ b, i.e. L z' = b.
-    let z = chol.l().solve_lower_triangular(&b)?;
-    Some((u, z))
+    Some((r, z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The factored form equals the normal-equation form `(RᵀR − kD, Rᵀz)`.
+    #[test]
+    fn downdates_match_the_normal_equations() {
+        let mut qr = RecursiveQr::new();
+        for i in 0..40 {
+            let x = i as f64;
+            let h = Vector6::from_fn(|k, _| libm::sin((0.3 + 0.2 * k as f64) * x + k as f64));
+            qr.add_row(&h, libm::cos(0.3 * x));
+        }
+        qr.noise_s = 2.0;
+        let lmin = (qr.r.transpose() * qr.r).symmetric_eigenvalues().min();
+        // k D with k = 0.3 λ_min/2 keeps RᵀR − kD positive definite (D ≤ 2I).
+        let g = (0.3 * lmin / 2.0 / qr.noise_s).sqrt();
+        let (r, z) = compensate(&qr, g).expect("positive definite");
+        let kd = Matrix6::from_diagonal(&Vector6::from_fn(|i, _| {
+            g * g * qr.noise_s * NOISE_GRAM_DIAGONAL[i]
+        }));
+        let a = qr.r.transpose() * qr.r - kd;
+        assert!((r.transpose() * r - a).norm() <= 1e-12 * a.norm());
+        let b = qr.r.transpose() * qr.z;
+        assert!((r.transpose() * z - b).norm() <= 1e-12 * b.norm());
+        assert!((0..6).all(|i| r[(i, i)] >= 0.0 && (0..i).all(|k| r[(i, k)] == 0.0)));
+        // With k ≥ λ_min (D ≥ I) the noise dominates: no answer.
+        assert!(compensate(&qr, (1.01 * lmin / qr.noise_s).sqrt()).is_none());
+    }
 }

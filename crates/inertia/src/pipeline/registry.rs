@@ -83,7 +83,9 @@ pub struct BackendEntry {
     pub name: &'static str,
     /// One line for help texts.
     pub summary: &'static str,
-    pub(crate) build: fn() -> Result<Box<dyn Backend + Send>, PipelineError>,
+    /// Why this build cannot run it, when it cannot.
+    pub unavailable: Option<&'static str>,
+    pub(crate) build: fn() -> Box<dyn Backend + Send>,
 }
 
 /// Every estimator, the default first.
@@ -99,25 +101,26 @@ pub static BACKENDS: &[BackendEntry] = &[NATIVE, CLARABEL];
 const NATIVE: BackendEntry = BackendEntry {
     name: "native",
     summary: "pure-Rust active-set, LMI-face Newton and barrier paths (default)",
-    build: || Ok(Box::new(crate::solver::native::NativeSolver::default())),
+    unavailable: None,
+    build: || Box::new(crate::solver::native::NativeSolver::default()),
 };
 
 const CLARABEL: BackendEntry = BackendEntry {
     name: "clarabel",
     summary: "Clarabel interior-point conic solver (builds with the `clarabel` feature)",
+    unavailable: if cfg!(feature = "clarabel") {
+        None
+    } else {
+        Some("this build has no Clarabel backend (rebuild with the `clarabel` feature, which needs system OpenBLAS)")
+    },
     build: || {
         #[cfg(feature = "clarabel")]
         {
-            Ok(Box::new(
-                crate::solver::clarabel_backend::ClarabelSolver::default(),
-            ))
+            Box::new(crate::solver::clarabel_backend::ClarabelSolver::default())
         }
         #[cfg(not(feature = "clarabel"))]
         {
-            Err(PipelineError::SolverUnavailable {
-                name: "clarabel",
-                why: "this build has no Clarabel backend (rebuild with the `clarabel` feature, which needs system OpenBLAS)",
-            })
+            unreachable!("validation refuses an unavailable backend")
         }
     },
 };
@@ -150,17 +153,24 @@ pub fn estimator(name: &str) -> Result<&'static EstimatorEntry, PipelineError> {
         .ok_or_else(|| PipelineError::UnknownEstimator { name: name.into() })
 }
 
-/// The backend called `name`.
+/// The backend called `name`, if this build can run it.
 pub fn backend(name: &str) -> Result<&'static BackendEntry, PipelineError> {
-    BACKENDS
+    let entry = BACKENDS
         .iter()
         .find(|e| e.name == name)
-        .ok_or_else(|| PipelineError::UnknownSolver { name: name.into() })
+        .ok_or_else(|| PipelineError::UnknownSolver { name: name.into() })?;
+    match entry.unavailable {
+        Some(why) => Err(PipelineError::SolverUnavailable {
+            name: entry.name,
+            why,
+        }),
+        None => Ok(entry),
+    }
 }
 
-/// A fresh backend for `entry`.
+/// A fresh backend for a validated entry.
 pub(crate) fn build_backend(
     entry: &BackendEntry,
 ) -> Result<Box<dyn Backend + Send>, PipelineError> {
-    (entry.build)()
+    Ok((entry.build)())
 }

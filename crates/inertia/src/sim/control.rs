@@ -9,6 +9,7 @@
 //! * [`WheelPulse`]: a single wheel spun up by a raised-cosine torque pulse.
 
 use super::InputLaw;
+use super::SimError;
 use crate::attitude::Quaternion;
 use crate::dynamics::GyrostatState;
 use nalgebra::{Matrix3, Vector3};
@@ -43,43 +44,82 @@ fn quintic(u: f64, t: f64) -> (f64, f64, f64) {
 /// PD + feed-forward slew controller on reaction wheels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SlewController {
-    /// Inertia the controller believes, kg m².
-    pub nominal_inertia_kg_m2: Matrix3<f64>,
-    /// Attitude at t = 0 (the first reference).
-    pub q0: Quaternion,
-    /// The slews, in time order and not overlapping.
-    pub slews: Vec<Slew>,
-    /// Closed-loop natural frequency, rad/s.
-    pub natural_freq_rad_s: f64,
-    /// Damping ratio.
-    pub damping: f64,
+    nominal_inertia_kg_m2: Matrix3<f64>,
+    q0: Quaternion,
+    slews: Vec<Slew>,
+    natural_freq_rad_s: f64,
+    damping: f64,
+    /// Reference attitude at each slew's start, derived from `q0` and `slews`.
     starts: Vec<Quaternion>,
 }
 
 impl SlewController {
-    /// Build the controller; reference attitudes at each slew start are precomputed.
-    #[must_use]
+    /// Build the controller: the inertia it believes (kg m²), the attitude at t = 0, the
+    /// slews (in time order, not overlapping, each with a positive duration), the
+    /// closed-loop natural frequency (rad/s, > 0) and damping ratio (≥ 0). Reference
+    /// attitudes at each slew start are precomputed.
     pub fn new(
         nominal_inertia_kg_m2: Matrix3<f64>,
         q0: Quaternion,
         slews: Vec<Slew>,
         natural_freq_rad_s: f64,
         damping: f64,
-    ) -> Self {
+    ) -> Result<Self, SimError> {
+        let bad = |field, value, why| Err(SimError::InvalidSetting { field, value, why });
+        if !nominal_inertia_kg_m2.iter().all(|v| v.is_finite()) {
+            return bad("nominal_inertia_kg_m2", f64::NAN, "must be finite");
+        }
+        if !(natural_freq_rad_s.is_finite() && natural_freq_rad_s > 0.0) {
+            return bad(
+                "natural_freq_rad_s",
+                natural_freq_rad_s,
+                "must be finite and > 0",
+            );
+        }
+        if !(damping.is_finite() && damping >= 0.0) {
+            return bad("damping", damping, "must be finite and >= 0");
+        }
+        let mut end = f64::NEG_INFINITY;
+        for s in &slews {
+            if !(s.duration_s.is_finite() && s.duration_s > 0.0) {
+                return bad("slew duration_s", s.duration_s, "must be finite and > 0");
+            }
+            if !(s.start_s.is_finite() && s.start_s >= end) {
+                return bad(
+                    "slew start_s",
+                    s.start_s,
+                    "slews must be in time order and must not overlap",
+                );
+            }
+            let n = s.axis.norm();
+            if !(n.is_finite() && n > 0.0) {
+                return bad("slew axis", n, "must be a finite, non-zero vector");
+            }
+            if !s.angle_rad.is_finite() {
+                return bad("slew angle_rad", s.angle_rad, "must be finite");
+            }
+            end = s.start_s + s.duration_s;
+        }
         let mut starts = Vec::with_capacity(slews.len());
         let mut q = q0;
         for s in &slews {
             starts.push(q);
             q = q.mul(&Quaternion::exp(&(axis(s) * s.angle_rad)));
         }
-        Self {
+        Ok(Self {
             nominal_inertia_kg_m2,
             q0,
             slews,
             natural_freq_rad_s,
             damping,
             starts,
-        }
+        })
+    }
+
+    /// The slews.
+    #[must_use]
+    pub fn slews(&self) -> &[Slew] {
+        &self.slews
     }
 
     /// Reference attitude, body rate and acceleration (reference axes) at `t_s`.

@@ -228,7 +228,7 @@ impl Scenario {
                     p.slews.clone(),
                     p.natural_freq_rad_s,
                     p.damping,
-                );
+                )?;
                 simulate(&cfg, &ctrl, &Zero)
             }
             Scenario::Spin(p) => simulate(&cfg, &p.pulse, &Zero),

@@ -95,8 +95,7 @@ impl NativeSettings {
 /// The pure-Rust backend.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NativeSolver {
-    /// Settings.
-    pub settings: NativeSettings,
+    settings: NativeSettings,
 }
 
 impl NativeSolver {
@@ -104,6 +103,12 @@ impl NativeSolver {
     pub fn new(settings: NativeSettings) -> Result<Self, SettingsError> {
         settings.validate()?;
         Ok(Self { settings })
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn settings(&self) -> &NativeSettings {
+        &self.settings
     }
 }
 
