@@ -1,7 +1,7 @@
-//! Discrete variational gyrostat rows, paper eqs. 46–54 with the ERRATA corrections.
+//! Discrete variational gyrostat rows, paper eqs. 46–54 with the corrections of docs/conventions.md §1–§2.
 //!
 //! For nodes `k, k+1, k+2` with attitudes `q`, the forced discrete gyrostat equation
-//! (eq. 46, torque sign per ERRATA §1) is linear in `j` (eq. 48):
+//! (eq. 46, torque sign per docs/conventions.md §1) is linear in `j` (eq. 48):
 //!
 //! ```text
 //! N(φ_{k+1}) (G(φ_{k+1}) j + h/2 ρ̄_{k+1}) − M(φ_k) (G(φ_k) j + h/2 ρ̄_k) = + h²/2 τ_{k+1}
@@ -9,7 +9,7 @@
 //! y_k = M(φ_k) h/2 ρ̄_k − N(φ_{k+1}) h/2 ρ̄_{k+1} + h²/2 τ_{k+1}                (eq. 54, corrected)
 //! ```
 //!
-//! * `φ_k = vec(q_k† q_{k+1})` belongs to the interval `[t_k, t_{k+1}]` (ERRATA §2).
+//! * `φ_k = vec(q_k† q_{k+1})` belongs to the interval `[t_k, t_{k+1}]` (docs/conventions.md §2).
 //! * `ρ̄_k` is the rotor momentum of that interval: the trapezoid `(ρ(t_k) + ρ(t_{k+1}))/2`
 //!   of node samples keeps the residual `H_k j − y_k` of an exact trajectory `O(h⁴)`.
 //! * `τ_{k+1}` is the known external torque at the shared node `t_{k+1}`.
@@ -184,7 +184,7 @@ pub fn check_unit(q: &Quaternion, node: usize) -> Result<(), RowError> {
 
 impl RowInput {
     /// Build the input from attitudes at nodes k, k+1, k+2, rotor momentum **node samples**
-    /// at the same nodes (averaged to interval values by the trapezoid rule, ERRATA §2),
+    /// at the same nodes (averaged to interval values by the trapezoid rule, docs/conventions.md §2),
     /// the known torque at node k+1, and the two interval lengths.
     pub fn from_nodes(
         t_k_s: f64,
@@ -229,7 +229,7 @@ impl RowInput {
         )
     }
 
-    /// The row `H_k`, `y_k` (eqs. 53 and 54, torque sign per ERRATA §1).
+    /// The row `H_k`, `y_k` (eqs. 53 and 54, torque sign per docs/conventions.md §1).
     pub fn row(&self) -> Result<Row, RowError> {
         let (t1, t2) = (self.t_k_s + self.h_s, self.t_k_s + self.h_s + self.h1_s);
         check_phi(&self.phi_k, self.t_k_s, t1)?;

@@ -11,11 +11,11 @@
 //! ```text
 //! minimise_j   ‖H_{1:N} j − y_{1:N}‖²  =  ‖R j − z‖² + const       (eqs. 55, 59)
 //! subject to   J(j) − εI ⪰ 0,
-//!              Σ(j) = ½ tr(J) I − J ⪰ 0          (physical consistency, ERRATA §4)
+//!              Σ(j) = ½ tr(J) I − J ⪰ 0          (physical consistency, docs/conventions.md §4)
 //!              or the paper's J11 + J22 ≥ J33 (and cyclic)            (eq. 9)
 //!              l_i ≤ j_i ≤ u_i                    (a-priori bounds)
 //! H_k = N(φ_{k+1}) G(φ_{k+1}) − M(φ_k) G(φ_k)                          (eq. 53)
-//! y_k = M(φ_k) h/2 ρ̄_k − N(φ_{k+1}) h/2 ρ̄_{k+1} + h²/2 τ_{k+1}         (eq. 54, ERRATA §1)
+//! y_k = M(φ_k) h/2 ρ̄_k − N(φ_{k+1}) h/2 ρ̄_{k+1} + h²/2 τ_{k+1}         (eq. 54, docs/conventions.md §1)
 //! ```
 //!
 //! ## Conventions
@@ -71,7 +71,7 @@
 //! * [`dynamics`] — the gyrostat equation and an RK4 step (eq. 26);
 //! * [`discrete`] — G, M, N and the rows H_k, y_k (eqs. 47–54);
 //! * [`telemetry`] — the sample record;
-//! * [`constraints`] — the feasible set (eqs. 9, 55, 57, ERRATA §4, prior bounds);
+//! * [`constraints`] — the feasible set (eqs. 9, 55, 57, docs/conventions.md §4, prior bounds);
 //! * [`solver`] — constrained least squares (eqs. 57, 59): the native solver (fast path,
 //!   active set, one-LMI-face Newton, barrier method) and Clarabel (feature `clarabel`);
 //! * [`estimator`] — Algorithm 1 (recursive), eq. 57 (batch), the finite-difference and

@@ -2,7 +2,7 @@
 //!
 //! `j = [J11, J22, J33, J12, J13, J23]ᵀ` in body axes, kg m². The matrix is symmetric,
 //! `J = Σ m_i S(r_i)ᵀ S(r_i)` (eq. 7). A physically realisable J has a positive
-//! semidefinite second-moment matrix `Σ = ½ tr(J) I − J` (ERRATA §4), which implies both
+//! semidefinite second-moment matrix `Σ = ½ tr(J) I − J` (docs/conventions.md §4), which implies both
 //! `J ⪰ 0` and the triangle inequalities on the principal moments; the paper's eq. 9 tests
 //! only the diagonal in body axes, which is necessary but not sufficient.
 //!
@@ -121,7 +121,7 @@ pub fn j_from_matrix(m: &Matrix3<f64>) -> InertiaVector {
     )
 }
 
-/// The second-moment matrix `Σ = ½ tr(J) I − J` (ERRATA §4).
+/// The second-moment matrix `Σ = ½ tr(J) I − J` (docs/conventions.md §4).
 #[must_use]
 pub fn second_moment(j: &Matrix3<f64>) -> Matrix3<f64> {
     Matrix3::identity() * (0.5 * j.trace()) - j

@@ -1,4 +1,4 @@
-//! Quaternion conventions (paper §II.C, ERRATA §3): property tests and known rotations.
+//! Quaternion conventions (paper §II.C, docs/conventions.md §3): property tests and known rotations.
 
 use approx::assert_relative_eq;
 use inertia::attitude::{incremental_rotation, skew, Quaternion};

@@ -1,4 +1,4 @@
-//! Constraint sets (paper eqs. 9, 55, 57; ERRATA §4) and the solver front end.
+//! Constraint sets (paper eqs. 9, 55, 57; docs/conventions.md §4) and the solver front end.
 
 use inertia::constraints::{ConstraintError, ConstraintSet};
 use inertia::solver::native::NativeSolver;
@@ -8,7 +8,7 @@ use inertia::tensor::{
 };
 use nalgebra::{Matrix3, Matrix6, Vector6};
 
-/// ERRATA §4: positive definite, passes eq. 9 on the diagonal, principal moments (1, 1, 2.5)
+/// docs/conventions.md §4: positive definite, passes eq. 9 on the diagonal, principal moments (1, 1, 2.5)
 /// violate the triangle inequality.
 fn errata_counterexample() -> Matrix3<f64> {
     Matrix3::new(1.75, 0.0, 0.75, 0.0, 1.0, 0.0, 0.75, 0.0, 1.75)
@@ -101,7 +101,7 @@ fn component_names() {
     }
 }
 
-/// When the unconstrained minimiser is the ERRATA counterexample, the default set returns
+/// When the unconstrained minimiser is the counterexample of docs/conventions.md §4, the default set returns
 /// a physically consistent J and the paper's set returns the unphysical one.
 #[test]
 fn errata_counterexample_default_constraints_fix_it_paper_ones_do_not() {

@@ -1,4 +1,4 @@
-//! The discrete variational rows on exact trajectories (paper eqs. 46–54, ERRATA §1–2).
+//! The discrete variational rows on exact trajectories (paper eqs. 46–54, docs/conventions.md §1–§2).
 //!
 //! For a trajectory integrated far more accurately than the effects measured, the
 //! residual `max_k ‖H_k j_true − y_k‖` must fall as h⁴. Four input cases: torque-free with
@@ -62,7 +62,7 @@ fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> 
 /// Which variant of the row to evaluate.
 #[derive(Clone, Copy)]
 enum Variant {
-    /// As implemented (ERRATA-corrected).
+    /// As implemented (corrected per docs/conventions.md §1–§2).
     Corrected,
     /// With the paper's printed torque sign: y − h² τ_{k+1}.
     PrintedTorqueSign,
@@ -158,7 +158,7 @@ fn varying_rho_and_torque_is_fourth_order() {
     );
 }
 
-/// ERRATA §1: the paper's printed `− h²/2 τ_{k+1}` in eq. 54 is a sign error; with it
+/// docs/conventions.md §1: the paper's printed `− h²/2 τ_{k+1}` in eq. 54 is a sign error; with it
 /// the residual is the whole torque term, O(h²).
 #[test]
 fn printed_torque_sign_is_second_order() {
@@ -170,7 +170,7 @@ fn printed_torque_sign_is_second_order() {
     );
 }
 
-/// ERRATA §2: ρ_k is the interval value; node values degrade the order to 3.
+/// docs/conventions.md §2: ρ_k is the interval value; node values degrade the order to 3.
 #[test]
 fn node_rho_is_third_order() {
     assert_order(

@@ -1,4 +1,4 @@
-//! The feasible set of the estimator: paper eqs. 9, 55, 57, ERRATA §4, and a-priori bounds.
+//! The feasible set of the estimator: paper eqs. 9, 55, 57, docs/conventions.md §4, and a-priori bounds.
 //!
 //! ```text
 //! J(j) − ε I ⪰ 0                                  (eq. 57, first LMI)
@@ -11,7 +11,7 @@
 //! condition for a J to be realisable by a mass distribution, and it implies the triangle
 //! inequalities on the principal moments (eq. 9 holds in *every* frame) and J ⪰ 0. The
 //! paper's eq. 9 constrains only the diagonal in body axes, which is necessary, not
-//! sufficient: ERRATA §4 gives a positive definite J that passes it and is not physical.
+//! sufficient: docs/conventions.md §4 gives a positive definite J that passes it and is not physical.
 //!
 //! A [`ConstraintSet`] is built by the user and turned into [`Constraints`] by
 //! [`ConstraintSet::validate`], before any data is read. Validation rejects non-finite or
@@ -34,7 +34,7 @@ pub const DEFAULT_EPSILON_KG_M2: f64 = 1e-6;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Consistency {
-    /// `Σ = ½ tr(J) I − J ⪰ 0` (ERRATA §4). The default.
+    /// `Σ = ½ tr(J) I − J ⪰ 0` (docs/conventions.md §4). The default.
     #[default]
     Physical,
     /// The paper's diagonal triangle inequalities (eq. 9), to reproduce the paper exactly.

@@ -1,4 +1,4 @@
-//! Can the data determine J? (paper §IV, last paragraph; ERRATA §5)
+//! Can the data determine J? (paper §IV, last paragraph; docs/conventions.md §5)
 //!
 //! `J` is determined only if `φ_k` changes in time (else `H_k = 0`) and some rotor momentum
 //! or known torque excites the rows (else `y ≡ 0` and J is fixed only up to scale). The

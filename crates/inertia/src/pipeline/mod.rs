@@ -17,19 +17,28 @@
 //!   estimator has an uncertainty model, and the solver's diagnostics.
 //!
 //! ```
+//! use inertia::constraints::ConstraintSet;
 //! use inertia::pipeline::{Pipeline, PipelineSettings};
 //! use inertia::sim::scenario::{Common, Scenario};
+//! use inertia::tensor::Component;
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let run = Scenario::slew().simulate(&Common { duration_s: Some(120.0), ..Common::paper() })?;
 //! let mut pipeline = Pipeline::new(&PipelineSettings {
-//!     memory_s: Some(600.0),
+//!     estimator: "variational".into(),                  // or "finite-difference", "momentum"
+//!     solver: "native".into(),                          // or "clarabel" (feature)
+//!     constraints: ConstraintSet::physical()            // J ⪰ εI and Σ ⪰ 0
+//!         .with_nominal(Component::J33, 3.0, 0.10),     // J33 within 10 % of 3 kg m²
+//!     memory_s: Some(600.0),                            // forget with a 600 s time constant
+//!     gyro_noise_deg_s_rthz: Some(1e-5),                // errors-in-variables compensation
 //!     ..PipelineSettings::default()
-//! })?;
-//! for s in &run.samples {
-//!     pipeline.push(s)?;
+//! })?;                                                  // bad settings fail here, typed
+//! for sample in &run.samples {
+//!     if let Some(e) = pipeline.push(sample)? {
+//!         // e.observability: determined, from the prior, or not (with the reason);
+//!         // e.inertia() is None without an answer; e.uncertainty holds σ per element.
+//!     }
 //! }
-//! let e = pipeline.last().expect("an estimate");
-//! assert!(e.observability.has_answer());
+//! let e = pipeline.last().unwrap();
 //! assert_eq!(e.within_3sigma(&run.inertia_kg_m2), Some(true));
 //! # Ok(())
 //! # }

@@ -82,7 +82,7 @@ fn random_set(rng: &mut ChaCha8Rng, anchor: &InertiaVector) -> ConstraintSet {
 }
 
 /// `n` problems from `seed`: conditions from 1 to 1e8, constraints inactive, active and
-/// absent, the ERRATA counterexample, and a J exactly on the boundary.
+/// absent, the counterexample of docs/conventions.md §4, and a J exactly on the boundary.
 pub fn problems(seed: u64, n: usize) -> Vec<RandomProblem> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(n + 2);
