@@ -52,7 +52,7 @@ pub struct Report {
     pub input: Option<InputSummary>,
     /// Estimator name.
     pub estimator: &'static str,
-    /// Solver backend name.
+    /// Solver backend name (`none` for estimators that solve nothing).
     pub solver: &'static str,
     /// Consistency condition (`physical`, `paper`, `positive-definite`).
     pub constraints: &'static str,
@@ -115,7 +115,12 @@ impl Report {
             schema_version: SCHEMA_VERSION,
             input: None,
             estimator: config.estimator().name,
-            solver: config.backend().name,
+            // An estimator without constraints solves nothing.
+            solver: if config.estimator().capabilities.constraints {
+                config.backend().name
+            } else {
+                "none"
+            },
             constraints: config.constraints().set().consistency.name(),
             batch,
             samples,
