@@ -254,25 +254,6 @@ pub(crate) fn solve_with<B: Backend + ?Sized>(
         }
         _ => (qr.r, qr.z),
     };
-    let sol = solve(&mut BackendRef(backend), &r, &z, constraints, warm)?;
+    let sol = solve(&mut &mut *backend, &r, &z, constraints, warm)?;
     Ok((Some(sol), observability))
-}
-
-/// Adapter so that `solve` can take an unsized backend.
-struct BackendRef<'a, B: Backend + ?Sized>(&'a mut B);
-
-impl<B: Backend + ?Sized> Backend for BackendRef<'_, B> {
-    fn name(&self) -> &'static str {
-        self.0.name()
-    }
-
-    fn solve_scaled(
-        &mut self,
-        r: &nalgebra::Matrix6<f64>,
-        z: &nalgebra::Vector6<f64>,
-        constraints: &Constraints,
-        warm: Option<&crate::tensor::InertiaVector>,
-    ) -> Result<crate::solver::Solution, crate::solver::SolveError> {
-        self.0.solve_scaled(r, z, constraints, warm)
-    }
 }

@@ -20,19 +20,6 @@ pub trait RowSource {
     fn gaps(&self) -> usize;
 }
 
-#[cfg(feature = "std")]
-impl<S: RowSource + ?Sized> RowSource for std::boxed::Box<S> {
-    fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>> {
-        (**self).push(s)
-    }
-    fn reset(&mut self) {
-        (**self).reset();
-    }
-    fn gaps(&self) -> usize {
-        (**self).gaps()
-    }
-}
-
 /// Three consecutive nodes and the incremental rotations of their two intervals.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Stencil {

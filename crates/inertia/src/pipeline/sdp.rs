@@ -65,7 +65,7 @@ fn recursive<S: RowSource + Default>(
     c: &PipelineConfig,
     settings: RecursiveSettings,
 ) -> Result<Recursive<S>, PipelineError> {
-    let backend = registry::build_backend(c.backend)?;
+    let backend = registry::build_backend(c.backend);
     RecursiveEstimator::new(S::default(), c.constraints, backend, settings).map_err(|source| {
         PipelineError::Estimator {
             sample: None,
@@ -138,7 +138,7 @@ fn run_batch<S: RowSource + Default>(
         source,
     };
     let qr = batch::reduce(samples, &mut source).map_err(wrap)?;
-    let mut backend = registry::build_backend(c.backend)?;
+    let mut backend = registry::build_backend(c.backend);
     let estimate = batch::solve_reduced(
         &qr,
         samples.last().map_or(0.0, |s| s.t_s),

@@ -177,6 +177,23 @@ pub fn solve(
     Ok(sol)
 }
 
+/// A borrowed backend is a backend (so that an unsized one can be handed to [`solve`]).
+impl<B: Backend + ?Sized> Backend for &mut B {
+    fn name(&self) -> &'static str {
+        (**self).name()
+    }
+
+    fn solve_scaled(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<Solution, SolveError> {
+        (**self).solve_scaled(r, z, constraints, warm)
+    }
+}
+
 #[cfg(feature = "std")]
 impl<B: Backend + ?Sized> Backend for std::boxed::Box<B> {
     fn name(&self) -> &'static str {
