@@ -121,6 +121,27 @@ pub enum ConstraintArg {
     PositiveDefinite,
 }
 
+/// Sources of the incremental rotations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RotationArg {
+    /// `vec(q_k† q_{k+1})` of the attitude quaternions.
+    Attitude,
+    /// The gyro's angle increment `w h` over each step (needs `w_*` columns).
+    Gyro,
+}
+
+/// Models of the wheel momentum between samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum RhoModelArg {
+    /// Decided from the data (the rows with the smaller residual variance).
+    #[default]
+    Auto,
+    /// Smooth across two steps: Richardson rows.
+    Smooth,
+    /// Linear within each step (commands held over each step): plain rows.
+    Held,
+}
+
 /// Input-format options shared by commands that read telemetry.
 #[derive(Debug, Args)]
 pub struct InputArgs {
@@ -181,6 +202,26 @@ pub struct EstimateArgs {
     /// of the variational estimator (README). Without it, no compensation.
     #[arg(long, value_name = "DEG_S_RTHZ")]
     pub gyro_noise: Option<f64>,
+    /// Where the incremental rotations come from (discrete-momentum estimator): the
+    /// attitude quaternions or the gyro's angle increments. Default: both are tried when
+    /// the telemetry has gyro rates, and the rows that fit better are used (the report
+    /// says which).
+    #[arg(long, value_enum, value_name = "SOURCE")]
+    pub rotation_source: Option<RotationArg>,
+    /// What the wheel momentum does between samples (discrete-momentum estimator):
+    /// `smooth` (Richardson O(h⁴) rows), `held` (torque commands held over each telemetry
+    /// step, changing at the samples: plain rows), or `auto` (decided from the data).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub rho_model: RhoModelArg,
+    /// Do not estimate an unknown constant disturbance torque (discrete-momentum
+    /// estimator; by default it is estimated, at no cost when it is absent).
+    #[arg(long)]
+    pub no_torque_bias: bool,
+    /// Longest momentum chain, s (discrete-momentum estimator): the conserved momentum
+    /// is re-anchored after this long, which bounds the effect of a drifting attitude
+    /// (gyro-propagated attitude). `0` for chains that end only at gaps.
+    #[arg(long, value_name = "S", default_value_t = inertia::pipeline::DEFAULT_MAX_CHAIN_S)]
+    pub chain: f64,
     /// True inertia (JSON) to report the relative Frobenius error against.
     #[arg(long, value_name = "J.json")]
     pub truth: Option<PathBuf>,

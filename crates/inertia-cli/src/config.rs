@@ -1,8 +1,9 @@
 //! Arguments validated into configurations.
 
-use crate::args::{ConstraintArg, EstimateArgs, InputArgs};
+use crate::args::{ConstraintArg, EstimateArgs, InputArgs, RhoModelArg, RotationArg};
 use crate::error::{input, CliError};
 use inertia::constraints::ConstraintSet;
+use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{PipelineError, PipelineSettings};
 use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
 use inertia::tensor::{j_from_matrix, Component};
@@ -142,6 +143,17 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         memory_s: a.memory,
         resample_s: a.resample,
         gyro_noise_deg_s_rthz: a.gyro_noise,
+        rotation_source: a.rotation_source.map(|r| match r {
+            RotationArg::Attitude => RotationSource::Attitude,
+            RotationArg::Gyro => RotationSource::Gyro,
+        }),
+        rho_model: match a.rho_model {
+            RhoModelArg::Auto => RhoModel::Auto,
+            RhoModelArg::Smooth => RhoModel::Smooth,
+            RhoModelArg::Held => RhoModel::Held,
+        },
+        torque_bias: !a.no_torque_bias,
+        max_chain_s: (a.chain != 0.0).then_some(a.chain),
         ..PipelineSettings::default()
     })
 }
@@ -154,6 +166,10 @@ fn option_of(field: &str) -> &str {
         "resample_s" => "--resample",
         "gyro_noise_deg_s_rthz" => "--gyro-noise",
         "constraints" => "--constraints/--bound/--nominal",
+        "rotation_source" => "--rotation-source",
+        "rho_model" => "--rho-model",
+        "torque_bias" => "--no-torque-bias",
+        "max_chain_s" => "--chain",
         other => other,
     }
 }

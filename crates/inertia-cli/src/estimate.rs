@@ -6,7 +6,7 @@ use crate::config::{self, settings_error, InertiaFile};
 use crate::error::{input, internal, CliError};
 use crate::history::HistoryFile;
 use inertia::discrete::RowError;
-use inertia::estimator::{Estimate, EstimatorError};
+use inertia::estimator::EstimatorError;
 use inertia::pipeline::report::{InputSummary, Report};
 use inertia::pipeline::{self, Pipeline, PipelineError};
 use inertia::telemetry::csv::TelemetryReader;
@@ -63,7 +63,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     });
     let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
     let mut first_times = [f64::NAN; 2];
-    let (last, excitation, samples, gaps): (Option<Estimate>, _, usize, usize) = if a.batch {
+    let (last, excitation, samples, gaps, row_model, torque) = if a.batch {
         let mut all = Vec::new();
         let mut lines = Vec::new();
         while let Some(item) = reader.next() {
@@ -86,7 +86,14 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         if let Some(h) = history.as_mut() {
             h.write(&out.estimate)?;
         }
-        (Some(out.estimate), out.excitation, all.len(), out.gaps)
+        (
+            Some(out.estimate),
+            out.excitation,
+            all.len(),
+            out.gaps,
+            out.row_model,
+            None,
+        )
     } else {
         let mut p = Pipeline::from_config(config).map_err(settings_error)?;
         let mut write_error = None;
@@ -116,6 +123,8 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             p.excitation(),
             p.estimator_samples(),
             p.gaps(),
+            p.row_model(),
+            p.torque_bias_nm(),
         )
     };
     if let Some(p) = progress {
@@ -149,6 +158,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             max_step_s: stats.max_step_s,
         })
         .with_excitation(excitation)
+        .with_row_model(row_model, torque)
         .with_truth(truth.as_ref());
     if a.json {
         println!(

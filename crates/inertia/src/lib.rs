@@ -87,6 +87,7 @@ pub mod attitude;
 mod barrier;
 pub mod constraints;
 pub mod discrete;
+pub mod discrete_momentum;
 pub mod dynamics;
 mod eigen3;
 pub mod estimator;

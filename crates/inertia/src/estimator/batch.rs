@@ -60,6 +60,7 @@ pub fn reduce<S: RowSource>(
         rows: m,
         weight: m as f64,
         noise_s,
+        nuisance: 0.0,
     })
 }
 

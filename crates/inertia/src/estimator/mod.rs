@@ -11,12 +11,15 @@
 //!
 //! Every estimate says whether the data determine J ([`observability`]).
 
+pub mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
 pub mod compensation;
+pub mod discrete_momentum;
 #[cfg(feature = "std")]
 pub mod excitation;
 pub mod momentum;
+pub mod momentum_rows;
 pub mod observability;
 pub mod qr;
 pub mod recursive;

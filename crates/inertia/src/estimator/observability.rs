@@ -214,13 +214,13 @@ impl core::fmt::Display for Observability {
 /// `sv` are the singular values of `R`: `tr((RᵀR)⁻¹) = Σ σ_k⁻²`.
 #[must_use]
 pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
-    if qr.weight < (6 + MIN_RESIDUAL_DOF) as f64 || sv.min() <= 0.0 {
+    if qr.residual_dof() < MIN_RESIDUAL_DOF as f64 || sv.min() <= 0.0 {
         return f64::INFINITY;
     }
     let Some(j) = crate::solver::unconstrained_minimiser(&qr.r, &qr.z) else {
         return f64::INFINITY;
     };
-    let s2 = qr.rss / (qr.weight - 6.0);
+    let s2 = qr.rss / qr.residual_dof();
     let var: f64 = sv.iter().map(|s| 1.0 / (s * s)).sum::<f64>() * s2;
     let jn = j.norm();
     if jn > 0.0 && var.is_finite() {
@@ -285,7 +285,7 @@ pub fn assess_with(
     };
     let weak = sv.iter().filter(|&&s| s * threshold < smax).count();
     let (reason, open_directions) = if qr.y_energy == 0.0 {
-        let rel = direction_relative_sigma(&sv, qr.weight);
+        let rel = direction_relative_sigma(&sv, qr.weight - qr.nuisance);
         if rel > settings.max_relative_sigma {
             return Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: rel,

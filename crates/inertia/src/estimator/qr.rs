@@ -29,6 +29,9 @@ pub struct RecursiveQr {
     /// Sum of the rows' errors-in-variables coefficients `noise_s` (weighted like the
     /// rows), s; see [`crate::discrete::Row::noise_s`].
     pub noise_s: f64,
+    /// Unknowns besides `j` that were minimised out of the rows (weighted like the rows):
+    /// degrees of freedom the residual does not have. Zero for the paper's rows.
+    pub nuisance: f64,
 }
 
 impl Default for RecursiveQr {
@@ -49,6 +52,7 @@ impl RecursiveQr {
             rows: 0,
             weight: 0.0,
             noise_s: 0.0,
+            nuisance: 0.0,
         }
     }
 
@@ -72,6 +76,13 @@ impl RecursiveQr {
     pub fn add(&mut self, row: &crate::discrete::Row) {
         self.add_block(&row.h, &row.y);
         self.noise_s += row.noise_s;
+    }
+
+    /// Residual degrees of freedom: effective rows minus `j`'s six and the nuisance
+    /// unknowns.
+    #[must_use]
+    pub fn residual_dof(&self) -> f64 {
+        self.weight - 6.0 - self.nuisance
     }
 
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).

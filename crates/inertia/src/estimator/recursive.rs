@@ -154,29 +154,16 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// Solve with the data so far, stamped `t_s`.
     pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
-        let sv = self.svd.singular_values(&self.qr.r);
-        self.sv = sv;
-        let observability = assess_with(
-            &self.qr,
-            &sv,
-            self.constraints.set().has_bounds(),
-            &self.settings.observability,
-        );
-        let (solution, observability) = solve_with(
+        self.sv = self.svd.singular_values(&self.qr.r);
+        let e = estimate_from(
             &mut self.backend,
             &self.qr,
+            &self.sv,
             &self.constraints,
-            observability,
-            self.settings.gyro_noise_rad_s_rthz,
+            &self.settings,
             self.last.and_then(|e| e.j()).as_ref(),
-        )?;
-        let e = Estimate {
             t_s,
-            rows: self.qr.rows,
-            observability,
-            solution,
-            uncertainty: None,
-        };
+        )?;
         self.last = Some(e);
         Ok(e)
     }
@@ -221,6 +208,40 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
             &self.settings.observability,
         )
     }
+}
+
+/// Assess and solve the state `qr` whose `R` has singular values `sv`: the estimate
+/// stamped `t_s`. Shared by the recursive estimators.
+pub(crate) fn estimate_from<B: Backend + ?Sized>(
+    backend: &mut B,
+    qr: &RecursiveQr,
+    sv: &nalgebra::Vector6<f64>,
+    constraints: &Constraints,
+    settings: &RecursiveSettings,
+    warm: Option<&crate::tensor::InertiaVector>,
+    t_s: f64,
+) -> Result<Estimate, EstimatorError> {
+    let observability = assess_with(
+        qr,
+        sv,
+        constraints.set().has_bounds(),
+        &settings.observability,
+    );
+    let (solution, observability) = solve_with(
+        backend,
+        qr,
+        constraints,
+        observability,
+        settings.gyro_noise_rad_s_rthz,
+        warm,
+    )?;
+    Ok(Estimate {
+        t_s,
+        rows: qr.rows,
+        observability,
+        solution,
+        uncertainty: None,
+    })
 }
 
 /// Solve (with errors-in-variables compensation when a gyro noise is given) when the

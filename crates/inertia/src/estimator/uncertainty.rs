@@ -4,7 +4,8 @@
 //! Two parts, added in quadrature per element:
 //!
 //! * **Noise:** the least-squares standard deviation `σ_LS = √(s² diag((RᵀR)⁻¹))`,
-//!   `s² = ρ²/(rows − 6)` (effective rows under forgetting).
+//!   `s² = ρ²/(rows − 6 − nuisance)` (effective rows under forgetting; nuisance
+//!   unknowns minimised out of the rows, [`super::qr::RecursiveQr::nuisance`]).
 //! * **Discretisation bias:** the rows are exact only to O(h⁴), which biases `ĵ` by
 //!   `c h²`. A shadow estimator on every other sample (step 2h) is biased by `4c h²`, so
 //!   `b̂ = (ĵ(h) − ĵ(2h))/3` measures it from the data (Richardson).
@@ -57,10 +58,10 @@ impl Uncertainty {
 /// of `R`. `None` without residual degrees of freedom or with a singular `R`.
 #[must_use]
 pub fn noise_sigma(qr: &RecursiveQr, sv: &Vector6<f64>, v: &Matrix6<f64>) -> Option<[f64; 6]> {
-    if !(qr.weight > 6.0 && qr.y_energy > 0.0) || sv.iter().any(|s| !(*s > 0.0)) {
+    if !(qr.residual_dof() > 0.0 && qr.y_energy > 0.0) || sv.iter().any(|s| !(*s > 0.0)) {
         return None;
     }
-    let s2 = qr.rss / (qr.weight - 6.0);
+    let s2 = qr.rss / qr.residual_dof();
     Some(core::array::from_fn(|k| {
         let var: f64 = (0..6)
             .map(|i| (v[(k, i)] / sv[i]) * (v[(k, i)] / sv[i]))

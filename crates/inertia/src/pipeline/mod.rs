@@ -44,6 +44,7 @@
 //! # }
 //! ```
 
+mod discrete_momentum;
 mod momentum;
 pub mod registry;
 mod sdp;
@@ -55,7 +56,7 @@ pub mod history;
 pub mod report;
 
 pub use registry::{BatchOutput, Capabilities, Estimator};
-pub use settings::{PipelineConfig, PipelineSettings};
+pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
@@ -235,6 +236,18 @@ impl Pipeline {
     #[must_use]
     pub fn last(&self) -> Option<&Estimate> {
         self.last.as_ref()
+    }
+
+    /// The row model in use, for estimators that choose one from the data.
+    #[must_use]
+    pub fn row_model(&self) -> Option<crate::estimator::momentum_rows::MomentumRowSettings> {
+        self.estimator.row_model()
+    }
+
+    /// The estimated constant body-frame disturbance torque, N m, where estimated.
+    #[must_use]
+    pub fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
+        self.estimator.torque_bias_nm()
     }
 
     /// The excitation report of the data so far (estimators with a least-squares state).

@@ -17,6 +17,7 @@ pub(crate) const MOMENTUM: EstimatorEntry = EstimatorEntry {
         constraints: false,
         compensation: false,
         uncertainty: false,
+        row_model: false,
     },
     build,
     batch: None,

@@ -6,6 +6,7 @@
 use super::settings::PipelineConfig;
 use super::PipelineError;
 use crate::estimator::excitation::Excitation;
+use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::sample::Sample;
 use crate::solver::Backend;
@@ -24,6 +25,14 @@ pub trait Estimator: Send {
     fn excitation(&self) -> Option<Excitation> {
         None
     }
+    /// The row model in use, for estimators that choose one.
+    fn row_model(&self) -> Option<MomentumRowSettings> {
+        None
+    }
+    /// The estimated constant body-frame disturbance torque, N m, where estimated.
+    fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
+        None
+    }
 }
 
 /// The answer of a batch run.
@@ -35,6 +44,8 @@ pub struct BatchOutput {
     pub excitation: Option<Excitation>,
     /// Gaps in the time stamps.
     pub gaps: usize,
+    /// The row model used, for estimators that choose one.
+    pub row_model: Option<MomentumRowSettings>,
 }
 
 /// What an estimator uses and needs.
@@ -48,6 +59,8 @@ pub struct Capabilities {
     pub compensation: bool,
     /// It has an uncertainty model.
     pub uncertainty: bool,
+    /// It takes the row-model settings (rotation source, model of ρ, torque bias).
+    pub row_model: bool,
 }
 
 /// Build a streaming estimator from a validated configuration.
@@ -91,6 +104,7 @@ pub struct BackendEntry {
 /// Every estimator, the default first.
 pub static ESTIMATORS: &[EstimatorEntry] = &[
     super::sdp::VARIATIONAL,
+    super::discrete_momentum::DISCRETE_MOMENTUM,
     super::sdp::FINITE_DIFFERENCE,
     super::momentum::MOMENTUM,
 ];

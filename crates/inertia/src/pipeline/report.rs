@@ -14,6 +14,7 @@
 
 use super::settings::PipelineConfig;
 use crate::estimator::excitation::Excitation;
+use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
 use crate::estimator::Estimate;
 use crate::solver::SolveStatus;
@@ -90,6 +91,11 @@ pub struct Report {
     pub relative_error: Option<f64>,
     /// The excitation report.
     pub excitation: Option<Excitation>,
+    /// The row model used (discrete momentum estimator): rotation source, plain or
+    /// Richardson rows, torque bias.
+    pub row_model: Option<MomentumRowSettings>,
+    /// The estimated constant body-frame disturbance torque, N m.
+    pub torque_bias_nm: Option<[f64; 3]>,
     #[serde(skip)]
     observability: Observability,
 }
@@ -139,6 +145,8 @@ impl Report {
             iterations: estimate.solution.map(|s| s.iterations),
             relative_error: None,
             excitation: None,
+            row_model: None,
+            torque_bias_nm: None,
             observability: estimate.observability,
         }
     }
@@ -154,6 +162,19 @@ impl Report {
     #[must_use]
     pub fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
         self.excitation = excitation;
+        self
+    }
+
+    /// With the row model and the estimated disturbance torque (N m), where the estimator
+    /// has them.
+    #[must_use]
+    pub fn with_row_model(
+        mut self,
+        row_model: Option<MomentumRowSettings>,
+        torque_bias_nm: Option<nalgebra::Vector3<f64>>,
+    ) -> Self {
+        self.row_model = row_model;
+        self.torque_bias_nm = torque_bias_nm.map(|t| [t.x, t.y, t.z]);
         self
     }
 
@@ -194,6 +215,9 @@ impl fmt::Display for Report {
             self.constraints,
             self.t
         )?;
+        if let Some(m) = &self.row_model {
+            writeln!(s, "rows: {}", m.describe())?;
+        }
         writeln!(s, "status: {}", self.observability)?;
         let (Some(m), Some(j)) = (self.inertia, self.j) else {
             return writeln!(s, "no estimate: the data cannot determine J");
@@ -230,6 +254,13 @@ impl fmt::Display for Report {
             for r in ax {
                 writeln!(s, "  [ {:>9.5} {:>9.5} {:>9.5} ]", r[0], r[1], r[2])?;
             }
+        }
+        if let Some(t) = self.torque_bias_nm {
+            writeln!(
+                s,
+                "unknown constant torque (body) [N m]: [{:.3e}, {:.3e}, {:.3e}]",
+                t[0], t[1], t[2]
+            )?;
         }
         if let Some(e) = self.relative_error {
             writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;

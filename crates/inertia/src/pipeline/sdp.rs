@@ -23,6 +23,7 @@ pub(crate) const VARIATIONAL: EstimatorEntry = EstimatorEntry {
         constraints: true,
         compensation: true,
         uncertainty: true,
+        row_model: false,
     },
     build: build::<VariationalRows>,
     batch: Some(run_batch::<VariationalRows>),
@@ -37,6 +38,7 @@ pub(crate) const FINITE_DIFFERENCE: EstimatorEntry = EstimatorEntry {
         constraints: true,
         compensation: false,
         uncertainty: false,
+        row_model: false,
     },
     build: build::<FiniteDifferenceRows>,
     batch: Some(run_batch::<FiniteDifferenceRows>),
@@ -152,5 +154,6 @@ fn run_batch<S: RowSource + Default>(
         estimate,
         excitation: Some(diagnose(&qr, &c.observability)),
         gaps: source.gaps(),
+        row_model: None,
     })
 }

@@ -4,6 +4,7 @@
 use super::registry::{self, BackendEntry, EstimatorEntry};
 use super::PipelineError;
 use crate::constraints::{ConstraintSet, Constraints};
+use crate::estimator::momentum_rows::{RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
 
 /// Settings of an estimation run. Every field has a documented default
@@ -35,7 +36,25 @@ pub struct PipelineSettings {
     pub uncertainty: bool,
     /// Thresholds of the observability test.
     pub observability: ObservabilitySettings,
+    /// Source of the incremental rotations (discrete momentum estimator). `None`
+    /// (default): the gyro and the attitude are both tried when the telemetry has gyro
+    /// rates, and the rows that fit better are used.
+    pub rotation_source: Option<RotationSource>,
+    /// What the rotor momentum does between samples (discrete momentum estimator):
+    /// default [`RhoModel::Auto`], decided from the data.
+    pub rho_model: RhoModel,
+    /// Estimate an unknown constant body-frame disturbance torque (discrete momentum
+    /// estimator; default `true`).
+    pub torque_bias: bool,
+    /// Longest momentum chain, s (discrete momentum estimator): bounds how far a
+    /// drifting attitude error can rotate the conserved momentum
+    /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Default
+    /// [`DEFAULT_MAX_CHAIN_S`].
+    pub max_chain_s: Option<f64>,
 }
+
+/// Default longest momentum chain, s.
+pub const DEFAULT_MAX_CHAIN_S: f64 = 30.0;
 
 impl Default for PipelineSettings {
     fn default() -> Self {
@@ -49,6 +68,10 @@ impl Default for PipelineSettings {
             gyro_noise_deg_s_rthz: None,
             uncertainty: true,
             observability: ObservabilitySettings::default(),
+            rotation_source: None,
+            rho_model: RhoModel::Auto,
+            torque_bias: true,
+            max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
         }
     }
 }
@@ -65,6 +88,10 @@ pub struct PipelineConfig {
     pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
     pub(crate) uncertainty: bool,
     pub(crate) observability: ObservabilitySettings,
+    pub(crate) rotation_source: Option<RotationSource>,
+    pub(crate) rho_model: RhoModel,
+    pub(crate) torque_bias: bool,
+    pub(crate) max_chain_s: Option<f64>,
 }
 
 fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
@@ -93,6 +120,7 @@ impl PipelineSettings {
         }
         positive("memory_s", self.memory_s, "a finite memory > 0 s")?;
         positive("resample_s", self.resample_s, "a finite period > 0 s")?;
+        positive("max_chain_s", self.max_chain_s, "a finite duration > 0 s")?;
         if let Some(g) = self.gyro_noise_deg_s_rthz {
             if !(g.is_finite() && g >= 0.0) {
                 return Err(PipelineError::InvalidSetting {
@@ -113,6 +141,25 @@ impl PipelineSettings {
                 setting: "constraints",
                 estimator: estimator.name,
             });
+        }
+        if !estimator.capabilities.row_model {
+            let defaults = PipelineSettings::default();
+            for (setting, changed) in [
+                (
+                    "rotation_source",
+                    self.rotation_source != defaults.rotation_source,
+                ),
+                ("rho_model", self.rho_model != defaults.rho_model),
+                ("torque_bias", self.torque_bias != defaults.torque_bias),
+                ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
+            ] {
+                if changed {
+                    return Err(PipelineError::NotApplicable {
+                        setting,
+                        estimator: estimator.name,
+                    });
+                }
+            }
         }
         let constraints = self.constraints.validate()?;
         // The observability thresholds are checked by the estimators' own settings.
@@ -141,6 +188,10 @@ impl PipelineSettings {
             gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
             uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
             observability: self.observability,
+            rotation_source: self.rotation_source,
+            rho_model: self.rho_model,
+            torque_bias: self.torque_bias,
+            max_chain_s: self.max_chain_s,
         })
     }
 }
@@ -193,6 +244,30 @@ impl PipelineConfig {
     #[must_use]
     pub fn uncertainty(&self) -> bool {
         self.uncertainty
+    }
+
+    /// Source of the incremental rotations (`None`: chosen from the data).
+    #[must_use]
+    pub fn rotation_source(&self) -> Option<RotationSource> {
+        self.rotation_source
+    }
+
+    /// Model of the rotor momentum between samples.
+    #[must_use]
+    pub fn rho_model(&self) -> RhoModel {
+        self.rho_model
+    }
+
+    /// Whether an unknown constant torque is estimated.
+    #[must_use]
+    pub fn torque_bias(&self) -> bool {
+        self.torque_bias
+    }
+
+    /// Longest momentum chain, s.
+    #[must_use]
+    pub fn max_chain_s(&self) -> Option<f64> {
+        self.max_chain_s
     }
 
     /// Observability thresholds.

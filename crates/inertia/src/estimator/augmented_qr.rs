@@ -1,0 +1,142 @@
+//! The least-squares state of the discrete momentum estimator: a fixed-size QR factor over
+//! the unknowns `[nuisance; j]` ([`super::momentum_rows`]), folded by Givens rotations like
+//! [`super::qr::RecursiveQr`] (paper eqs. 60–61).
+//!
+//! Because `j` comes last, the trailing 6×6 block of `R` (and of `z`) is the problem in `j`
+//! with every nuisance unknown minimised out exactly: `min_x ‖R x − z‖² = ‖R_jj j − z_j‖² +
+//! const` for each `j`. [`AugmentedQr::reduced`] hands that block to the constrained
+//! solvers and the observability test, which then see the same `(R, z, ρ²)` as for the
+//! paper's rows. Eliminating the initial momenta of a finished chain is dropping the rows
+//! of `R` in which they appear ([`AugmentedQr::eliminate_anchors`]).
+
+use super::momentum_rows::{AugmentedRow, ANCHOR0, J, TORQUE, UNKNOWNS};
+use super::qr::RecursiveQr;
+use crate::givens::fold_row;
+use crate::math::sqrt;
+use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
+
+/// `(R, z, ρ²)` over the 15 unknowns, and counters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AugmentedQr {
+    r: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
+    z: SVector<f64, UNKNOWNS>,
+    rss: f64,
+    y_energy: f64,
+    rows: usize,
+    weight: f64,
+    /// Nuisance unknowns introduced so far (degrees of freedom the residual does not have).
+    nuisance: f64,
+}
+
+impl AugmentedQr {
+    /// The empty state; `shared_nuisance` unknowns (the disturbance torque) are counted
+    /// from the start.
+    #[must_use]
+    pub fn new(shared_nuisance: usize) -> Self {
+        Self {
+            r: SMatrix::zeros(),
+            z: SVector::zeros(),
+            rss: 0.0,
+            y_energy: 0.0,
+            rows: 0,
+            weight: 0.0,
+            nuisance: shared_nuisance as f64,
+        }
+    }
+
+    /// Fold a 3-row block.
+    pub fn add(&mut self, row: &AugmentedRow) {
+        for i in 0..3 {
+            let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
+            let y = row.b[i];
+            self.y_energy += y * y;
+            let left = fold_row(&mut self.r, &a, Some((&mut self.z, y)));
+            self.rss += left * left;
+            self.rows += 1;
+            self.weight += 1.0;
+        }
+    }
+
+    /// Count `n` more nuisance unknowns (a new chain's initial momenta).
+    pub fn add_nuisance(&mut self, n: usize) {
+        self.nuisance += n as f64;
+    }
+
+    /// Minimise the initial-momentum unknowns out of the rows so far (a chain ended):
+    /// they occupy the leading columns, so only the leading rows of `R` involve them.
+    pub fn eliminate_anchors(&mut self) {
+        for i in ANCHOR0..TORQUE {
+            for k in 0..UNKNOWNS {
+                self.r[(i, k)] = 0.0;
+            }
+            self.z[i] = 0.0;
+        }
+    }
+
+    /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`).
+    pub fn scale(&mut self, lambda: f64) {
+        let s = sqrt(lambda);
+        self.r *= s;
+        self.z *= s;
+        self.rss *= lambda;
+        self.y_energy *= lambda;
+        self.weight *= lambda;
+        self.nuisance *= lambda;
+    }
+
+    /// Scalar rows folded in.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Residual sum of squares per residual degree of freedom, `∞` without any.
+    #[must_use]
+    pub fn residual_variance(&self) -> f64 {
+        let dof = self.weight - 6.0 - self.nuisance;
+        if dof > 0.0 {
+            self.rss / dof
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The reduced problem in `j`: the trailing 6×6 block, with the nuisance unknowns
+    /// counted in [`RecursiveQr::nuisance`].
+    #[must_use]
+    pub fn reduced(&self) -> RecursiveQr {
+        RecursiveQr {
+            r: Matrix6::from_fn(|i, k| self.r[(J + i, J + k)]),
+            z: Vector6::from_fn(|i, _| self.z[J + i]),
+            rss: self.rss,
+            y_energy: self.y_energy,
+            rows: self.rows,
+            weight: self.weight,
+            noise_s: 0.0,
+            nuisance: self.nuisance,
+        }
+    }
+
+    /// The nuisance unknowns at a given `j`: back-substitution through the leading rows
+    /// (`τ_b` and the current chain's initial momenta); zero for unknowns the rows never
+    /// involved.
+    #[must_use]
+    pub fn nuisance_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J> {
+        let mut x = SVector::<f64, J>::zeros();
+        for i in (0..J).rev() {
+            let d = self.r[(i, i)];
+            if d == 0.0 {
+                continue;
+            }
+            let mut s = self.z[i];
+            for k in i + 1..J {
+                s -= self.r[(i, k)] * x[k];
+            }
+            for k in 0..6 {
+                s -= self.r[(i, J + k)] * j[k];
+            }
+            x[i] = s / d;
+        }
+        x
+    }
+}

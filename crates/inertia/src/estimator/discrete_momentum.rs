@@ -1,0 +1,308 @@
+//! The discrete momentum estimator (beyond the paper): the rows of
+//! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; j]`
+//! ([`super::augmented_qr`]), the nuisance unknowns minimised out exactly, and the same
+//! observability test, constraint sets and solvers as Algorithm 1 on the reduced problem
+//! in `j`.
+//!
+//! * [`DiscreteMomentumEstimator`] — recursive, no allocation per sample;
+//! * [`reduce_batch`] — every row stacked, one dense Householder QR per chain and one for
+//!   the shared unknowns: an independent code path that must agree with the recursive one.
+
+use super::augmented_qr::AugmentedQr;
+use super::momentum_rows::{AugmentedRow, MomentumRowSettings, MomentumRows};
+use super::qr::RecursiveQr;
+use super::recursive::{estimate_from, RecursiveSettings};
+use super::svd_tracker::SvdTracker;
+use super::{Estimate, EstimatorError};
+use crate::constraints::Constraints;
+use crate::sample::Sample;
+use crate::solver::Backend;
+use nalgebra::{Vector3, Vector6};
+
+/// Settings of the discrete momentum estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MomentumEstimatorSettings {
+    /// How rows are formed.
+    pub rows: MomentumRowSettings,
+    /// Solve cadence, memory and observability thresholds (the errors-in-variables
+    /// compensation of the paper's rows does not apply and must be `None`).
+    pub recursive: RecursiveSettings,
+}
+
+impl MomentumEstimatorSettings {
+    /// Check the settings.
+    pub fn validate(&self) -> Result<(), EstimatorError> {
+        self.recursive.validate()?;
+        if self.recursive.gyro_noise_rad_s_rthz.is_some() {
+            return Err(EstimatorError::InvalidSetting {
+                field: "gyro_noise_rad_s_rthz",
+                why: "errors-in-variables compensation applies to the paper's rows only",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The recursive discrete momentum estimator.
+#[derive(Debug, Clone)]
+pub struct DiscreteMomentumEstimator<B: Backend> {
+    source: MomentumRows,
+    qr: AugmentedQr,
+    svd: SvdTracker,
+    sv: Vector6<f64>,
+    reduced: RecursiveQr,
+    constraints: Constraints,
+    backend: B,
+    settings: MomentumEstimatorSettings,
+    samples: usize,
+    since_solve: usize,
+    last_block_t_s: Option<f64>,
+    epoch: u64,
+    last: Option<Estimate>,
+}
+
+impl<B: Backend> DiscreteMomentumEstimator<B> {
+    /// A new estimator.
+    pub fn new(
+        settings: MomentumEstimatorSettings,
+        constraints: Constraints,
+        backend: B,
+    ) -> Result<Self, EstimatorError> {
+        settings.validate()?;
+        let r = &settings.rows;
+        Ok(Self {
+            source: MomentumRows::new(*r),
+            qr: AugmentedQr::new(r.shared_nuisance() + r.nuisance_per_chain()),
+            svd: SvdTracker::new(),
+            sv: Vector6::zeros(),
+            reduced: RecursiveQr::new(),
+            constraints,
+            backend,
+            settings,
+            samples: 0,
+            since_solve: 0,
+            last_block_t_s: None,
+            epoch: 0,
+            last: None,
+        })
+    }
+
+    /// Fold one sample into the least-squares state without solving. Returns whether it
+    /// completed a row block.
+    pub fn fold(&mut self, s: &Sample) -> Result<bool, EstimatorError> {
+        let index = self.samples;
+        self.samples += 1;
+        let row = self.source.push(s).map_err(|source| EstimatorError::Row {
+            sample: index,
+            source,
+        })?;
+        let Some(row) = row else {
+            return Ok(false);
+        };
+        self.fold_row(&row, s.t_s);
+        Ok(true)
+    }
+
+    fn fold_row(&mut self, row: &AugmentedRow, t_s: f64) {
+        if self.source.epoch() != self.epoch {
+            self.epoch = self.source.epoch();
+            self.qr.eliminate_anchors();
+            self.qr
+                .add_nuisance(self.settings.rows.nuisance_per_chain());
+        }
+        if let (Some(m), Some(t0)) = (self.settings.recursive.memory_s, self.last_block_t_s) {
+            self.qr.scale(libm::exp(-(t_s - t0) / m));
+        }
+        self.last_block_t_s = Some(t_s);
+        self.qr.add(row);
+        self.since_solve += 1;
+    }
+
+    /// Feed one sample. Returns an estimate when this sample completed a block and a solve
+    /// was due.
+    pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+        if !self.fold(s)? {
+            return Ok(None);
+        }
+        if self.since_solve < self.settings.recursive.solve_every || self.qr.rows() < 6 {
+            return Ok(None);
+        }
+        self.solve_now(s.t_s).map(Some)
+    }
+
+    /// Solve with the data so far, stamped `t_s`.
+    pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
+        self.since_solve = 0;
+        self.reduced = self.qr.reduced();
+        self.sv = self.svd.singular_values(&self.reduced.r);
+        let e = estimate_from(
+            &mut self.backend,
+            &self.reduced,
+            &self.sv,
+            &self.constraints,
+            &self.settings.recursive,
+            self.last.and_then(|e| e.j()).as_ref(),
+            t_s,
+        )?;
+        self.last = Some(e);
+        Ok(e)
+    }
+
+    /// Least-squares standard deviation per element at the last solve.
+    #[must_use]
+    pub fn noise_sigma(&self) -> Option<[f64; 6]> {
+        super::uncertainty::noise_sigma(&self.reduced, &self.sv, self.svd.v())
+    }
+
+    /// The reduced least-squares state in `j` at the last solve.
+    #[must_use]
+    pub fn reduced(&self) -> &RecursiveQr {
+        &self.reduced
+    }
+
+    /// The full least-squares state.
+    #[must_use]
+    pub fn qr(&self) -> &AugmentedQr {
+        &self.qr
+    }
+
+    /// The latest estimate.
+    #[must_use]
+    pub fn last(&self) -> Option<&Estimate> {
+        self.last.as_ref()
+    }
+
+    /// The constant body-frame disturbance torque, N m, at the latest estimate's `j`
+    /// (`None` before an answer or when it is not estimated).
+    #[must_use]
+    pub fn torque_bias_nm(&self) -> Option<Vector3<f64>> {
+        let j = self.last.and_then(|e| e.j())?;
+        self.settings.rows.torque_bias.then(|| {
+            let x = self.qr.nuisance_at(&j);
+            Vector3::new(x[6], x[7], x[8])
+        })
+    }
+
+    /// The row settings.
+    #[must_use]
+    pub fn row_settings(&self) -> &MomentumRowSettings {
+        &self.settings.rows
+    }
+
+    /// Gaps in the time stamps so far.
+    #[must_use]
+    pub fn gaps(&self) -> usize {
+        self.source.gaps()
+    }
+
+    /// Samples fed so far.
+    #[must_use]
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+}
+
+/// The reduced least-squares state of all samples at once, by dense Householder QR: per
+/// chain over `[X₀ X₁ τ_b j]`, keeping the rows free of the chain's initial momenta, then
+/// once over the stacked `[τ_b j]` rows of every chain.
+#[cfg(feature = "std")]
+pub fn reduce_batch(
+    samples: &[Sample],
+    settings: &MomentumRowSettings,
+) -> Result<(RecursiveQr, usize), EstimatorError> {
+    use super::momentum_rows::{J, TORQUE, UNKNOWNS};
+    use nalgebra::{DMatrix, DVector};
+    if samples.len() < super::MIN_SAMPLES {
+        return Err(EstimatorError::TooFewSamples {
+            need: super::MIN_SAMPLES,
+            got: samples.len(),
+        });
+    }
+    let mut source = MomentumRows::new(*settings);
+    use std::{vec, vec::Vec};
+    let mut chains: Vec<Vec<AugmentedRow>> = vec![Vec::new()];
+    let mut epoch = 0;
+    for (i, s) in samples.iter().enumerate() {
+        let row = source
+            .push(s)
+            .map_err(|source| EstimatorError::Row { sample: i, source })?;
+        if let Some(row) = row {
+            if source.epoch() != epoch {
+                epoch = source.epoch();
+                chains.push(Vec::new());
+            }
+            if let Some(c) = chains.last_mut() {
+                c.push(row);
+            }
+        }
+    }
+    // Householder QR of an m×n system (zero-padded to at least n rows): (R, Qᵀy, ‖y‖²).
+    let factor = |a: DMatrix<f64>, y: DVector<f64>| {
+        let (m, n) = a.shape();
+        let rows = m.max(n);
+        let a = a.resize_vertically(rows, 0.0);
+        let y = y.resize_vertically(rows, 0.0);
+        let energy = y.norm_squared();
+        let qr = a.qr();
+        let qty = qr.q().transpose() * &y;
+        (qr.r(), qty.rows(0, n).into_owned(), energy)
+    };
+    // Only the columns the rows use: a zero column would leave its row of R holding
+    // information about the others.
+    let anchors = settings.nuisance_per_chain();
+    let shared = settings.shared_nuisance() + 6;
+    let columns: Vec<usize> = (0..anchors)
+        .chain(if settings.torque_bias {
+            TORQUE..UNKNOWNS
+        } else {
+            J..UNKNOWNS
+        })
+        .collect();
+    let mut stacked_a: Vec<f64> = Vec::new();
+    let mut stacked_y: Vec<f64> = Vec::new();
+    let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
+    let mut nuisance = settings.shared_nuisance() as f64;
+    for chain in chains.iter().filter(|c| !c.is_empty()) {
+        nuisance += anchors as f64;
+        let m = 3 * chain.len();
+        let a = DMatrix::from_fn(m, columns.len(), |i, k| chain[i / 3].a[(i % 3, columns[k])]);
+        let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);
+        rows += m;
+        let (r, qty, energy) = factor(a, y);
+        y_energy += energy;
+        rss += (energy - qty.norm_squared()).max(0.0);
+        for i in anchors..columns.len() {
+            stacked_a.extend((anchors..columns.len()).map(|k| r[(i, k)]));
+            stacked_y.push(qty[i]);
+        }
+    }
+    let m = stacked_y.len();
+    let a = DMatrix::from_row_slice(m, shared, &stacked_a);
+    let y = DVector::from_vec(stacked_y);
+    let (r, qty, energy) = factor(a, y);
+    rss += (energy - qty.norm_squared()).max(0.0);
+    let off = shared - 6;
+    let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
+    let mut z = Vector6::from_fn(|i, _| qty[off + i]);
+    for i in 0..6 {
+        if rr[(i, i)] < 0.0 {
+            for k in 0..6 {
+                rr[(i, k)] = -rr[(i, k)];
+            }
+            z[i] = -z[i];
+        }
+    }
+    Ok((
+        RecursiveQr {
+            r: rr,
+            z,
+            rss,
+            y_energy,
+            rows,
+            weight: rows as f64,
+            noise_s: 0.0,
+            nuisance,
+        },
+        source.gaps(),
+    ))
+}

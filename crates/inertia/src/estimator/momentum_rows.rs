@@ -1,0 +1,438 @@
+//! Rows of the discrete momentum estimator ([`crate::discrete_momentum`]) from a stream of
+//! samples: plain, or Richardson-extrapolated to O(h⁴).
+//!
+//! # Unknowns
+//!
+//! `x = [X₀; X₁; τ_b; j]` ([`UNKNOWNS`] = 15): two 3-vectors of initial momentum
+//! (the plain rows use only `X₀ = L̄₀`), the constant body-frame disturbance torque `τ_b`
+//! (columns zero when [`MomentumRowSettings::torque_bias`] is off) and `j` last, so that
+//! the trailing 6×6 block of a QR factor is the reduced problem in `j` alone.
+//!
+//! # Plain rows
+//!
+//! One 3-row block per interval k: `A_k j − X₀ − S_k τ_b = b_k + T_k`
+//! ([`crate::discrete_momentum`]). Exact when `ρ` is linear and `τ` constant across each
+//! interval apart from the O(h²) bias of the discrete Lagrangian; that is the case when
+//! the wheel commands are held over each telemetry step and change at the samples.
+//!
+//! # Richardson rows
+//!
+//! With `F_k` the plain row of interval k and `F^{2h}` the same row built on the stride-2
+//! subgrid over `[c−1, c+1]` (φ of the double step, the same trapezoid rule for `ρ̄`, the
+//! subgrid's own torque sums), the row centred on node c is
+//!
+//! ```text
+//! (4/3) · ½ (F_{c−1} + F_c) − (1/3) F^{2h}_{[c−1, c+1]}
+//! ```
+//!
+//! whose O(h²) bias cancels (the bias is even in h). Each parity p of `c−1` has its own
+//! subgrid and so its own initial momentum: the row's constant is
+//! `X_p = (4/3) L̄₀ − (1/3) L̄₀^{2h,p}`. It assumes `ρ` is smooth across the stencil; with
+//! commands held over each telemetry step the plain rows are the better model.
+//!
+//! # Rotation source
+//!
+//! `φ_k` from the attitude (`vec(q_k† q_{k+1})`) or from the gyro's delta angle over the
+//! interval (`w_k h_k`, the sample's average rate over the following interval,
+//! docs/conventions.md). `C_k` always comes from the attitude. A star tracker's white
+//! attitude noise enters `φ` differenced; a gyro's enters once.
+//!
+//! # Chains
+//!
+//! A gap ([`crate::sample::is_gap`]) or a step that rotates too far restarts the chain:
+//! the sums restart and the initial momenta become new unknowns; [`MomentumRows::epoch`]
+//! counts the restarts so the estimator can eliminate the old ones.
+
+use crate::attitude::Quaternion;
+use crate::discrete::{check_phi, check_unit, RowError};
+use crate::discrete_momentum::IntervalMomentum;
+use crate::sample::{is_gap, Sample};
+use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
+
+/// Number of unknowns: `[X₀ (3); X₁ (3); τ_b (3); j (6)]`.
+pub const UNKNOWNS: usize = 15;
+/// Column of the first initial-momentum unknown.
+pub const ANCHOR0: usize = 0;
+/// Column of the second initial-momentum unknown (Richardson rows, odd centres).
+pub const ANCHOR1: usize = 3;
+/// Column of the disturbance torque `τ_b`.
+pub const TORQUE: usize = 6;
+/// Column of `j`.
+pub const J: usize = 9;
+
+/// Where the incremental rotation `φ_k` comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum RotationSource {
+    /// `vec(q_k† q_{k+1})` of the telemetered attitude.
+    Attitude,
+    /// The gyro's delta angle `w_k h_k` (needs `w_*` in the telemetry).
+    Gyro,
+}
+
+impl RotationSource {
+    /// Name for reports and options (`attitude`, `gyro`).
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            RotationSource::Attitude => "attitude",
+            RotationSource::Gyro => "gyro",
+        }
+    }
+}
+
+/// What the telemetry's rotor momentum does between samples: which rows fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum RhoModel {
+    /// Decide from the data: the row model with the smaller residual variance (default).
+    #[default]
+    Auto,
+    /// `ρ` is smooth across two steps (a continuous law, or commands faster than the
+    /// telemetry): Richardson rows.
+    Smooth,
+    /// `ρ` is linear within each step (wheel torque commands held over each telemetry
+    /// step, changing at the samples): plain rows, for which the trapezoid is exact.
+    Held,
+}
+
+impl RhoModel {
+    /// Name for reports and options (`auto`, `smooth`, `held`).
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            RhoModel::Auto => "auto",
+            RhoModel::Smooth => "smooth",
+            RhoModel::Held => "held",
+        }
+    }
+}
+
+/// How the rows are formed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct MomentumRowSettings {
+    /// Source of `φ` (default [`RotationSource::Attitude`]).
+    pub rotation: RotationSource,
+    /// Richardson rows (default `false`: plain rows).
+    pub richardson: bool,
+    /// Estimate a constant body-frame disturbance torque `τ_b` (default `true`).
+    pub torque_bias: bool,
+    /// Longest chain, s: a chain is restarted (its initial momentum becomes a new unknown)
+    /// once it spans this long, so that a slowly drifting attitude error (a
+    /// gyro-propagated attitude's random walk) rotates the momentum by at most the drift
+    /// within one chain. `None`: chains end only at gaps.
+    pub max_chain_s: Option<f64>,
+}
+
+impl Default for MomentumRowSettings {
+    fn default() -> Self {
+        Self {
+            rotation: RotationSource::Attitude,
+            richardson: false,
+            torque_bias: true,
+            max_chain_s: None,
+        }
+    }
+}
+
+impl MomentumRowSettings {
+    /// One line for reports, e.g. `rotation from gyro, Richardson rows, torque bias`.
+    #[must_use]
+    pub fn describe(&self) -> &'static str {
+        match (self.rotation, self.richardson, self.torque_bias) {
+            (RotationSource::Attitude, false, true) => {
+                "rotation from attitude, plain rows, unknown constant torque"
+            }
+            (RotationSource::Attitude, true, true) => {
+                "rotation from attitude, Richardson rows, unknown constant torque"
+            }
+            (RotationSource::Gyro, false, true) => {
+                "rotation from gyro, plain rows, unknown constant torque"
+            }
+            (RotationSource::Gyro, true, true) => {
+                "rotation from gyro, Richardson rows, unknown constant torque"
+            }
+            (RotationSource::Attitude, false, false) => "rotation from attitude, plain rows",
+            (RotationSource::Attitude, true, false) => "rotation from attitude, Richardson rows",
+            (RotationSource::Gyro, false, false) => "rotation from gyro, plain rows",
+            (RotationSource::Gyro, true, false) => "rotation from gyro, Richardson rows",
+        }
+    }
+
+    /// Unknowns besides `j` the rows involve in one chain.
+    #[must_use]
+    pub fn nuisance_per_chain(&self) -> usize {
+        if self.richardson {
+            6
+        } else {
+            3
+        }
+    }
+
+    /// Unknowns besides `j` shared by every chain (`τ_b`).
+    #[must_use]
+    pub fn shared_nuisance(&self) -> usize {
+        if self.torque_bias {
+            3
+        } else {
+            0
+        }
+    }
+}
+
+/// One 3-row block `a x = b` in the unknowns `x` ([`UNKNOWNS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AugmentedRow {
+    /// Coefficients, 3×15.
+    pub a: SMatrix<f64, 3, UNKNOWNS>,
+    /// Right-hand side, N m s.
+    pub b: Vector3<f64>,
+}
+
+/// A plain row's parts, kept for the Richardson combination.
+#[derive(Debug, Clone, Copy)]
+struct Plain {
+    a: Matrix3x6<f64>,
+    /// `b_k + T_k`.
+    rhs: Vector3<f64>,
+    /// `S_k`.
+    s: Matrix3<f64>,
+}
+
+/// A node as the rows need it.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    t_s: f64,
+    q: Quaternion,
+    c: Matrix3<f64>,
+    rho_nms: Vector3<f64>,
+    tau_nm: Vector3<f64>,
+    omega_rad_s: Option<Vector3<f64>>,
+}
+
+/// The row source.
+#[derive(Debug, Clone)]
+pub struct MomentumRows {
+    settings: MomentumRowSettings,
+    /// The last three nodes of the chain, newest last (`None` before they exist).
+    nodes: [Option<Node>; 3],
+    /// Times of the two nodes before `nodes[0]`, older first (the stride-2 subgrid's
+    /// interior weights need them).
+    t_older_s: [Option<f64>; 2],
+    /// Incremental rotation of the newest interval (`nodes[1]` → `nodes[2]`), as a unit
+    /// quaternion.
+    f_last: Quaternion,
+    /// Nodes in the chain so far.
+    count: usize,
+    /// Time of the chain's first node, s.
+    chain_start_s: f64,
+    /// `S`, `T` of the unit-step grid, up to the newest interior node.
+    s: Matrix3<f64>,
+    t: Vector3<f64>,
+    /// The same per parity of the stride-2 subgrid.
+    s2: [Matrix3<f64>; 2],
+    t2: [Vector3<f64>; 2],
+    prev: Option<Plain>,
+    /// The gyro's angle increment over the previous interval (coning term).
+    alpha_prev: Option<Vector3<f64>>,
+    epoch: u64,
+    gaps: usize,
+}
+
+impl MomentumRows {
+    /// A new source.
+    #[must_use]
+    pub fn new(settings: MomentumRowSettings) -> Self {
+        Self {
+            settings,
+            nodes: [None; 3],
+            t_older_s: [None; 2],
+            f_last: Quaternion::IDENTITY,
+            count: 0,
+            chain_start_s: 0.0,
+            s: Matrix3::zeros(),
+            t: Vector3::zeros(),
+            s2: [Matrix3::zeros(); 2],
+            t2: [Vector3::zeros(); 2],
+            prev: None,
+            alpha_prev: None,
+            epoch: 0,
+            gaps: 0,
+        }
+    }
+
+    /// The settings.
+    #[must_use]
+    pub fn settings(&self) -> &MomentumRowSettings {
+        &self.settings
+    }
+
+    /// Chains started so far minus one: changes whenever the initial momenta of later
+    /// rows are new unknowns.
+    #[must_use]
+    pub fn epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// Gaps seen so far.
+    #[must_use]
+    pub fn gaps(&self) -> usize {
+        self.gaps
+    }
+
+    /// Start a new chain with `first` (or empty).
+    fn restart(&mut self, first: Option<Node>) {
+        let had_rows = self.count >= 2;
+        *self = Self {
+            epoch: self.epoch + u64::from(had_rows),
+            gaps: self.gaps,
+            ..Self::new(self.settings)
+        };
+        if let Some(n) = first {
+            self.nodes[2] = Some(n);
+            self.count = 1;
+            self.chain_start_s = n.t_s;
+        }
+    }
+
+    /// Forget the chain (the next sample starts a new one).
+    pub fn reset(&mut self) {
+        self.restart(None);
+    }
+
+    /// Feed a sample; the row block it completes, if any.
+    pub fn push(&mut self, s: &Sample) -> Result<Option<AugmentedRow>, RowError> {
+        check_unit(&s.q, 2)?;
+        let node = Node {
+            t_s: s.t_s,
+            q: s.q,
+            c: s.q.to_matrix(),
+            rho_nms: s.rho_nms,
+            tau_nm: s.tau_nm,
+            omega_rad_s: s.omega_rad_s,
+        };
+        let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
+        if !finite(&node.rho_nms) {
+            return Err(RowError::NonFinite {
+                what: "rotor momentum",
+            });
+        }
+        if !finite(&node.tau_nm) {
+            return Err(RowError::NonFinite {
+                what: "known torque",
+            });
+        }
+        let Some(b) = self.nodes[2] else {
+            self.restart(Some(node));
+            return Ok(None);
+        };
+        let h = node.t_s - b.t_s;
+        if !(h.is_finite() && h > 0.0) {
+            return Err(RowError::NonFinite {
+                what: "sample period",
+            });
+        }
+        if let Some(a) = self.nodes[1] {
+            if is_gap(b.t_s - a.t_s, h) {
+                self.gaps += 1;
+                self.restart(Some(node));
+                return Ok(None);
+            }
+        }
+        if let Some(max) = self.settings.max_chain_s {
+            if b.t_s - self.chain_start_s >= max {
+                // A new chain from node b: no interval is lost.
+                self.restart(Some(b));
+            }
+        }
+        let f = match self.settings.rotation {
+            RotationSource::Attitude => b.q.conjugate().mul(&node.q).positive_scalar(),
+            RotationSource::Gyro => {
+                let w = b.omega_rad_s.ok_or(RowError::MissingGyroRate)?;
+                if !finite(&w) {
+                    return Err(RowError::NonFinite { what: "gyro rate" });
+                }
+                // `w h` is the angle integral ∫ω dt, not the rotation vector: the
+                // classical two-increment coning term (α_{k−1} × α_k)/12 restores it to
+                // O(h⁴) per step.
+                let alpha = w * h;
+                let theta = match self.alpha_prev {
+                    Some(a) => alpha + a.cross(&alpha) / 12.0,
+                    None => alpha,
+                };
+                self.alpha_prev = Some(alpha);
+                Quaternion::exp(&theta).positive_scalar()
+            }
+        };
+        if let Err(e) = check_phi(&f.v, b.t_s, node.t_s) {
+            self.restart(Some(node));
+            return Err(e);
+        }
+        // Node b is interior once it has a predecessor: add its impulse to the sums.
+        if let Some(a) = self.nodes[1] {
+            let hbar = 0.5 * (node.t_s - a.t_s);
+            self.s += b.c * hbar;
+            self.t += b.c * b.tau_nm * hbar;
+        }
+        let m = IntervalMomentum::new(&b.c, &f.v, &(0.5 * (b.rho_nms + node.rho_nms)), h);
+        let plain = Plain {
+            a: m.a,
+            rhs: m.b + self.t,
+            s: self.s,
+        };
+        let f_prev = self.f_last;
+        self.t_older_s = [self.t_older_s[1], self.nodes[0].map(|n| n.t_s)];
+        self.nodes = [self.nodes[1], self.nodes[2], Some(node)];
+        self.f_last = f;
+        self.count += 1;
+        let prev = self.prev.replace(plain);
+        if !self.settings.richardson {
+            return Ok(Some(self.assemble(&plain.a, &plain.rhs, &plain.s, ANCHOR0)));
+        }
+        // Richardson: centre c = nodes[1], needs the previous interval.
+        let (Some(prev), Some(cm1)) = (prev, self.nodes[0]) else {
+            return Ok(None);
+        };
+        let f2 = f_prev.mul(&f).positive_scalar();
+        check_phi(&f2.v, cm1.t_s, node.t_s).inspect_err(|_| self.restart(Some(node)))?;
+        // Index of c−1 in the chain: count − 3.
+        let parity = (self.count - 3) % 2;
+        // c−1 is interior of its subgrid when the subgrid has a node before it.
+        if self.count >= 5 {
+            if let Some(t_before) = self.t_older_s[0] {
+                let hbar2 = 0.5 * (node.t_s - t_before);
+                self.s2[parity] += cm1.c * hbar2;
+                self.t2[parity] += cm1.c * cm1.tau_nm * hbar2;
+            }
+        }
+        let h2 = node.t_s - cm1.t_s;
+        let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &(0.5 * (cm1.rho_nms + node.rho_nms)), h2);
+        let (w, v) = (2.0 / 3.0, 1.0 / 3.0);
+        let a = (prev.a + plain.a) * w - m2.a * v;
+        let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
+        let s = (prev.s + plain.s) * w - self.s2[parity] * v;
+        let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
+        Ok(Some(self.assemble(&a, &rhs, &s, anchor)))
+    }
+
+    fn assemble(
+        &self,
+        a: &Matrix3x6<f64>,
+        rhs: &Vector3<f64>,
+        s: &Matrix3<f64>,
+        anchor: usize,
+    ) -> AugmentedRow {
+        let mut out = SMatrix::<f64, 3, UNKNOWNS>::zeros();
+        for i in 0..3 {
+            out[(i, anchor + i)] = -1.0;
+        }
+        if self.settings.torque_bias {
+            out.fixed_view_mut::<3, 3>(0, TORQUE).copy_from(&(-s));
+        }
+        out.fixed_view_mut::<3, 6>(0, J).copy_from(a);
+        AugmentedRow { a: out, b: *rhs }
+    }
+}

@@ -1,0 +1,231 @@
+//! The discrete momentum estimator ([`crate::estimator::discrete_momentum`]) in the
+//! pipeline, with the row model chosen from the data.
+//!
+//! Where a setting leaves a choice open (the rotation source when the telemetry has gyro
+//! rates, plain or Richardson rows), every candidate row model folds every sample, and each
+//! solve uses the candidate whose residual variance `ρ²/(rows − unknowns)` is smallest:
+//! the model that explains the data best. A noisier rotation source, or a model of `ρ`
+//! between samples that does not fit (Richardson rows on wheel commands held over each
+//! telemetry step, plain rows on commands that change between samples), leaves larger
+//! residuals. Only the chosen candidate is solved.
+
+use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
+use super::settings::PipelineConfig;
+use super::PipelineError;
+use crate::estimator::discrete_momentum::{
+    reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
+};
+use crate::estimator::excitation::{diagnose, Excitation};
+use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource};
+use crate::estimator::qr::RecursiveQr;
+use crate::estimator::recursive::RecursiveSettings;
+use crate::estimator::uncertainty::combine;
+use crate::estimator::{batch, Estimate, EstimatorError};
+use crate::sample::Sample;
+use crate::solver::Backend;
+use nalgebra::Vector3;
+use std::boxed::Box;
+use std::vec::Vec;
+
+/// Registry entry.
+pub(crate) const DISCRETE_MOMENTUM: EstimatorEntry = EstimatorEntry {
+    name: "discrete-momentum",
+    summary: "discrete conservation of angular momentum (telescoped paper rows), unknown constant torque, Richardson O(h^4) rows, constrained",
+    capabilities: Capabilities {
+        needs_gyro: false,
+        constraints: true,
+        compensation: false,
+        uncertainty: true,
+        row_model: true,
+    },
+    build,
+    batch: Some(run_batch),
+};
+
+type Candidate = DiscreteMomentumEstimator<Box<dyn Backend + Send>>;
+
+/// The candidate row settings for a configuration, given whether the telemetry has gyro
+/// rates.
+fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
+    let rotations: &[RotationSource] = match c.rotation_source {
+        Some(RotationSource::Attitude) => &[RotationSource::Attitude],
+        Some(RotationSource::Gyro) => &[RotationSource::Gyro],
+        None if has_gyro => &[RotationSource::Gyro, RotationSource::Attitude],
+        None => &[RotationSource::Attitude],
+    };
+    let richardson: &[bool] = match c.rho_model {
+        RhoModel::Held => &[false],
+        RhoModel::Smooth => &[true],
+        RhoModel::Auto => &[false, true],
+    };
+    rotations
+        .iter()
+        .flat_map(|&rotation| {
+            richardson
+                .iter()
+                .map(move |&richardson| MomentumRowSettings {
+                    rotation,
+                    richardson,
+                    torque_bias: c.torque_bias,
+                    max_chain_s: c.max_chain_s,
+                })
+        })
+        .collect()
+}
+
+fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorSettings {
+    MomentumEstimatorSettings {
+        rows,
+        recursive: RecursiveSettings {
+            solve_every: 1,
+            observability: c.observability,
+            memory_s: c.memory_s,
+            gyro_noise_rad_s_rthz: None,
+        },
+    }
+}
+
+/// Index of the smallest residual variance (the first on ties; `0` when none is finite).
+fn best(variances: impl Iterator<Item = f64>) -> usize {
+    let mut out = (0, f64::INFINITY);
+    for (i, v) in variances.enumerate() {
+        if v < out.1 {
+            out = (i, v);
+        }
+    }
+    out.0
+}
+
+struct DiscreteMomentum {
+    config: PipelineConfig,
+    candidates: Vec<Candidate>,
+    chosen: usize,
+    since_solve: usize,
+}
+
+fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
+    // Validate the estimator settings now; candidates are built at the first sample.
+    MomentumEstimatorSettings::validate(&settings(c, MomentumRowSettings::default())).map_err(
+        |source| PipelineError::Estimator {
+            sample: None,
+            source,
+        },
+    )?;
+    Ok(Box::new(DiscreteMomentum {
+        config: *c,
+        candidates: Vec::new(),
+        chosen: 0,
+        since_solve: 0,
+    }))
+}
+
+impl DiscreteMomentum {
+    fn start(&mut self, first: &Sample) -> Result<(), EstimatorError> {
+        for rows in candidates(&self.config, first.omega_rad_s.is_some()) {
+            let backend = registry::build_backend(self.config.backend);
+            self.candidates.push(DiscreteMomentumEstimator::new(
+                settings(&self.config, rows),
+                self.config.constraints,
+                backend,
+            )?);
+        }
+        Ok(())
+    }
+}
+
+impl Estimator for DiscreteMomentum {
+    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+        if self.candidates.is_empty() {
+            self.start(s)?;
+        }
+        let mut folded = false;
+        for c in &mut self.candidates {
+            folded |= c.fold(s)?;
+        }
+        if !folded {
+            return Ok(None);
+        }
+        self.since_solve += 1;
+        if self.since_solve < self.config.solve_every {
+            return Ok(None);
+        }
+        self.chosen = best(self.candidates.iter().map(|c| c.qr().residual_variance()));
+        let Some(c) = self.candidates.get_mut(self.chosen) else {
+            return Ok(None);
+        };
+        if c.qr().rows() < 6 {
+            return Ok(None);
+        }
+        self.since_solve = 0;
+        let mut e = c.solve_now(s.t_s)?;
+        if self.config.uncertainty {
+            if let (Some(j), Some(noise)) = (e.j(), c.noise_sigma()) {
+                e.uncertainty = Some(combine(&noise, &j, None));
+            }
+        }
+        Ok(Some(e))
+    }
+
+    fn gaps(&self) -> usize {
+        self.candidates.first().map_or(0, |c| c.gaps())
+    }
+
+    fn excitation(&self) -> Option<Excitation> {
+        let c = self.candidates.get(self.chosen)?;
+        (c.reduced().rows > 0).then(|| diagnose(c.reduced(), &self.config.observability))
+    }
+
+    fn row_model(&self) -> Option<MomentumRowSettings> {
+        self.candidates.get(self.chosen).map(|c| *c.row_settings())
+    }
+
+    fn torque_bias_nm(&self) -> Option<Vector3<f64>> {
+        self.candidates.get(self.chosen)?.torque_bias_nm()
+    }
+}
+
+fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    let wrap = |source| PipelineError::Estimator {
+        sample: match source {
+            EstimatorError::Row { sample, .. } => Some(sample),
+            _ => None,
+        },
+        source,
+    };
+    let has_gyro = samples.first().is_some_and(|s| s.omega_rad_s.is_some());
+    let mut reduced: Vec<(MomentumRowSettings, RecursiveQr, usize)> = Vec::new();
+    for rows in candidates(c, has_gyro) {
+        let (qr, gaps) = reduce_batch(samples, &rows).map_err(wrap)?;
+        reduced.push((rows, qr, gaps));
+    }
+    let variance = |qr: &RecursiveQr| {
+        let dof = qr.residual_dof();
+        if dof > 0.0 {
+            qr.rss / dof
+        } else {
+            f64::INFINITY
+        }
+    };
+    let chosen = best(reduced.iter().map(|(_, qr, _)| variance(qr)));
+    let Some((rows, qr, gaps)) = reduced.get(chosen) else {
+        return Err(PipelineError::NoBatch {
+            estimator: DISCRETE_MOMENTUM.name,
+        });
+    };
+    let mut backend = registry::build_backend(c.backend);
+    let estimate = batch::solve_reduced(
+        qr,
+        samples.last().map_or(0.0, |s| s.t_s),
+        &c.constraints,
+        &mut *backend,
+        &c.observability,
+        None,
+    )
+    .map_err(wrap)?;
+    Ok(BatchOutput {
+        estimate,
+        excitation: Some(diagnose(qr, &c.observability)),
+        gaps: *gaps,
+        row_model: Some(*rows),
+    })
+}

@@ -1,0 +1,362 @@
+//! The discrete momentum form (inertia::discrete_momentum, estimator::momentum_rows,
+//! estimator::discrete_momentum): the exact identity with the paper's rows, conservation
+//! orders on exact trajectories (plain O(h²), Richardson O(h⁴)), recovery of a known J with
+//! an unknown constant torque, recursive vs batch, gaps, and the rotation sources.
+
+use inertia::attitude::Quaternion;
+use inertia::constraints::ConstraintSet;
+use inertia::discrete::RowInput;
+use inertia::discrete_momentum::IntervalMomentum;
+use inertia::dynamics::GyrostatState;
+use inertia::estimator::discrete_momentum::{
+    reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
+};
+use inertia::estimator::momentum_rows::{
+    MomentumRowSettings, MomentumRows, RotationSource, ANCHOR0, ANCHOR1, J,
+};
+use inertia::estimator::observability::Observability;
+use inertia::sample::Sample;
+use inertia::sim::scenario::{Common, Scenario};
+use inertia::sim::{simulate, InputLaw, SimConfig};
+use inertia::solver::native::NativeSolver;
+use inertia::tensor::{j_from_matrix, paper_j_true, relative_frobenius_error};
+use nalgebra::{Matrix3x6, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+    Vector3::new(
+        0.05 * (0.7 * t).sin(),
+        0.03 * (1.1 * t).cos(),
+        -0.04 * (0.5 * t + 1.0).sin(),
+    )
+}
+
+fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+    Vector3::new(
+        0.02 * (0.9 * t).cos(),
+        -0.015 * (1.3 * t).sin(),
+        0.01 * (0.4 * t).sin() + 0.005,
+    )
+}
+
+fn exact_samples(h: f64, duration_s: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
+    let cfg = SimConfig {
+        inertia_kg_m2: paper_j_true(),
+        initial: GyrostatState {
+            q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
+            omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
+            rho_nms: Vector3::new(0.1, -0.2, 0.3),
+        },
+        t0_s: 0.0,
+        dt_s: h,
+        samples: SimConfig::samples_for(duration_s, h),
+        substeps: 64,
+        disturbance_nm_rthz: 0.0,
+        gyro_noise_deg_s_rthz: 0.0,
+        seed: 0,
+        inertia_change: None,
+    };
+    simulate(&cfg, rho, tau).expect("valid config").samples
+}
+
+fn random_unit(rng: &mut ChaCha8Rng, scale: f64) -> Quaternion {
+    Quaternion::exp(&Vector3::from_fn(|_, _| rng.random_range(-scale..scale)))
+}
+
+#[test]
+fn paper_rows_are_rotated_differences_of_interval_momenta() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..200 {
+        let q0 = random_unit(&mut rng, 3.0);
+        let q1 = q0.mul(&random_unit(&mut rng, 0.4));
+        let q2 = q1.mul(&random_unit(&mut rng, 0.4));
+        let rho: [Vector3<f64>; 3] =
+            core::array::from_fn(|_| Vector3::from_fn(|_, _| rng.random_range(-1.0..1.0)));
+        let tau = Vector3::from_fn(|_, _| rng.random_range(-1.0..1.0));
+        let (h0, h1) = (rng.random_range(0.05..0.5), rng.random_range(0.05..0.5));
+        let j = nalgebra::Vector6::from_fn(|_, _| rng.random_range(-2.0..2.0));
+        let input = RowInput::from_nodes(
+            0.0,
+            [&q0, &q1, &q2],
+            [&rho[0], &rho[1], &rho[2]],
+            &tau,
+            h0,
+            h1,
+        )
+        .expect("input");
+        let row = input.row().expect("row");
+        let c1 = q1.to_matrix();
+        let l0 = IntervalMomentum::new(&q0.to_matrix(), &input.phi_k, &input.rho_k_nms, h0);
+        let l1 = IntervalMomentum::new(&c1, &input.phi_k1, &input.rho_k1_nms, h1);
+        let hbar = 0.5 * (h0 + h1);
+        let lhs = c1 * (row.h * j - row.y);
+        let rhs = (l1.momentum(&j) - l0.momentum(&j) - c1 * tau * hbar) * (0.5 * hbar);
+        assert!(
+            (lhs - rhs).norm() <= 1e-12 * (1.0 + lhs.norm()),
+            "identity off by {:e}",
+            (lhs - rhs).norm()
+        );
+    }
+}
+
+/// Largest drift `‖(A_k j − b_k) − (A_0 j − b_0)‖` over rows of the same anchor: the
+/// conserved quantity's error.
+fn max_drift(samples: &[Sample], settings: MomentumRowSettings) -> f64 {
+    let j = j_from_matrix(&paper_j_true());
+    let mut src = MomentumRows::new(settings);
+    let mut first: [Option<Vector3<f64>>; 2] = [None; 2];
+    let mut worst: f64 = 0.0;
+    for s in samples {
+        let Some(row) = src.push(s).expect("row") else {
+            continue;
+        };
+        let a: Matrix3x6<f64> = row.a.fixed_view::<3, 6>(0, J).into_owned();
+        let d = a * j - row.b;
+        let slot = if row.a[(0, ANCHOR1)] != 0.0 { 1 } else { 0 };
+        assert!(row.a[(0, ANCHOR0)] != 0.0 || slot == 1);
+        match first[slot] {
+            None => first[slot] = Some(d),
+            Some(d0) => worst = worst.max((d - d0).norm()),
+        }
+    }
+    worst
+}
+
+fn fitted_order(settings: MomentumRowSettings, rho: &dyn InputLaw, tau: &dyn InputLaw) -> f64 {
+    let pts: Vec<(f64, f64)> = [0.2, 0.1, 0.05, 0.025]
+        .iter()
+        .map(|&h| {
+            let d = max_drift(&exact_samples(h, 8.0, rho, tau), settings);
+            (f64::ln(h), d.ln())
+        })
+        .collect();
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+#[test]
+fn conservation_is_second_order_plain_and_fourth_order_with_richardson() {
+    for richardson in [false, true] {
+        let settings = MomentumRowSettings {
+            richardson,
+            torque_bias: false,
+            ..Default::default()
+        };
+        let p = fitted_order(settings, &rho_dot, &torque);
+        let (lo, hi) = if richardson { (3.7, 4.3) } else { (1.8, 2.2) };
+        assert!(
+            (lo..=hi).contains(&p),
+            "richardson {richardson}: order {p:.3} not in [{lo}, {hi}]"
+        );
+    }
+}
+
+fn estimator(rows: MomentumRowSettings) -> DiscreteMomentumEstimator<NativeSolver> {
+    DiscreteMomentumEstimator::new(
+        MomentumEstimatorSettings {
+            rows,
+            ..Default::default()
+        },
+        ConstraintSet::positive_definite()
+            .validate()
+            .expect("valid"),
+        NativeSolver::default(),
+    )
+    .expect("valid settings")
+}
+
+fn final_error(
+    samples: &[Sample],
+    rows: MomentumRowSettings,
+    truth: &nalgebra::Matrix3<f64>,
+) -> f64 {
+    let mut e = estimator(rows);
+    for s in samples {
+        e.push(s).expect("push");
+    }
+    let last = e.last().expect("estimates");
+    assert!(matches!(
+        last.observability,
+        Observability::Determined { .. }
+    ));
+    relative_frobenius_error(&last.inertia().expect("answer"), truth)
+}
+
+#[test]
+fn recovers_j_on_the_paper_scenarios_without_gyro_noise() {
+    // Richardson rows: the O(h²) bias cancels, so the error is far below the plain rows'.
+    for (sc, plain_max, rich_max) in [
+        (Scenario::slew(), 3e-5, 1e-6),
+        (Scenario::spin(), 2e-4, 1e-6),
+    ] {
+        let run = sc
+            .simulate(&Common {
+                gyro_noise_deg_s_rthz: 0.0,
+                ..Common::paper()
+            })
+            .expect("sim");
+        for rotation in [RotationSource::Attitude, RotationSource::Gyro] {
+            let rows = |richardson| MomentumRowSettings {
+                rotation,
+                richardson,
+                ..Default::default()
+            };
+            let plain = final_error(&run.samples, rows(false), &run.inertia_kg_m2);
+            let rich = final_error(&run.samples, rows(true), &run.inertia_kg_m2);
+            // The gyro's angle increments carry an O(h³) coning remainder per step.
+            let rich_max = if rotation == RotationSource::Gyro {
+                20.0 * rich_max
+            } else {
+                rich_max
+            };
+            assert!(
+                plain < plain_max,
+                "{} {rotation:?} plain {plain:e}",
+                sc.name()
+            );
+            assert!(
+                rich < rich_max,
+                "{} {rotation:?} Richardson {rich:e}",
+                sc.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn an_unknown_constant_torque_is_estimated_and_does_not_bias_j() {
+    // Simulate with a constant torque, then hide it from the telemetry.
+    let tau_b = Vector3::new(1e-5, -2e-5, 1.5e-5);
+    let sc = Scenario::slew();
+    let common = Common::noise_free();
+    let cfg = sc.config(&common);
+    let Scenario::Slew(plan) = &sc else {
+        unreachable!()
+    };
+    let ctrl = inertia::sim::control::SlewController::new(
+        plan.nominal_inertia_kg_m2,
+        cfg.initial.q,
+        plan.slews.clone(),
+        plan.natural_freq_rad_s,
+        plan.damping,
+    )
+    .expect("controller");
+    let constant = move |_t: f64, _x: &GyrostatState| tau_b;
+    let mut run = simulate(&cfg, &ctrl, &constant).expect("sim");
+    for s in &mut run.samples {
+        s.tau_nm = Vector3::zeros();
+    }
+    let rows = |torque_bias| MomentumRowSettings {
+        richardson: true,
+        torque_bias,
+        ..Default::default()
+    };
+    let with = final_error(&run.samples, rows(true), &run.inertia_kg_m2);
+    let without = final_error(&run.samples, rows(false), &run.inertia_kg_m2);
+    assert!(with < 2e-6, "with the torque unknown: {with:e}");
+    assert!(
+        without > 100.0 * with,
+        "without it: {without:e} vs {with:e}"
+    );
+    let mut e = estimator(rows(true));
+    for s in &run.samples {
+        e.push(s).expect("push");
+    }
+    let est = e.torque_bias_nm().expect("torque estimate");
+    assert!(
+        (est - tau_b).norm() < 1e-3 * tau_b.norm(),
+        "{est:?} vs {tau_b:?}"
+    );
+}
+
+#[test]
+fn recursive_and_batch_agree_with_gaps_and_chains() {
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(120.0),
+            ..Common::paper()
+        })
+        .expect("sim");
+    // A one-minute gap in the middle.
+    let mut samples = run.samples.clone();
+    samples.retain(|s| !(50.0..110.0).contains(&s.t_s));
+    for richardson in [false, true] {
+        for max_chain_s in [None, Some(20.0)] {
+            let rows = MomentumRowSettings {
+                richardson,
+                max_chain_s,
+                ..Default::default()
+            };
+            let mut e = estimator(rows);
+            for s in &samples {
+                e.push(s).expect("push");
+            }
+            let rec = inertia::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z)
+                .expect("regular");
+            let (qr, gaps) = reduce_batch(&samples, &rows).expect("batch");
+            let bat = inertia::solver::unconstrained_minimiser(&qr.r, &qr.z).expect("regular");
+            assert_eq!(gaps, 1);
+            assert_eq!(e.gaps(), 1);
+            assert!(
+                (rec - bat).norm() < 1e-9 * bat.norm(),
+                "richardson {richardson} chain {max_chain_s:?}: {:e}",
+                (rec - bat).norm() / bat.norm()
+            );
+            // The batch residual is ‖y‖² − ‖Qᵀy‖², which cancels: agreement to 1e-4.
+            assert!((qr.rss - e.reduced().rss).abs() < 1e-4 * qr.rss);
+            assert_eq!(qr.nuisance, e.reduced().nuisance);
+        }
+    }
+}
+
+#[test]
+fn a_gap_starts_a_new_chain() {
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(20.0),
+            ..Common::noise_free()
+        })
+        .expect("sim");
+    let mut src = MomentumRows::new(MomentumRowSettings::default());
+    let mut rows = 0;
+    for s in run.samples.iter().filter(|s| !(8.0..12.0).contains(&s.t_s)) {
+        rows += usize::from(src.push(s).expect("row").is_some());
+    }
+    assert_eq!(src.gaps(), 1);
+    assert_eq!(src.epoch(), 1);
+    // One row per interval, none across the gap.
+    assert_eq!(
+        rows,
+        run.samples
+            .iter()
+            .filter(|s| !(8.0..12.0).contains(&s.t_s))
+            .count()
+            - 2
+    );
+}
+
+#[test]
+fn gyro_rotation_needs_gyro_rates() {
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(2.0),
+            ..Common::noise_free()
+        })
+        .expect("sim");
+    let mut src = MomentumRows::new(MomentumRowSettings {
+        rotation: RotationSource::Gyro,
+        ..Default::default()
+    });
+    let mut s = run.samples[0];
+    s.omega_rad_s = None;
+    assert!(src.push(&s).expect("first").is_none());
+    let err = src
+        .push(&run.samples[1])
+        .expect_err("no rate on the first interval");
+    assert_eq!(err, inertia::discrete::RowError::MissingGyroRate);
+}
