@@ -368,3 +368,125 @@ fn products_of_inertia_are_tensor_entries() {
     let h: Vector3<f64> = masses.iter().map(|(m, r)| r.cross(&w.cross(r)) * *m).sum();
     assert!((j * w - h).norm() < 1e-14);
 }
+
+/// "Determined" is withdrawn on deliberately broken telemetry.
+mod status {
+    use inertia::attitude::Quaternion;
+    use inertia::constraints::ConstraintSet;
+    use inertia::estimator::observability::{Observability, Unobservable};
+    use inertia::pipeline::{Pipeline, PipelineError, PipelineSettings};
+    use inertia::sample::Sample;
+    use inertia::sim::scenario::{Common, Scenario};
+
+    fn run(
+        samples: &[Sample],
+        settings: &PipelineSettings,
+    ) -> Result<Observability, PipelineError> {
+        let mut p = Pipeline::new(settings)?;
+        for s in samples {
+            p.push(s)?;
+        }
+        Ok(p.last().expect("estimates").observability)
+    }
+
+    fn slew() -> Vec<Sample> {
+        Scenario::slew()
+            .simulate(&Common {
+                duration_s: Some(120.0),
+                ..Common::paper()
+            })
+            .expect("sim")
+            .samples
+    }
+
+    fn settings(estimator: &str) -> PipelineSettings {
+        PipelineSettings {
+            estimator: estimator.into(),
+            constraints: ConstraintSet::positive_definite(),
+            ..PipelineSettings::default()
+        }
+    }
+
+    #[test]
+    fn a_wrong_quaternion_convention_stops_with_the_option_that_fixes_it() {
+        let good = slew();
+        for (name, f, option) in [
+            (
+                "conjugated",
+                (|q: &Quaternion| q.conjugate()) as fn(&Quaternion) -> Quaternion,
+                "--jpl",
+            ),
+            (
+                "scalar first",
+                |q: &Quaternion| {
+                    let [w, x, y, z] = q.to_wxyz();
+                    Quaternion::from_xyzw([w, x, y, z])
+                },
+                "--scalar-first",
+            ),
+        ] {
+            let bad: Vec<Sample> = good.iter().map(|s| Sample { q: f(&s.q), ..*s }).collect();
+            for estimator in ["discrete-momentum", "variational"] {
+                let e = run(&bad, &settings(estimator)).expect_err(name);
+                assert!(
+                    matches!(e, PipelineError::AttitudeConvention { .. })
+                        && e.to_string().contains(option),
+                    "{name}, {estimator}: {e}"
+                );
+                let b =
+                    inertia::pipeline::batch(&bad, &settings(estimator).validate().expect("valid"))
+                        .expect_err("batch");
+                assert!(b.to_string().contains(option), "{b}");
+            }
+        }
+        // The good data pass the same check.
+        assert!(run(&good, &settings("discrete-momentum")).is_ok());
+    }
+
+    #[test]
+    fn a_reversed_wheel_momentum_sign_is_not_determined() {
+        let bad: Vec<Sample> = slew()
+            .iter()
+            .map(|s| Sample {
+                rho_nms: -s.rho_nms,
+                ..*s
+            })
+            .collect();
+        for estimator in ["discrete-momentum", "variational"] {
+            let o = run(&bad, &settings(estimator)).expect("runs");
+            assert!(
+                matches!(
+                    o,
+                    Observability::NotObservable(Unobservable::AtFloor {
+                        unconstrained_negative: true,
+                        ..
+                    })
+                ),
+                "{estimator}: {o}"
+            );
+            assert!(o.to_string().contains("reversed sign of rho"));
+        }
+    }
+
+    #[test]
+    fn data_that_contradict_the_constraint_set_lean_on_it() {
+        // The paper's J_true lies 2.5e-5 kg m² outside Σ ⪰ 0 (docs/conventions.md §4); the
+        // discrete momentum rows resolve that, so the physical set's answer is the set's.
+        let samples = slew();
+        let physical = PipelineSettings {
+            estimator: "discrete-momentum".into(),
+            ..PipelineSettings::default()
+        };
+        let o = run(&samples, &physical).expect("runs");
+        assert!(
+            matches!(
+                o,
+                Observability::FromPrior(Unobservable::ConflictsWithConstraints { .. })
+            ),
+            "{o}"
+        );
+        // Without that constraint the same data determine J.
+        let o = run(&samples, &settings("discrete-momentum")).expect("runs");
+        assert!(matches!(o, Observability::Determined { .. }), "{o}");
+    }
+}

@@ -79,6 +79,22 @@ pub enum Unobservable {
     NoiseDominated,
     /// The estimate is not finite: the estimator diverged on these data.
     Diverged,
+    /// The constrained answer rests on the `J ⪰ εI` floor: the data do not support a
+    /// positive-definite J.
+    AtFloor {
+        /// Smallest principal moment of the answer, kg m².
+        min_moment_kg_m2: f64,
+        /// Whether the unconstrained least-squares J is negative definite: the signature
+        /// of a reversed sign of ρ or τ, or of a wrong quaternion convention.
+        unconstrained_negative: bool,
+    },
+    /// The constraints moved the answer further than the data's noise allows: the data
+    /// contradict the constraint set, and the answer is the constraint set's.
+    ConflictsWithConstraints {
+        /// `(‖R ĵ − z‖² − ‖R j_ls − z‖²)/s²`, a χ² with 6 degrees of freedom if the truth
+        /// satisfies the constraints.
+        chi2: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -122,6 +138,23 @@ impl core::fmt::Display for Unobservable {
             Unobservable::Diverged => write!(
                 f,
                 "the estimate is not finite: the estimator diverged on these data"
+            ),
+            Unobservable::AtFloor {
+                min_moment_kg_m2,
+                unconstrained_negative,
+            } => {
+                write!(
+                    f,
+                    "the answer rests on the J ⪰ εI floor (smallest principal moment {min_moment_kg_m2:.2e} kg m²): the data do not support a positive-definite J"
+                )?;
+                if *unconstrained_negative {
+                    f.write_str("; the unconstrained J is negative definite, the signature of a reversed sign of rho or tau or of a wrong quaternion convention (docs/conventions.md §1, §3)")?;
+                }
+                Ok(())
+            }
+            Unobservable::ConflictsWithConstraints { chi2 } => write!(
+                f,
+                "the constraints moved the answer {chi2:.1e} noise variances away from the data's least-squares J: the data contradict the constraint set"
             ),
             Unobservable::IllConditioned {
                 condition,

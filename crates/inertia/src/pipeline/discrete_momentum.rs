@@ -12,6 +12,7 @@
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
 use super::PipelineError;
+use crate::estimator::audit::audit;
 use crate::estimator::discrete_momentum::{
     reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
@@ -19,7 +20,7 @@ use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
-use crate::estimator::uncertainty::combine;
+use crate::estimator::uncertainty::{combine, noise_sigma};
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::sample::Sample;
 use crate::solver::Backend;
@@ -163,6 +164,12 @@ impl Estimator for DiscreteMomentum {
                 e.uncertainty = Some(combine(&noise, &j, None));
             }
         }
+        audit(
+            &mut e,
+            c.reduced(),
+            self.config.constraints.set().epsilon_kg_m2,
+            self.config.observability.max_relative_sigma,
+        );
         Ok(Some(e))
     }
 
@@ -213,7 +220,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         });
     };
     let mut backend = registry::build_backend(c.backend);
-    let estimate = batch::solve_reduced(
+    let mut estimate = batch::solve_reduced(
         qr,
         samples.last().map_or(0.0, |s| s.t_s),
         &c.constraints,
@@ -222,6 +229,21 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         None,
     )
     .map_err(wrap)?;
+    if c.uncertainty {
+        let svd = qr.r.svd(false, true);
+        if let (Some(j), Some(v_t)) = (estimate.j(), svd.v_t) {
+            let sv = svd.singular_values;
+            if let Some(noise) = noise_sigma(qr, &sv, &v_t.transpose()) {
+                estimate.uncertainty = Some(combine(&noise, &j, None));
+            }
+        }
+    }
+    audit(
+        &mut estimate,
+        qr,
+        c.constraints.set().epsilon_kg_m2,
+        c.observability.max_relative_sigma,
+    );
     Ok(BatchOutput {
         estimate,
         excitation: Some(diagnose(qr, &c.observability)),

@@ -63,6 +63,7 @@ use crate::estimator::excitation::Excitation;
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
 use crate::sample::Sample;
+use crate::telemetry::convention::{ConventionCheck, Verdict};
 use std::boxed::Box;
 use std::string::String;
 
@@ -114,6 +115,19 @@ pub enum PipelineError {
         /// The estimator.
         estimator: &'static str,
     },
+    /// The attitude disagrees with the gyro rates, and another reading of the quaternion
+    /// columns agrees ([`crate::telemetry::convention`]).
+    #[error("the attitude quaternions disagree with the gyro rates (median relative mismatch {as_read:.2} over {steps} steps; {fixed:.2e} when read differently): {fix}")]
+    AttitudeConvention {
+        /// The fix, naming the option.
+        fix: &'static str,
+        /// Median relative mismatch as read.
+        as_read: f64,
+        /// Median relative mismatch with the fix.
+        fixed: f64,
+        /// Steps compared.
+        steps: usize,
+    },
     /// The constraint set is unusable.
     #[error("constraints: {0}")]
     Constraints(#[from] ConstraintError),
@@ -145,6 +159,7 @@ pub struct Pipeline {
     input_samples: usize,
     estimator_samples: usize,
     last: Option<Estimate>,
+    convention: ConventionCheck,
 }
 
 impl core::fmt::Debug for Pipeline {
@@ -177,6 +192,7 @@ impl Pipeline {
             input_samples: 0,
             estimator_samples: 0,
             last: None,
+            convention: ConventionCheck::default(),
         })
     }
 
@@ -197,6 +213,22 @@ impl Pipeline {
     ) -> Result<(), PipelineError> {
         let index = self.input_samples;
         self.input_samples += 1;
+        if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
+            self.convention.push(s);
+            if let Verdict::Wrong {
+                reading,
+                as_read,
+                fixed,
+            } = self.convention.verdict()
+            {
+                return Err(PipelineError::AttitudeConvention {
+                    fix: reading.fix(),
+                    as_read,
+                    fixed,
+                    steps: self.convention.steps(),
+                });
+            }
+        }
         let Self {
             resampler,
             estimator,
@@ -230,6 +262,13 @@ impl Pipeline {
                 result
             }
         }
+    }
+
+    /// How the attitude compares with the gyro rates so far
+    /// ([`crate::telemetry::convention`]).
+    #[must_use]
+    pub fn attitude_check(&self) -> Verdict {
+        self.convention.verdict()
     }
 
     /// The newest estimate.
@@ -299,5 +338,22 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     let run = entry.batch.ok_or(PipelineError::NoBatch {
         estimator: entry.name,
     })?;
+    let mut check = ConventionCheck::default();
+    for s in samples {
+        check.push(s);
+    }
+    if let Verdict::Wrong {
+        reading,
+        as_read,
+        fixed,
+    } = check.verdict()
+    {
+        return Err(PipelineError::AttitudeConvention {
+            fix: reading.fix(),
+            as_read,
+            fixed,
+            steps: check.steps(),
+        });
+    }
     run(samples, config)
 }

@@ -5,6 +5,7 @@
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
 use super::PipelineError;
+use crate::estimator::audit::audit;
 use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use crate::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
@@ -52,6 +53,7 @@ struct Sdp<S: RowSource> {
     shadow: Option<Box<Recursive<S>>>,
     samples: usize,
     observability: crate::estimator::observability::ObservabilitySettings,
+    epsilon_kg_m2: f64,
 }
 
 fn settings(c: &PipelineConfig) -> RecursiveSettings {
@@ -97,6 +99,7 @@ fn build<S: RowSource + Default + Send + 'static>(
         shadow,
         samples: 0,
         observability: c.observability,
+        epsilon_kg_m2: c.constraints.set().epsilon_kg_m2,
     }))
 }
 
@@ -115,6 +118,12 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
             let j_half = half.last().and_then(|h| h.j());
             e.uncertainty = Some(combine(&noise, &j, j_half.as_ref()));
         }
+        audit(
+            &mut e,
+            self.main.qr(),
+            self.epsilon_kg_m2,
+            self.observability.max_relative_sigma,
+        );
         Ok(Some(e))
     }
 
@@ -141,7 +150,7 @@ fn run_batch<S: RowSource + Default>(
     };
     let qr = batch::reduce(samples, &mut source).map_err(wrap)?;
     let mut backend = registry::build_backend(c.backend);
-    let estimate = batch::solve_reduced(
+    let mut estimate = batch::solve_reduced(
         &qr,
         samples.last().map_or(0.0, |s| s.t_s),
         &c.constraints,
@@ -150,6 +159,12 @@ fn run_batch<S: RowSource + Default>(
         c.gyro_noise_rad_s_rthz,
     )
     .map_err(wrap)?;
+    audit(
+        &mut estimate,
+        &qr,
+        c.constraints.set().epsilon_kg_m2,
+        c.observability.max_relative_sigma,
+    );
     Ok(BatchOutput {
         estimate,
         excitation: Some(diagnose(&qr, &c.observability)),

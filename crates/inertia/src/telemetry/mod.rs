@@ -3,5 +3,6 @@
 //! With the `csv` feature, [`csv::TelemetryReader`] streams [`crate::sample::Sample`]s
 //! from a CSV file with validation that names the file, line and column of every problem.
 
+pub mod convention;
 #[cfg(feature = "csv")]
 pub mod csv;

@@ -1,0 +1,72 @@
+//! Can the status be trusted? Checks of an answer against its own data, run after every
+//! solve (beyond the paper). "Determined" is a promise that the answer is right within its
+//! stated σ; it is withdrawn when:
+//!
+//! * the answer rests on the `J ⪰ εI` floor (smallest principal moment below 2ε): the
+//!   data do not support a positive-definite J, which is what a reversed sign of ρ or τ or
+//!   a conjugated quaternion produce → [`Unobservable::AtFloor`], no answer;
+//! * the stated σ is comparable to J (`σ_F > max_relative_sigma · ‖Ĵ‖_F`) →
+//!   [`Unobservable::Uncertain`], no answer;
+//! * the constraints moved the answer further than the noise allows:
+//!   `χ² = (‖R ĵ − z‖² − ‖R j_ls − z‖²)/s²`, which is χ²-distributed with at most six
+//!   degrees of freedom when the truth satisfies the constraints, exceeds
+//!   [`CONFLICT_CHI2`] → [`Unobservable::ConflictsWithConstraints`], reported as an answer
+//!   that leans on the constraint set ([`Observability::FromPrior`]), not on the data.
+
+use super::observability::{Observability, Unobservable};
+use super::qr::RecursiveQr;
+use super::Estimate;
+use crate::tensor::matrix_from_j;
+
+/// χ² threshold of the constraint-conflict test: the 1 − 10⁻⁴ quantile of χ²₆.
+pub const CONFLICT_CHI2: f64 = 27.86;
+
+/// Withdraw or qualify the status of `e` (solved from `qr` under a `J ⪰ εI` floor of
+/// `epsilon_kg_m2`) where its own data contradict it.
+pub fn audit(e: &mut Estimate, qr: &RecursiveQr, epsilon_kg_m2: f64, max_relative_sigma: f64) {
+    if !matches!(
+        e.observability,
+        Observability::Determined { .. } | Observability::FromPrior(_)
+    ) {
+        return;
+    }
+    let Some(j) = e.j() else { return };
+    let m = matrix_from_j(&j);
+    let min_moment_kg_m2 = crate::eigen3::symmetric_eigen3(&m).0.min();
+    let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
+    if min_moment_kg_m2 < 2.0 * epsilon_kg_m2 {
+        let unconstrained_negative = unconstrained
+            .is_some_and(|u| crate::eigen3::symmetric_eigen3(&matrix_from_j(&u)).0.max() < 0.0);
+        e.observability = Observability::NotObservable(Unobservable::AtFloor {
+            min_moment_kg_m2,
+            unconstrained_negative,
+        });
+        e.solution = None;
+        e.uncertainty = None;
+        return;
+    }
+    if let Some(u) = &e.uncertainty {
+        let relative_sigma = u.frobenius_sigma_kg_m2() / m.norm();
+        if !(relative_sigma <= max_relative_sigma) {
+            e.observability = Observability::NotObservable(Unobservable::Uncertain {
+                relative_sigma,
+                threshold: max_relative_sigma,
+            });
+            e.solution = None;
+            e.uncertainty = None;
+            return;
+        }
+    }
+    let dof = qr.residual_dof();
+    if let (Some(u), true, Observability::Determined { .. }) =
+        (unconstrained, dof > 0.0 && qr.rss > 0.0, e.observability)
+    {
+        let s2 = qr.rss / dof;
+        let gain = (qr.r * j - qr.z).norm_squared() - (qr.r * u - qr.z).norm_squared();
+        let chi2 = gain / s2;
+        if chi2 > CONFLICT_CHI2 {
+            e.observability =
+                Observability::FromPrior(Unobservable::ConflictsWithConstraints { chi2 });
+        }
+    }
+}

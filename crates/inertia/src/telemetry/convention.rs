@@ -1,0 +1,192 @@
+//! Does the attitude agree with the gyro? A check of the quaternion convention
+//! (docs/conventions.md §3) on telemetry that has both.
+//!
+//! Over each step the attitude implies a body rate `ω_q = 2 vec(q_k† q_{k+1})/h` (to
+//! O(h²)), which must match the gyro's average rate `w_k` over the same step. Read with the
+//! wrong convention, it does not: a conjugated quaternion (JPL / inertial → body) gives
+//! `ω_q ≈ −C ω` in the wrong frame; scalar-first columns read as scalar-last scramble the
+//! components. [`ConventionCheck`] gathers steps in which the body turns clearly faster than
+//! the gyro noise, and [`ConventionCheck::verdict`] compares the median relative mismatch
+//! `|ω_q − w|/|w|` as read against each alternative reading; the one that fits names the
+//! option that fixes the file. Fixed size, no allocation.
+
+use crate::attitude::Quaternion;
+use crate::sample::Sample;
+use nalgebra::Vector3;
+
+/// Steps needed before a verdict.
+pub const STEPS_NEEDED: usize = 64;
+/// Smallest gyro rate counted, rad/s (a step slower than this says little about frames).
+pub const MIN_RATE_RAD_S: f64 = 2e-3;
+/// A reading fits when its median relative mismatch is below this.
+pub const FIT: f64 = 0.25;
+
+/// Readings of the quaternion columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reading {
+    /// As given.
+    AsRead,
+    /// Conjugated: inertial → body (JPL / Shuster), fixed by `--jpl`.
+    Conjugated,
+    /// The columns are scalar first, fixed by `--scalar-first`.
+    ScalarFirst,
+    /// Both, fixed by `--scalar-first --jpl`.
+    ScalarFirstConjugated,
+    /// The gyro rates have the opposite sign.
+    GyroNegated,
+}
+
+impl Reading {
+    const ALL: [Reading; 5] = [
+        Reading::AsRead,
+        Reading::Conjugated,
+        Reading::ScalarFirst,
+        Reading::ScalarFirstConjugated,
+        Reading::GyroNegated,
+    ];
+
+    /// The fix, in words (naming the command-line option where there is one).
+    #[must_use]
+    pub fn fix(&self) -> &'static str {
+        match self {
+            Reading::AsRead => "none needed",
+            Reading::Conjugated => {
+                "the quaternions look conjugated (inertial → body, JPL/Shuster): use --jpl"
+            }
+            Reading::ScalarFirst => {
+                "the quaternion columns look scalar first ([w, x, y, z]): use --scalar-first"
+            }
+            Reading::ScalarFirstConjugated => {
+                "the quaternions look scalar first and conjugated: use --scalar-first --jpl"
+            }
+            Reading::GyroNegated => {
+                "the gyro rates look negated relative to the attitude: check the sign of w_x, w_y, w_z"
+            }
+        }
+    }
+
+    fn apply(&self, q: &Quaternion) -> Quaternion {
+        let sf = |q: &Quaternion| {
+            let [x, y, z, w] = q.to_xyzw();
+            Quaternion::from_wxyz([x, y, z, w])
+        };
+        match self {
+            Reading::AsRead | Reading::GyroNegated => *q,
+            Reading::Conjugated => q.conjugate(),
+            Reading::ScalarFirst => sf(q),
+            Reading::ScalarFirstConjugated => sf(q).conjugate(),
+        }
+    }
+}
+
+/// The outcome of the check.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Verdict {
+    /// Not enough turning steps with gyro rates yet.
+    Undecided,
+    /// The attitude agrees with the gyro as read (median relative mismatch given).
+    Consistent(f64),
+    /// Another reading fits: the fix, and the mismatch as read and as fixed.
+    Wrong {
+        /// The reading that fits.
+        reading: Reading,
+        /// Median relative mismatch as read.
+        as_read: f64,
+        /// Median relative mismatch with the fix.
+        fixed: f64,
+    },
+    /// No reading fits (frames, time tags or units differ): the mismatch as read.
+    Disagree(f64),
+}
+
+/// Mismatches of the steps gathered so far, per reading.
+#[derive(Debug, Clone)]
+pub struct ConventionCheck {
+    prev: Option<Sample>,
+    mismatch: [[f64; STEPS_NEEDED]; 5],
+    steps: usize,
+}
+
+impl Default for ConventionCheck {
+    fn default() -> Self {
+        Self {
+            prev: None,
+            mismatch: [[0.0; STEPS_NEEDED]; 5],
+            steps: 0,
+        }
+    }
+}
+
+impl ConventionCheck {
+    /// Feed the next sample (no effect once decided, or without gyro rates).
+    pub fn push(&mut self, s: &Sample) {
+        if self.steps >= STEPS_NEEDED {
+            return;
+        }
+        let prev = self.prev.replace(*s);
+        let Some(a) = prev else { return };
+        let (Some(w), h) = (a.omega_rad_s, s.t_s - a.t_s) else {
+            return;
+        };
+        let wn = w.norm();
+        if !(h > 0.0 && h.is_finite() && wn >= MIN_RATE_RAD_S && wn.is_finite()) {
+            return;
+        }
+        // Only short steps: 2 vec(·)/h must be a good rate estimate (|w h| < 0.2 rad).
+        if wn * h > 0.2 {
+            return;
+        }
+        for (k, reading) in Reading::ALL.iter().enumerate() {
+            let (qa, qb) = (reading.apply(&a.q), reading.apply(&s.q));
+            let wq: Vector3<f64> = qa.conjugate().mul(&qb).positive_scalar().v * (2.0 / h);
+            let wg = if *reading == Reading::GyroNegated {
+                -w
+            } else {
+                w
+            };
+            self.mismatch[k][self.steps] = (wq - wg).norm() / wn;
+        }
+        self.steps += 1;
+    }
+
+    /// Steps gathered.
+    #[must_use]
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The verdict on the steps so far.
+    #[must_use]
+    pub fn verdict(&self) -> Verdict {
+        if self.steps < STEPS_NEEDED {
+            return Verdict::Undecided;
+        }
+        let medians: [f64; 5] = core::array::from_fn(|k| {
+            let mut m = self.mismatch[k];
+            m.sort_unstable_by(f64::total_cmp);
+            m[STEPS_NEEDED / 2]
+        });
+        let as_read = medians[0];
+        if as_read < FIT {
+            return Verdict::Consistent(as_read);
+        }
+        let (best, fixed) =
+            medians
+                .iter()
+                .enumerate()
+                .skip(1)
+                .fold(
+                    (0, f64::INFINITY),
+                    |b, (k, &m)| if m < b.1 { (k, m) } else { b },
+                );
+        if fixed < FIT && fixed < 0.5 * as_read {
+            Verdict::Wrong {
+                reading: Reading::ALL[best],
+                as_read,
+                fixed,
+            }
+        } else {
+            Verdict::Disagree(as_read)
+        }
+    }
+}
