@@ -1,7 +1,7 @@
 //! The simulation loop: integration on the controller's grid, sensors, telemetry.
 //!
 //! Time grid: integration nodes `t_b = t0_s + b·dt_s`; telemetry nodes every
-//! [`Realism::telemetry_every`]-th of them. Each integration interval is split at the
+//! [`super::Realism::telemetry_every`]-th of them. Each integration interval is split at the
 //! command ticks inside it ([`super::commands`]), and each piece into equal RK4 substeps
 //! no longer than `dt_s/substeps`; without ticks inside, the interval has exactly
 //! `substeps` substeps (the paper's simulator). The gyro, the gyro-propagated attitude and
