@@ -896,6 +896,10 @@ fn invalid_settings_name_their_field() {
             Box::new(|r| r.commands = Some(CommandHold::at(0.0))),
         ),
         (
+            "commands.rate_hz",
+            Box::new(|r| r.commands = Some(CommandHold::at(1e6))),
+        ),
+        (
             "commands.phase_s",
             Box::new(|r| {
                 r.commands = Some(CommandHold {

@@ -20,6 +20,9 @@
 
 use super::SimError;
 
+/// The most command ticks allowed in one integration node period.
+pub const MAX_TICKS_PER_NODE: f64 = 1000.0;
+
 /// Zero-order hold of the wheel torque commands.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CommandHold {
@@ -51,13 +54,21 @@ impl CommandHold {
         t0_s + self.phase_s + j as f64 * self.period_s()
     }
 
-    /// Check the rate and the phase.
-    pub fn validate(&self) -> Result<(), SimError> {
+    /// Check the rate and the phase; `dt_s` is the integration node period, which may
+    /// hold at most [`MAX_TICKS_PER_NODE`] ticks.
+    pub fn validate(&self, dt_s: f64) -> Result<(), SimError> {
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return Err(SimError::InvalidSetting {
                 field: "commands.rate_hz",
                 value: self.rate_hz,
                 why: "must be finite and > 0",
+            });
+        }
+        if self.rate_hz * dt_s > MAX_TICKS_PER_NODE {
+            return Err(SimError::InvalidSetting {
+                field: "commands.rate_hz",
+                value: self.rate_hz,
+                why: "must not exceed 1000 ticks per integration node period dt_s",
             });
         }
         if !(self.phase_s.is_finite() && self.phase_s >= 0.0 && self.phase_s < self.period_s()) {

@@ -103,7 +103,7 @@ impl Realism {
         self.mekf.validate()?;
         self.wheels.validate(dt_s * self.telemetry_every as f64)?;
         if let Some(c) = &self.commands {
-            c.validate()?;
+            c.validate(dt_s)?;
         }
         self.environment.validate()?;
         if self.attitude == AttitudeSource::Mekf {

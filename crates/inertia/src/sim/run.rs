@@ -144,8 +144,9 @@ pub fn simulate(
                     t_s: t_b,
                     bias_rad_s: f.bias_rad_s(),
                     attitude_sigma_rad: Vector3::new(p[(0, 0)], p[(1, 1)], p[(2, 2)])
-                        .map(f64::sqrt),
-                    bias_sigma_rad_s: Vector3::new(p[(3, 3)], p[(4, 4)], p[(5, 5)]).map(f64::sqrt),
+                        .map(|v| v.max(0.0).sqrt()),
+                    bias_sigma_rad_s: Vector3::new(p[(3, 3)], p[(4, 4)], p[(5, 5)])
+                        .map(|v| v.max(0.0).sqrt()),
                 });
             }
             if skewed {
