@@ -67,27 +67,139 @@ pub enum ScenarioArg {
     Spin,
 }
 
+/// Spacecraft presets (inertia, sensors, wheels and manoeuvre; see the library's
+/// `sim::presets`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// 12U-class small satellite: MEMS gyro (ARW 0.15 deg/√h, bias, bias instability),
+    /// star tracker 5″/5″/40″ at 5 Hz, MEKF attitude, slews on wheels with 10 Hz commands
+    /// and 1e-5 N m s speed quantisation (600 s).
+    SmallSat,
+    /// Three-axis microsatellite: FOG (ARW 0.02 deg/√h), star tracker 3″/3″/25″ at 10 Hz,
+    /// MEKF attitude, 5 Hz wheel commands (900 s).
+    Microsat,
+}
+
+/// Where the telemetered attitude comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AttitudeArg {
+    /// The true attitude.
+    Truth,
+    /// Propagated from the gyro's delta angles (the paper's model).
+    Gyro,
+    /// A star tracker sampled at every telemetry node.
+    StarTracker,
+    /// A multiplicative EKF fusing gyro and star tracker (flight-software style).
+    Mekf,
+}
+
 /// `inertia simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Scenario.
+    /// Scenario (one of --scenario and --preset is required).
+    #[arg(
+        long,
+        value_enum,
+        required_unless_present = "preset",
+        conflicts_with = "preset"
+    )]
+    pub scenario: Option<ScenarioArg>,
+    /// A spacecraft preset instead of the paper's scenarios; the options below override
+    /// its settings.
     #[arg(long, value_enum)]
-    pub scenario: ScenarioArg,
-    /// Duration, s [default: 300 for slew, 180 for spin].
+    pub preset: Option<PresetArg>,
+    /// Duration, s [default: 300 for slew, 180 for spin, the preset's].
     #[arg(long, value_name = "S")]
     pub duration: Option<f64>,
-    /// Sample period h, s.
+    /// Integration node period h, s: the telemetry period unless --telemetry-dt is given.
     #[arg(long, value_name = "S", default_value_t = 0.1)]
     pub dt: f64,
+    /// Telemetry period, s: a whole multiple of --dt (write every n-th node; the gyro's
+    /// delta angle covers the whole period), e.g. `--dt 0.1 --telemetry-dt 1`.
+    #[arg(long, value_name = "S")]
+    pub telemetry_dt: Option<f64>,
     /// Noise seed.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub seed: u64,
-    /// Gyro rate noise spectral density, deg/s/√Hz.
-    #[arg(long, value_name = "DEG_S_RTHZ", default_value_t = 1e-5)]
-    pub gyro_noise: f64,
-    /// Unknown disturbance torque spectral density, N m/√Hz.
-    #[arg(long, value_name = "NM_RTHZ", default_value_t = 1e-8)]
-    pub disturbance: f64,
+    /// Gyro rate noise spectral density, deg/s/√Hz [default: 1e-5, or the preset's].
+    #[arg(long, value_name = "DEG_S_RTHZ", conflicts_with = "gyro_arw_deg_rthr")]
+    pub gyro_noise: Option<f64>,
+    /// Gyro angle random walk, deg/√h (= 60 × the density in deg/s/√Hz).
+    #[arg(long, value_name = "DEG_RTHR")]
+    pub gyro_arw_deg_rthr: Option<f64>,
+    /// Constant gyro bias per body axis, deg/h, e.g. `2:-1.5:1`.
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub gyro_bias_deg_h: Option<String>,
+    /// Gyro bias instability, deg/h: stationary 1σ of a first-order Gauss–Markov bias
+    /// starting at 0.
+    #[arg(long, value_name = "DEG_H")]
+    pub gyro_bias_instability_deg_h: Option<f64>,
+    /// Correlation time of the bias instability, s [default: 3600, or the preset's].
+    #[arg(long, value_name = "S")]
+    pub gyro_bias_correlation_s: Option<f64>,
+    /// Unknown disturbance torque spectral density, N m/√Hz [default: 1e-8, or the
+    /// preset's].
+    #[arg(long, value_name = "NM_RTHZ")]
+    pub disturbance: Option<f64>,
+    /// Source of the telemetered attitude [default: gyro, or the preset's (mekf)].
+    #[arg(long, value_enum)]
+    pub attitude: Option<AttitudeArg>,
+    /// Star-tracker 1σ noise, arcsec: cross-boresight x, cross-boresight y and roll about
+    /// the boresight [default: 5:5:40, or the preset's].
+    #[arg(long, value_name = "X:Y:ROLL")]
+    pub star_tracker_arcsec: Option<String>,
+    /// Star-tracker boresight, body axes [default: 0:0:1].
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub star_tracker_boresight: Option<String>,
+    /// Star-tracker update rate of the MEKF, Hz (1/(rate·dt) a whole number)
+    /// [default: the telemetry rate, or the preset's].
+    #[arg(long, value_name = "HZ")]
+    pub star_tracker_hz: Option<f64>,
+    /// Telemeter the MEKF's raw gyro rates instead of bias-corrected ones.
+    #[arg(long)]
+    pub mekf_raw_rates: bool,
+    /// Hold the wheel torque commands at this controller rate, Hz (zero-order hold)
+    /// [default: continuous, or the preset's].
+    #[arg(long, value_name = "HZ")]
+    pub controller_hz: Option<f64>,
+    /// Time of the first command tick after t = 0, s, in [0, 1/controller-hz): 0 puts
+    /// ticks on the telemetry nodes, dt/2 half-way between them.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub command_phase: f64,
+    /// Wheel-momentum telemetry LSB, N m s (rounding) [default: 0, or the preset's].
+    #[arg(long, value_name = "NMS")]
+    pub wheel_quantization_nms: Option<f64>,
+    /// Wheel-momentum telemetry white noise 1σ per axis, N m s.
+    #[arg(long, value_name = "NMS")]
+    pub wheel_noise_nms: Option<f64>,
+    /// Wheel time-tag skew, s: ρ at node t is the true ρ at t + SKEW (|SKEW| ≤ the
+    /// telemetry period).
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub wheel_skew_s: Option<f64>,
+    /// Wheel spin-inertia scale error per body axis (telemetered = (1 + e) true),
+    /// e.g. `0.01:0:-0.01`.
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub wheel_scale_error: Option<String>,
+    /// Misalignment of the telemetered wheel momentum: a rotation vector, deg, body axes.
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub wheel_misalignment_deg: Option<String>,
+    /// Gravity-gradient torque (unknown: not in tau_*) on a circular orbit at this
+    /// altitude, km. The inertial position is written as extra columns r_x,r_y,r_z (m).
+    #[arg(long, value_name = "KM")]
+    pub gravity_gradient_altitude_km: Option<f64>,
+    /// Orbit inclination, deg (with --gravity-gradient-altitude-km). RAAN 0 and argument
+    /// of latitude 0 at t = 0: the orbit starts on the inertial x axis, so with
+    /// inclination 0 the initial body axes are radial, along-track and orbit normal.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub orbit_inclination_deg: f64,
+    /// Constant unknown body-frame torque, N m, e.g. `1e-5:0:0` (not in tau_*).
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub constant_torque_nm: Option<String>,
     /// Output CSV file (the truth goes to the same name with `.truth.json`).
     #[arg(short = 'o', long, value_name = "FILE.csv")]
     pub output: PathBuf,

@@ -1,10 +1,19 @@
 //! `inertia simulate`.
+//!
+//! The paper's scenarios or a spacecraft preset, with the library's realism settings
+//! (`inertia::sim::Realism`) from the command line. With gravity gradient on, the CSV
+//! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
+//! at each sample (ignored by `estimate`, which reads columns by name).
 
-use crate::args::{ScenarioArg, SimulateArgs};
+use crate::args::{AttitudeArg, PresetArg, ScenarioArg, SimulateArgs};
 use crate::config::InertiaFile;
 use crate::error::{input, write_failed, CliError};
+use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
+use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
+use inertia::sim::{AttitudeSource, CommandHold, Orbit, SimOutput};
 use inertia::telemetry::csv::write_samples;
+use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
 /// The truth file next to a telemetry file: `X.csv` → `X.truth.json`.
@@ -20,9 +29,45 @@ pub fn scenario(s: ScenarioArg) -> Scenario {
     }
 }
 
-/// Run the command.
-pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
-    let sc = scenario(a.scenario);
+/// `n` finite numbers separated by ':'.
+fn numbers(flag: &str, s: &str, n: usize) -> Result<Vec<f64>, CliError> {
+    let v: Vec<f64> = s
+        .split(':')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| {
+            input(format!(
+                "{flag} {s:?}: expected {n} numbers separated by ':'"
+            ))
+        })?;
+    if v.len() != n || !v.iter().all(|x| x.is_finite()) {
+        return Err(input(format!(
+            "{flag} {s:?}: expected {n} finite numbers separated by ':'"
+        )));
+    }
+    Ok(v)
+}
+
+/// A vector option `X:Y:Z`.
+fn vector(flag: &str, s: &Option<String>) -> Result<Option<Vector3<f64>>, CliError> {
+    s.as_deref()
+        .map(|s| numbers(flag, s, 3).map(|v| Vector3::new(v[0], v[1], v[2])))
+        .transpose()
+}
+
+/// The scenario and its settings from the arguments.
+fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
+    let (sc, mut common) = match (a.preset, a.scenario) {
+        (Some(p), _) => {
+            let p = match p {
+                PresetArg::SmallSat => Preset::small_sat(),
+                PresetArg::Microsat => Preset::microsat(),
+            };
+            (p.scenario, p.common)
+        }
+        (None, Some(s)) => (scenario(s), Common::paper()),
+        (None, None) => return Err(input("one of --scenario and --preset is required")),
+    };
     if let Some(d) = a.duration {
         if !(d.is_finite() && d > 0.0) {
             return Err(input(format!("--duration {d}: must be finite and > 0")));
@@ -31,25 +76,8 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     if !(a.dt.is_finite() && a.dt > 0.0) {
         return Err(input(format!("--dt {}: must be finite and > 0", a.dt)));
     }
-    let numbers = |flag: &str, s: &str, n: usize| -> Result<Vec<f64>, CliError> {
-        let v: Vec<f64> = s
-            .split(':')
-            .map(|x| x.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                input(format!(
-                    "{flag} {s:?}: expected {n} numbers separated by ':'"
-                ))
-            })?;
-        if v.len() != n || !v.iter().all(|x| x.is_finite()) {
-            return Err(input(format!(
-                "{flag} {s:?}: expected {n} finite numbers separated by ':'"
-            )));
-        }
-        Ok(v)
-    };
-    let j0 = inertia::tensor::paper_j_true();
-    let inertia_change = match (&a.inertia_step, &a.inertia_ramp) {
+    let j0 = common.inertia_kg_m2;
+    common.inertia_change = match (&a.inertia_step, &a.inertia_ramp) {
         (Some(s), _) => {
             let v = numbers("--inertia-step", s, 2)?;
             Some(inertia::sim::InertiaChange::Step {
@@ -70,21 +98,127 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         }
         (None, None) => None,
     };
-    let common = Common {
-        inertia_change,
-        dt_s: a.dt,
-        duration_s: a.duration,
-        // Keep the integrator's substep near 5 ms whatever the sample period.
-        substeps: ((a.dt / 0.005).round() as usize).max(1),
-        disturbance_nm_rthz: a.disturbance,
-        gyro_noise_deg_s_rthz: a.gyro_noise,
-        seed: a.seed,
-        ..Common::paper()
+    common.dt_s = a.dt;
+    common.duration_s = a.duration;
+    // Keep the integrator's substep near 5 ms whatever the node period.
+    common.substeps = ((a.dt / 0.005).round() as usize).max(1);
+    common.seed = a.seed;
+    if let Some(d) = a.disturbance {
+        common.disturbance_nm_rthz = d;
+    }
+    if let Some(g) = a.gyro_noise {
+        common.gyro_noise_deg_s_rthz = g;
+    }
+    if let Some(arw) = a.gyro_arw_deg_rthr {
+        common.gyro_noise_deg_s_rthz = arw_deg_rthr_to_deg_s_rthz(arw);
+    }
+    let r = &mut common.realism;
+    if let Some(t) = a.telemetry_dt {
+        let n = t / a.dt;
+        let every = n.round();
+        if !(t.is_finite() && every >= 1.0 && (n - every).abs() <= 1e-9 * every) {
+            return Err(input(format!(
+                "--telemetry-dt {t}: must be a whole multiple (>= 1) of --dt {}",
+                a.dt
+            )));
+        }
+        r.telemetry_every = every as usize;
+    }
+    if let Some(b) = vector("--gyro-bias-deg-h", &a.gyro_bias_deg_h)? {
+        r.gyro.bias_deg_h = b;
+    }
+    if let Some(b) = a.gyro_bias_instability_deg_h {
+        r.gyro.bias_instability_deg_h = b;
+    }
+    if let Some(t) = a.gyro_bias_correlation_s {
+        r.gyro.bias_correlation_s = t;
+    }
+    if let Some(s) = a.attitude {
+        r.attitude = match s {
+            AttitudeArg::Truth => AttitudeSource::Truth,
+            AttitudeArg::Gyro => AttitudeSource::GyroPropagated,
+            AttitudeArg::StarTracker => AttitudeSource::StarTracker,
+            AttitudeArg::Mekf => AttitudeSource::Mekf,
+        };
+    }
+    if let Some(v) = vector("--star-tracker-arcsec", &a.star_tracker_arcsec)? {
+        r.star_tracker.noise_arcsec = v;
+    }
+    if let Some(v) = vector("--star-tracker-boresight", &a.star_tracker_boresight)? {
+        r.star_tracker.boresight_body = v;
+    }
+    if let Some(hz) = a.star_tracker_hz {
+        r.star_tracker.rate_hz = Some(hz);
+    }
+    if a.mekf_raw_rates {
+        r.mekf.bias_corrected_rates = false;
+    }
+    if let Some(hz) = a.controller_hz {
+        r.commands = Some(CommandHold {
+            rate_hz: hz,
+            phase_s: a.command_phase,
+        });
+    } else if a.command_phase != 0.0 {
+        match r.commands.as_mut() {
+            Some(c) => c.phase_s = a.command_phase,
+            None => return Err(input("--command-phase needs --controller-hz")),
+        }
+    }
+    if let Some(q) = a.wheel_quantization_nms {
+        r.wheels.quantization_nms = q;
+    }
+    if let Some(n) = a.wheel_noise_nms {
+        r.wheels.noise_nms = n;
+    }
+    if let Some(s) = a.wheel_skew_s {
+        r.wheels.skew_s = s;
+    }
+    if let Some(v) = vector("--wheel-scale-error", &a.wheel_scale_error)? {
+        r.wheels.scale_error = v;
+    }
+    if let Some(v) = vector("--wheel-misalignment-deg", &a.wheel_misalignment_deg)? {
+        r.wheels.misalignment_deg = v;
+    }
+    if let Some(km) = a.gravity_gradient_altitude_km {
+        r.environment.orbit = Some(Orbit {
+            inclination_deg: a.orbit_inclination_deg,
+            ..Orbit::circular(km * 1e3)
+        });
+    }
+    if let Some(v) = vector("--constant-torque-nm", &a.constant_torque_nm)? {
+        r.environment.constant_torque_nm = v;
+    }
+    Ok((sc, common))
+}
+
+/// Write the telemetry CSV, with the orbit position columns when there is an orbit.
+fn write_csv(path: &Path, out: &SimOutput) -> Result<(), CliError> {
+    let Some(orbit) = out.orbit else {
+        let file = std::fs::File::create(path).map_err(|e| write_failed(path, e))?;
+        return write_samples(std::io::BufWriter::new(file), &out.samples)
+            .map_err(|e| write_failed(path, e));
     };
+    let mut buf = Vec::new();
+    write_samples(&mut buf, &out.samples).map_err(|e| write_failed(path, e))?;
+    let text = String::from_utf8(buf).map_err(crate::error::internal)?;
+    let mut csv = String::with_capacity(text.len() + 64 * out.samples.len());
+    let mut lines = text.lines();
+    if let Some(header) = lines.next() {
+        csv.push_str(header);
+        csv.push_str(",r_x,r_y,r_z\n");
+    }
+    for (line, s) in lines.zip(&out.samples) {
+        let r = orbit.position_m(s.t_s);
+        csv.push_str(&format!("{line},{:?},{:?},{:?}\n", r.x, r.y, r.z));
+    }
+    std::fs::write(path, csv).map_err(|e| write_failed(path, e))
+}
+
+/// Run the command.
+pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
+    let (sc, common) = settings(a)?;
     let out = sc.simulate(&common).map_err(input)?;
-    let file = std::fs::File::create(&a.output).map_err(|e| write_failed(&a.output, e))?;
-    write_samples(std::io::BufWriter::new(file), &out.samples)
-        .map_err(|e| write_failed(&a.output, e))?;
+    write_csv(&a.output, &out)?;
     let truth = truth_path(&a.output);
     // The truth file holds the inertia at the end of the run (after any change).
     let t_end = out.samples.last().map_or(0.0, |s| s.t_s);
@@ -95,8 +229,11 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         "wrote {} ({} samples, {} scenario, h = {} s) and {}",
         a.output.display(),
         out.samples.len(),
-        sc.name(),
-        a.dt,
+        a.preset.map_or(sc.name(), |p| match p {
+            PresetArg::SmallSat => "small-sat",
+            PresetArg::Microsat => "microsat",
+        }),
+        common.dt_s * common.realism.telemetry_every as f64,
         truth.display()
     );
     Ok(())

@@ -602,3 +602,128 @@ fn jitter_gaps_and_iso_time_stamps() {
     });
     assert_bad(&mixed, &[], &["mixed.csv:7", "time stamp"]);
 }
+
+#[test]
+fn simulate_realism_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let read = |p: &Path| std::fs::read_to_string(p).unwrap();
+    // A preset, decimated to 1 Hz telemetry with its 10 Hz controller.
+    let small = dir.path().join("small.csv");
+    let o = inertia(&[
+        "simulate",
+        "--preset",
+        "small-sat",
+        "--duration",
+        "30",
+        "--telemetry-dt",
+        "1",
+        "-o",
+        small.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = read(&small);
+    assert!(text.starts_with("t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z,tau_x,tau_y,tau_z,w_x,w_y,w_z\n"));
+    assert_eq!(text.lines().count(), 32, "header + 31 samples at 1 Hz");
+    let truth: serde_json::Value =
+        serde_json::from_str(&read(&dir.path().join("small.truth.json"))).unwrap();
+    assert_eq!(truth["inertia_kg_m2"][0][0], 0.31);
+
+    // The paper's slew with every effect on; gravity gradient adds r_x,r_y,r_z.
+    let all = dir.path().join("all.csv");
+    let o = inertia(&[
+        "simulate",
+        "--scenario",
+        "slew",
+        "--duration",
+        "20",
+        "--attitude",
+        "star-tracker",
+        "--star-tracker-arcsec",
+        "5:5:40",
+        "--gyro-arw-deg-rthr",
+        "0.02",
+        "--gyro-bias-deg-h",
+        "1:-1:0.5",
+        "--controller-hz",
+        "10",
+        "--command-phase",
+        "0.05",
+        "--wheel-quantization-nms",
+        "1e-4",
+        "--wheel-skew-s",
+        "-0.05",
+        "--gravity-gradient-altitude-km",
+        "500",
+        "--constant-torque-nm",
+        "1e-5:0:-1e-5",
+        "-o",
+        all.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = read(&all);
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[14..], ["r_x", "r_y", "r_z"]);
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 201);
+    for row in &rows {
+        let r = (row[14] * row[14] + row[15] * row[15] + row[16] * row[16]).sqrt();
+        assert!((r - 6_878_137.0).abs() < 1e-3, "orbit radius {r}");
+        for rho in &row[5..8] {
+            let steps = rho / 1e-4;
+            assert!(
+                (steps - steps.round()).abs() < 1e-6,
+                "ρ {rho} not quantised"
+            );
+        }
+        // The unknown torques are not telemetered.
+        assert_eq!(&row[8..11], [0.0, 0.0, 0.0]);
+    }
+    // `estimate` reads it (extra columns ignored).
+    let o = inertia(&["estimate", all.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // Invalid settings name the option or the field.
+    let bad = |extra: &[&str], needle: &str| {
+        let out = dir.path().join("bad.csv");
+        let mut args = vec!["simulate", "--scenario", "slew", "--duration", "5"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let o = inertia(&args);
+        assert!(!o.status.success(), "{extra:?} accepted");
+        assert!(stderr(&o).contains(needle), "{extra:?}: {}", stderr(&o));
+    };
+    bad(&["--telemetry-dt", "0.15"], "--telemetry-dt");
+    bad(
+        &["--controller-hz", "10", "--command-phase", "0.2"],
+        "commands.phase_s",
+    );
+    bad(&["--command-phase", "0.05"], "--controller-hz");
+    bad(&["--star-tracker-arcsec", "1:2"], "--star-tracker-arcsec");
+    bad(&["--wheel-skew-s", "0.5"], "wheels.skew_s");
+    bad(
+        &["--attitude", "mekf", "--star-tracker-hz", "3"],
+        "star_tracker.rate_hz",
+    );
+    bad(&["--preset", "microsat"], "cannot be used with");
+    // --help documents the options.
+    let help = stdout(&inertia(&["simulate", "--help"]));
+    for opt in [
+        "--preset",
+        "--attitude",
+        "--controller-hz",
+        "--command-phase",
+        "--telemetry-dt",
+        "--star-tracker-arcsec",
+        "--gyro-arw-deg-rthr",
+        "--gyro-bias-deg-h",
+        "--wheel-quantization-nms",
+        "--wheel-skew-s",
+        "--gravity-gradient-altitude-km",
+        "--constant-torque-nm",
+    ] {
+        assert!(help.contains(opt), "{opt} missing from --help");
+    }
+}

@@ -50,6 +50,7 @@ fn config(dt: f64, substeps: usize) -> SimConfig {
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
         inertia_change: None,
+        realism: Default::default(),
     }
 }
 

@@ -56,6 +56,7 @@ fn exact_samples(h: f64, duration_s: f64, rho: &dyn InputLaw, tau: &dyn InputLaw
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
         inertia_change: None,
+        realism: Default::default(),
     };
     simulate(&cfg, rho, tau).expect("valid config").samples
 }

@@ -24,6 +24,7 @@ fn torque_free(
         gyro_noise_deg_s_rthz: 0.0,
         seed: 0,
         inertia_change: None,
+        realism: Default::default(),
     };
     simulate(&cfg, &Zero, &Zero).unwrap()
 }

@@ -14,18 +14,45 @@
 //! measured attitude is propagated from the noisy increments, so `φ_k` carries the gyro
 //! noise. Rotor momentum is sampled at the nodes without noise. Everything is seeded and
 //! reproducible: ChaCha8 streams, one for the disturbance and one for the gyro.
+//!
+//! Beyond the paper ([`Realism`], default off, so the default output is unchanged bit for
+//! bit): attitude from the truth, a star tracker ([`star_tracker`]) or a multiplicative EKF
+//! ([`mekf`]); gyro bias and bias instability ([`gyro`]); wheel commands held at a
+//! controller rate ([`commands`]); wheel telemetry skew, scale error, misalignment, noise
+//! and quantisation ([`wheels`]); gravity-gradient and constant unknown torques
+//! ([`environment`]); telemetry decimation; spacecraft presets ([`presets`]). The loop is
+//! in [`run`].
+//!
+//! Noise streams (ChaCha8 seeded with [`SimConfig::seed`]), one per source so that
+//! turning one effect on leaves the others' noise unchanged: 0 disturbance torque,
+//! 1 gyro angle random walk, 2 star tracker, 3 wheel telemetry noise, 4 gyro bias
+//! instability.
 
+pub mod commands;
 pub mod control;
+pub mod environment;
+pub mod gyro;
+pub mod mekf;
+pub mod presets;
+pub mod realism;
+pub mod run;
 pub mod scenario;
 pub mod sensors;
+pub mod star_tracker;
+pub mod wheels;
 
-use crate::attitude::Quaternion;
-use crate::dynamics::{rk4_step, GyrostatState};
+pub use commands::CommandHold;
+pub use environment::{Environment, Orbit};
+pub use gyro::GyroErrors;
+pub use mekf::MekfSettings;
+pub use realism::{AttitudeSource, Realism};
+pub use run::simulate;
+pub use star_tracker::StarTracker;
+pub use wheels::WheelTelemetry;
+
+use crate::dynamics::GyrostatState;
 use crate::sample::Sample;
 use nalgebra::{Matrix3, Vector3};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::Distribution;
 
 /// A vector-valued input (ρ̇ or τ, N m) as a function of time and true state.
 pub trait InputLaw: Sync {
@@ -119,11 +146,13 @@ pub struct SimConfig {
     pub initial: GyrostatState,
     /// Start time, s.
     pub t0_s: f64,
-    /// Sample period h, s.
+    /// Integration node period h, s: the telemetry period when
+    /// [`Realism::telemetry_every`] is 1 (the default), else `telemetry_every · dt_s` is.
     pub dt_s: f64,
     /// Number of telemetry nodes (samples).
     pub samples: usize,
-    /// RK4 substeps per sample period.
+    /// RK4 substeps per integration node period (more where command ticks split it:
+    /// no substep is longer than `dt_s/substeps`).
     pub substeps: usize,
     /// Unknown disturbance torque spectral density, N m/√Hz per axis.
     pub disturbance_nm_rthz: f64,
@@ -133,6 +162,9 @@ pub struct SimConfig {
     pub seed: u64,
     /// A change of inertia during the run (none by default).
     pub inertia_change: Option<InertiaChange>,
+    /// Sensors, actuators, environment and telemetry beyond the paper's model
+    /// (`Default`: the paper's model, bit for bit).
+    pub realism: Realism,
 }
 
 impl SimConfig {
@@ -150,6 +182,22 @@ pub struct TruthSample {
     pub t_s: f64,
     /// True state.
     pub state: GyrostatState,
+    /// True gyro bias over the integration interval starting at this node, rad/s, body
+    /// axes (zero unless [`GyroErrors`] are set).
+    pub gyro_bias_rad_s: Vector3<f64>,
+}
+
+/// The MEKF's state at a telemetry node ([`AttitudeSource::Mekf`] only).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterSample {
+    /// Time, s.
+    pub t_s: f64,
+    /// Gyro bias estimate, rad/s, body axes.
+    pub bias_rad_s: Vector3<f64>,
+    /// 1σ of the attitude error about each body axis (√diag P), rad.
+    pub attitude_sigma_rad: Vector3<f64>,
+    /// 1σ of the bias estimate per body axis, rad/s.
+    pub bias_sigma_rad_s: Vector3<f64>,
 }
 
 /// A simulated run: telemetry as the estimator sees it and the truth beside it.
@@ -163,6 +211,13 @@ pub struct SimOutput {
     pub inertia_kg_m2: Matrix3<f64>,
     /// The inertia change, if any (see [`SimOutput::inertia_at`]).
     pub inertia_change: Option<InertiaChange>,
+    /// The orbit when gravity gradient acts: [`Orbit::position_m`] gives the inertial
+    /// position at each sample's time, from which (with q and J) the unknown
+    /// gravity-gradient torque follows ([`environment::gravity_gradient_torque_nm`]).
+    pub orbit: Option<Orbit>,
+    /// The MEKF's bias estimate and σ at each telemetry node (empty unless the attitude
+    /// source is [`AttitudeSource::Mekf`]).
+    pub filter: Vec<FilterSample>,
 }
 
 impl SimOutput {
@@ -239,95 +294,6 @@ impl SimConfig {
                 "must be finite with a non-zero quaternion",
             );
         }
-        Ok(())
+        self.realism.validate(self.dt_s)
     }
-}
-
-/// Run the simulator. `rho_dot` is the wheel control law, `known_torque` the external
-/// torque that is reported in telemetry.
-pub fn simulate(
-    cfg: &SimConfig,
-    rho_dot: &dyn InputLaw,
-    known_torque: &dyn InputLaw,
-) -> Result<SimOutput, SimError> {
-    cfg.validate()?;
-    let j = cfg.inertia_kg_m2;
-    let j_inv = j
-        .try_inverse()
-        .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
-    let n = cfg.samples;
-    let h = cfg.dt_s;
-    let sub = cfg.substeps;
-    let dt = h / sub as f64;
-
-    let mut dist_rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    dist_rng.set_stream(0);
-    let dist = sensors::normal(cfg.disturbance_nm_rthz / dt.sqrt());
-    let mut gyro = sensors::IntegratingGyro::new(cfg.gyro_noise_deg_s_rthz, h, cfg.seed);
-
-    let mut x = cfg.initial;
-    x.q = x.q.normalize().unwrap_or(Quaternion::IDENTITY);
-    let mut q_meas = x.q;
-    let mut samples = Vec::with_capacity(n);
-    let mut truth = Vec::with_capacity(n);
-    // One extra interval past the last node so the last sample's rate is defined.
-    let j0 = cfg.inertia_kg_m2;
-    for k in 0..n {
-        let t_k = cfg.t0_s + k as f64 * h;
-        let x_k = x;
-        let tau_k = known_torque.eval(t_k, &x_k);
-        let mut angle = Vector3::zeros();
-        for s in 0..sub {
-            let t = t_k + s as f64 * dt;
-            let d = Vector3::from_fn(|_, _| dist.sample(&mut dist_rng));
-            let (jm, jm_inv, jdot) = match &cfg.inertia_change {
-                None => (j, j_inv, Matrix3::zeros()),
-                Some(c) => {
-                    // A step inside this substep: apply it at the substep's start,
-                    // conserving angular momentum Jω.
-                    if let InertiaChange::Step { at_s, to_kg_m2 } = *c {
-                        if at_s > t - 0.5 * dt && at_s <= t + 0.5 * dt {
-                            let inv = to_kg_m2.try_inverse().unwrap_or(j_inv);
-                            x.omega_rad_s = inv * (c.inertia_at(&j0, t - dt) * x.omega_rad_s);
-                        }
-                    }
-                    let jm = c.inertia_at(&j0, t + 0.5 * dt);
-                    let inv = jm.try_inverse().unwrap_or(j_inv);
-                    (jm, inv, c.rate_at(&j0, t + 0.5 * dt))
-                }
-            };
-            let f = |tt: f64, xx: &GyrostatState| {
-                (
-                    rho_dot.eval(tt, xx),
-                    known_torque.eval(tt, xx) + d - jdot * xx.omega_rad_s,
-                )
-            };
-            let (next, da) = rk4_step(&jm, &jm_inv, t, dt, &x, &f);
-            x = next;
-            angle += da;
-        }
-        let increment = x_k.q.conjugate().mul(&x.q);
-        let (noisy_increment, rate) = gyro.measure(&increment, &angle);
-        samples.push(Sample {
-            t_s: t_k,
-            q: q_meas,
-            rho_nms: x_k.rho_nms,
-            tau_nm: tau_k,
-            omega_rad_s: Some(rate),
-        });
-        truth.push(TruthSample {
-            t_s: t_k,
-            state: x_k,
-        });
-        q_meas = q_meas
-            .mul(&noisy_increment)
-            .normalize()
-            .unwrap_or(Quaternion::IDENTITY);
-    }
-    Ok(SimOutput {
-        samples,
-        truth,
-        inertia_kg_m2: j,
-        inertia_change: cfg.inertia_change,
-    })
 }

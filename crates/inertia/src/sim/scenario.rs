@@ -13,7 +13,7 @@
 //! 1e-8 N m/√Hz, gyro noise 1e-5 deg/s/√Hz, 20 RK4 substeps per sample.
 
 use super::control::{Slew, SlewController, WheelPulse};
-use super::{simulate, SimConfig, SimError, SimOutput, Zero};
+use super::{simulate, Realism, SimConfig, SimError, SimOutput, Zero};
 use crate::attitude::Quaternion;
 use crate::dynamics::GyrostatState;
 use crate::tensor::paper_j_true;
@@ -29,7 +29,8 @@ pub const SPIN_J33_TOLERANCE: f64 = 0.10;
 pub struct Common {
     /// True inertia, kg m².
     pub inertia_kg_m2: Matrix3<f64>,
-    /// Sample period h, s.
+    /// Integration node period h, s (the telemetry period unless
+    /// [`Realism::telemetry_every`] > 1).
     pub dt_s: f64,
     /// Duration, s (`None`: the scenario's default).
     pub duration_s: Option<f64>,
@@ -43,6 +44,11 @@ pub struct Common {
     pub seed: u64,
     /// A change of inertia during the run.
     pub inertia_change: Option<super::InertiaChange>,
+    /// Sensors, actuators, environment and telemetry beyond the paper's model
+    /// (`Default`: none, the paper's simulator bit for bit). With
+    /// [`Realism::telemetry_every`] = n the telemetry period is `n · dt_s` and the
+    /// duration is counted in telemetry periods.
+    pub realism: Realism,
 }
 
 impl Common {
@@ -58,6 +64,7 @@ impl Common {
             gyro_noise_deg_s_rthz: 1e-5,
             seed: 1,
             inertia_change: None,
+            realism: Realism::default(),
         }
     }
 
@@ -208,12 +215,16 @@ impl Scenario {
             initial,
             t0_s: 0.0,
             dt_s: common.dt_s,
-            samples: SimConfig::samples_for(duration, common.dt_s),
+            samples: SimConfig::samples_for(
+                duration,
+                common.dt_s * common.realism.telemetry_every.max(1) as f64,
+            ),
             substeps: common.substeps,
             disturbance_nm_rthz: common.disturbance_nm_rthz,
             gyro_noise_deg_s_rthz: common.gyro_noise_deg_s_rthz,
             seed: common.seed,
             inertia_change: common.inertia_change,
+            realism: common.realism,
         }
     }
 

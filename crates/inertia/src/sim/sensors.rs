@@ -6,6 +6,10 @@
 //! h, i.e. the average rate over the interval. The attitude solution is propagated from
 //! the same noisy increments, `q̃_{k+1} = q̃_k (q_k† q_{k+1}) exp(n_k)`, i.e. an ideal
 //! (coning-compensated) strapdown integration whose only error is the gyro noise.
+//!
+//! The simulator now samples the gyro through [`super::gyro::Gyro`], which draws the same
+//! noise from the same stream and adds bias and bias instability when they are set;
+//! [`IntegratingGyro`] remains as the plain model.
 
 use crate::attitude::Quaternion;
 use nalgebra::Vector3;

@@ -1,0 +1,193 @@
+//! Spacecraft presets beside the paper's two scenarios: a 12U-class small satellite and a
+//! three-axis microsatellite, each a slew [`Scenario`] with its own [`Common`] settings.
+//!
+//! The numbers are representative of published datasheets of the named equipment
+//! classes, not of one product; every one can be overridden on the returned
+//! [`Preset::common`] and [`Preset::scenario`].
+//!
+//! | | [`Preset::small_sat`] | [`Preset::microsat`] |
+//! |---|---|---|
+//! | inertia | 12U CubeSat, about 20 kg in 22.6 × 22.6 × 34 cm (`m(a² + b²)/12` ≈ 0.28, 0.28, 0.17 kg m²), made asymmetric by deployed panels, with products of inertia | about 60 kg, 0.6 × 0.6 × 0.7 m: 4.6, 5.1, 3.7 kg m² with products |
+//! | gyro | tactical MEMS IMU (STIM300 class): ARW 0.15 deg/√h, turn-on bias of a few deg/h, bias instability 0.5 deg/h | fibre-optic gyro (µFORS / DSP-1760 class): ARW 0.02 deg/√h, bias 0.3 deg/h, bias instability 0.05 deg/h |
+//! | star tracker | CubeSat tracker: 5″/5″/40″ (1σ cross-boresight/roll), 5 Hz | microsat tracker: 3″/3″/25″, 10 Hz |
+//! | attitude | MEKF | MEKF |
+//! | wheels | 3 × ~50 mN m s CubeSat wheels, 10 Hz commands; speed LSB ≈ 1 rpm on a ~1e-4 kg m² rotor: 1e-5 N m s | 3 × ~0.2 N m s wheels, 5 Hz commands; 0.1 rpm on a ~4e-4 kg m² rotor: 4e-6 N m s |
+//! | manoeuvre | six 30–45° slews of 60 s, 600 s | six 30–60° slews of 90 s, 900 s |
+//!
+//! Both telemeter at 10 Hz (integration step 0.1 s, 20 RK4 substeps) and keep the white
+//! disturbance torque; no environmental torque is on by default (set
+//! [`super::Realism::environment`]).
+
+use super::control::Slew;
+use super::scenario::{Common, Scenario, SlewPlan};
+use super::{
+    AttitudeSource, CommandHold, GyroErrors, MekfSettings, Realism, SimError, SimOutput,
+    StarTracker, WheelTelemetry,
+};
+use crate::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
+use nalgebra::{Matrix3, Vector3};
+
+/// A named spacecraft: a scenario and its settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preset {
+    /// Short name (`small-sat`, `microsat`).
+    pub name: &'static str,
+    /// The manoeuvre.
+    pub scenario: Scenario,
+    /// Inertia, sensors and everything else.
+    pub common: Common,
+}
+
+fn slews(list: &[([f64; 3], f64, f64)], duration_s: f64) -> Vec<Slew> {
+    let deg = core::f64::consts::PI / 180.0;
+    list.iter()
+        .map(|&(axis, angle_deg, start_s)| Slew {
+            axis: Vector3::from(axis),
+            angle_rad: angle_deg * deg,
+            start_s,
+            duration_s,
+        })
+        .collect()
+}
+
+impl Preset {
+    /// The 12U-class small satellite (module docs).
+    #[must_use]
+    pub fn small_sat() -> Self {
+        let plan = SlewPlan {
+            duration_s: 600.0,
+            slews: slews(
+                &[
+                    ([1.0, 0.0, 0.0], 40.0, 10.0),
+                    ([0.0, 1.0, 0.0], -35.0, 110.0),
+                    ([0.0, 0.0, 1.0], 45.0, 210.0),
+                    ([1.0, 1.0, 0.0], 30.0, 310.0),
+                    ([0.0, 1.0, -1.0], -40.0, 410.0),
+                    ([1.0, 1.0, 1.0], 45.0, 510.0),
+                ],
+                60.0,
+            ),
+            nominal_inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(0.3, 0.3, 0.2)),
+            natural_freq_rad_s: 0.2,
+            damping: 0.8,
+        };
+        let realism = Realism {
+            attitude: AttitudeSource::Mekf,
+            gyro: GyroErrors {
+                bias_deg_h: Vector3::new(2.0, -1.5, 1.0),
+                bias_instability_deg_h: 0.5,
+                bias_correlation_s: 600.0,
+            },
+            star_tracker: StarTracker {
+                noise_arcsec: Vector3::new(5.0, 5.0, 40.0),
+                boresight_body: Vector3::z(),
+                rate_hz: Some(5.0),
+            },
+            mekf: MekfSettings::default(),
+            wheels: WheelTelemetry {
+                quantization_nms: 1e-5,
+                ..WheelTelemetry::default()
+            },
+            commands: Some(CommandHold::at(10.0)),
+            ..Realism::default()
+        };
+        Self {
+            name: "small-sat",
+            scenario: Scenario::Slew(plan),
+            common: Common {
+                inertia_kg_m2: Matrix3::new(
+                    0.31, -0.006, 0.004, //
+                    -0.006, 0.27, 0.002, //
+                    0.004, 0.002, 0.18,
+                ),
+                dt_s: 0.1,
+                duration_s: None,
+                substeps: 20,
+                disturbance_nm_rthz: 1e-8,
+                gyro_noise_deg_s_rthz: arw_deg_rthr_to_deg_s_rthz(0.15),
+                seed: 1,
+                inertia_change: None,
+                realism,
+            },
+        }
+    }
+
+    /// The three-axis microsatellite (module docs).
+    #[must_use]
+    pub fn microsat() -> Self {
+        let plan = SlewPlan {
+            duration_s: 900.0,
+            slews: slews(
+                &[
+                    ([1.0, 0.0, 0.0], 45.0, 10.0),
+                    ([0.0, 1.0, 0.0], -60.0, 160.0),
+                    ([0.0, 0.0, 1.0], 50.0, 310.0),
+                    ([1.0, 1.0, 0.0], 30.0, 460.0),
+                    ([0.0, 1.0, -1.0], -45.0, 610.0),
+                    ([1.0, 1.0, 1.0], 60.0, 760.0),
+                ],
+                90.0,
+            ),
+            nominal_inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(4.5, 5.0, 3.5)),
+            natural_freq_rad_s: 0.15,
+            damping: 0.8,
+        };
+        let realism = Realism {
+            attitude: AttitudeSource::Mekf,
+            gyro: GyroErrors {
+                bias_deg_h: Vector3::new(0.3, -0.2, 0.25),
+                bias_instability_deg_h: 0.05,
+                bias_correlation_s: 1800.0,
+            },
+            star_tracker: StarTracker {
+                noise_arcsec: Vector3::new(3.0, 3.0, 25.0),
+                boresight_body: Vector3::z(),
+                rate_hz: Some(10.0),
+            },
+            mekf: MekfSettings {
+                initial_bias_sigma_deg_h: 1.0,
+                ..MekfSettings::default()
+            },
+            wheels: WheelTelemetry {
+                quantization_nms: 4e-6,
+                ..WheelTelemetry::default()
+            },
+            commands: Some(CommandHold::at(5.0)),
+            ..Realism::default()
+        };
+        Self {
+            name: "microsat",
+            scenario: Scenario::Slew(plan),
+            common: Common {
+                inertia_kg_m2: Matrix3::new(
+                    4.6, 0.05, -0.08, //
+                    0.05, 5.1, 0.03, //
+                    -0.08, 0.03, 3.7,
+                ),
+                dt_s: 0.1,
+                duration_s: None,
+                substeps: 20,
+                disturbance_nm_rthz: 5e-8,
+                gyro_noise_deg_s_rthz: arw_deg_rthr_to_deg_s_rthz(0.02),
+                seed: 1,
+                inertia_change: None,
+                realism,
+            },
+        }
+    }
+
+    /// A preset by its [`Preset::name`].
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<Self> {
+        match name {
+            "small-sat" => Some(Self::small_sat()),
+            "microsat" => Some(Self::microsat()),
+            _ => None,
+        }
+    }
+
+    /// Simulate the preset.
+    pub fn simulate(&self) -> Result<SimOutput, SimError> {
+        self.scenario.simulate(&self.common)
+    }
+}
