@@ -8,56 +8,19 @@
 
 use inertia::attitude::Quaternion;
 use inertia::discrete::{Row, RowInput};
-use inertia::dynamics::GyrostatState;
 use inertia::sample::Sample;
-use inertia::sim::{simulate, InputLaw, SimConfig, Zero};
+use inertia::sim::{simulate, InputLaw, Zero};
 use inertia::tensor::{j_from_matrix, paper_j_true};
 use nalgebra::Vector3;
 
 const DURATION_S: f64 = 8.0;
 const STEPS: [f64; 5] = [0.2, 0.1, 0.05, 0.025, 0.0125];
 
-fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
-    Vector3::new(
-        0.05 * (0.7 * t).sin(),
-        0.03 * (1.1 * t).cos(),
-        -0.04 * (0.5 * t + 1.0).sin(),
-    )
-}
-
-fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
-    Vector3::new(
-        0.02 * (0.9 * t).cos(),
-        -0.015 * (1.3 * t).sin(),
-        0.01 * (0.4 * t).sin() + 0.005,
-    )
-}
-
-/// A noise-free run from the convergence tests' initial state, sample period `dt`.
-fn config(dt: f64, substeps: usize) -> SimConfig {
-    SimConfig {
-        inertia_kg_m2: paper_j_true(),
-        initial: GyrostatState {
-            q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
-            omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
-            rho_nms: Vector3::new(0.1, -0.2, 0.3),
-        },
-        t0_s: 0.0,
-        dt_s: dt,
-        samples: SimConfig::samples_for(DURATION_S, dt),
-        substeps,
-        disturbance_nm_rthz: 0.0,
-        gyro_noise_deg_s_rthz: 0.0,
-        seed: 0,
-        inertia_change: None,
-        realism: Default::default(),
-    }
-}
+mod trajectory;
+use trajectory::{config, rho_dot, torque};
 
 fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
-    simulate(&config(h, 64), rho, tau)
-        .expect("valid config")
-        .samples
+    trajectory::exact_samples(h, DURATION_S, rho, tau)
 }
 
 /// Which variant of the row to evaluate.
@@ -284,7 +247,7 @@ mod jittered {
         jitter: bool,
     ) -> Vec<Sample> {
         let fine = h / 20.0;
-        let cfg = config(fine, 4);
+        let cfg = config(fine, 4, DURATION_S);
         let all = simulate(&cfg, rho, tau).expect("valid config").samples;
         let mut out = Vec::new();
         let mut k = 0;

@@ -17,49 +17,15 @@ use inertia::estimator::momentum_rows::{
 use inertia::estimator::observability::Observability;
 use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{simulate, InputLaw, SimConfig};
+use inertia::sim::{simulate, InputLaw};
 use inertia::solver::native::NativeSolver;
 use inertia::tensor::{j_from_matrix, paper_j_true, relative_frobenius_error};
 use nalgebra::{Matrix3x6, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
-    Vector3::new(
-        0.05 * (0.7 * t).sin(),
-        0.03 * (1.1 * t).cos(),
-        -0.04 * (0.5 * t + 1.0).sin(),
-    )
-}
-
-fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
-    Vector3::new(
-        0.02 * (0.9 * t).cos(),
-        -0.015 * (1.3 * t).sin(),
-        0.01 * (0.4 * t).sin() + 0.005,
-    )
-}
-
-fn exact_samples(h: f64, duration_s: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {
-    let cfg = SimConfig {
-        inertia_kg_m2: paper_j_true(),
-        initial: GyrostatState {
-            q: Quaternion::exp(&Vector3::new(0.3, -0.2, 0.5)),
-            omega_rad_s: Vector3::new(0.6, -0.4, 0.8),
-            rho_nms: Vector3::new(0.1, -0.2, 0.3),
-        },
-        t0_s: 0.0,
-        dt_s: h,
-        samples: SimConfig::samples_for(duration_s, h),
-        substeps: 64,
-        disturbance_nm_rthz: 0.0,
-        gyro_noise_deg_s_rthz: 0.0,
-        seed: 0,
-        inertia_change: None,
-        realism: Default::default(),
-    };
-    simulate(&cfg, rho, tau).expect("valid config").samples
-}
+mod trajectory;
+use trajectory::{exact_samples, rho_dot, torque};
 
 fn random_unit(rng: &mut ChaCha8Rng, scale: f64) -> Quaternion {
     Quaternion::exp(&Vector3::from_fn(|_, _| rng.random_range(-scale..scale)))
