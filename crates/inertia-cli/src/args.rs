@@ -248,10 +248,13 @@ pub enum RhoModelArg {
     /// Decided from the data (the rows with the smaller residual variance).
     #[default]
     Auto,
-    /// Smooth across two steps: Richardson rows.
+    /// Smooth across two steps (a continuous law): Richardson rows, O(h^4).
     Smooth,
-    /// Linear within each step (commands held over each step): plain rows.
+    /// Linear within each step (torque commands held over each telemetry step, changing
+    /// at the samples): Richardson rows with the double step's mean momentum, O(h^4).
     Held,
+    /// Plain one-step rows, O(h^2), whatever the wheels do.
+    Plain,
 }
 
 /// Input-format options shared by commands that read telemetry.

@@ -151,6 +151,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
             RhoModelArg::Auto => RhoModel::Auto,
             RhoModelArg::Smooth => RhoModel::Smooth,
             RhoModelArg::Held => RhoModel::Held,
+            RhoModelArg::Plain => RhoModel::Plain,
         },
         torque_bias: !a.no_torque_bias,
         max_chain_s: (a.chain != 0.0).then_some(a.chain),

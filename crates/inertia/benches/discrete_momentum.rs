@@ -8,7 +8,7 @@
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::discrete_momentum::{DiscreteMomentumEstimator, MomentumEstimatorSettings};
-use inertia::estimator::momentum_rows::MomentumRowSettings;
+use inertia::estimator::momentum_rows::{MomentumRowSettings, Stencil};
 use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use inertia::estimator::rows::VariationalRows;
 use inertia::sim::scenario::{Common, Scenario};
@@ -22,11 +22,11 @@ fn bench(c: &mut Criterion) {
     let start = 2000;
     let set = || ConstraintSet::positive_definite().validate().unwrap();
     let mut g = c.benchmark_group("per_sample_slew");
-    for richardson in [false, true] {
+    for stencil in [Stencil::Plain, Stencil::Smooth] {
         let mut e = DiscreteMomentumEstimator::new(
             MomentumEstimatorSettings {
                 rows: MomentumRowSettings {
-                    richardson,
+                    stencil,
                     ..Default::default()
                 },
                 ..Default::default()
@@ -43,7 +43,7 @@ fn bench(c: &mut Criterion) {
             e.push(s).unwrap();
         }
         let mut k = 0;
-        let name = if richardson {
+        let name = if stencil.richardson() {
             "discrete_momentum_richardson"
         } else {
             "discrete_momentum_plain"

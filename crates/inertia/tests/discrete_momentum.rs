@@ -1,7 +1,8 @@
 //! The discrete momentum form (inertia::discrete_momentum, estimator::momentum_rows,
 //! estimator::discrete_momentum): the exact identity with the paper's rows, conservation
 //! orders on exact trajectories (plain O(h²), Richardson O(h⁴)), recovery of a known J with
-//! an unknown constant torque, recursive vs batch, gaps, and the rotation sources.
+//! an unknown constant torque, the stencils for smooth and held wheel momentum, recursive vs
+//! batch, gaps, and the rotation sources.
 
 use inertia::attitude::Quaternion;
 use inertia::constraints::ConstraintSet;
@@ -12,12 +13,12 @@ use inertia::estimator::discrete_momentum::{
     reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
 use inertia::estimator::momentum_rows::{
-    MomentumRowSettings, MomentumRows, RotationSource, ANCHOR0, ANCHOR1, J,
+    MomentumRowSettings, MomentumRows, RotationSource, Stencil, ANCHOR0, ANCHOR1, J,
 };
 use inertia::estimator::observability::Observability;
 use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{simulate, InputLaw};
+use inertia::sim::{simulate, AttitudeSource, CommandHold, InputLaw, Realism};
 use inertia::solver::native::NativeSolver;
 use inertia::tensor::{j_from_matrix, paper_j_true, relative_frobenius_error};
 use nalgebra::{Matrix3x6, Vector3};
@@ -108,9 +109,10 @@ fn fitted_order(settings: MomentumRowSettings, rho: &dyn InputLaw, tau: &dyn Inp
 
 #[test]
 fn conservation_is_second_order_plain_and_fourth_order_with_richardson() {
-    for richardson in [false, true] {
+    for stencil in [Stencil::Plain, Stencil::Smooth] {
+        let richardson = stencil.richardson();
         let settings = MomentumRowSettings {
-            richardson,
+            stencil,
             torque_bias: false,
             ..Default::default()
         };
@@ -170,7 +172,11 @@ fn recovers_j_on_the_paper_scenarios_without_gyro_noise() {
         for rotation in [RotationSource::Attitude, RotationSource::Gyro] {
             let rows = |richardson| MomentumRowSettings {
                 rotation,
-                richardson,
+                stencil: if richardson {
+                    Stencil::Smooth
+                } else {
+                    Stencil::Plain
+                },
                 ..Default::default()
             };
             let plain = final_error(&run.samples, rows(false), &run.inertia_kg_m2);
@@ -219,7 +225,7 @@ fn an_unknown_constant_torque_is_estimated_and_does_not_bias_j() {
         s.tau_nm = Vector3::zeros();
     }
     let rows = |torque_bias| MomentumRowSettings {
-        richardson: true,
+        stencil: Stencil::Smooth,
         torque_bias,
         ..Default::default()
     };
@@ -252,10 +258,10 @@ fn recursive_and_batch_agree_with_gaps_and_chains() {
     // A one-minute gap in the middle.
     let mut samples = run.samples.clone();
     samples.retain(|s| !(50.0..110.0).contains(&s.t_s));
-    for richardson in [false, true] {
+    for stencil in [Stencil::Plain, Stencil::Smooth, Stencil::Held] {
         for max_chain_s in [None, Some(20.0)] {
             let rows = MomentumRowSettings {
-                richardson,
+                stencil,
                 max_chain_s,
                 ..Default::default()
             };
@@ -271,7 +277,7 @@ fn recursive_and_batch_agree_with_gaps_and_chains() {
             assert_eq!(e.gaps(), 1);
             assert!(
                 (rec - bat).norm() < 1e-9 * bat.norm(),
-                "richardson {richardson} chain {max_chain_s:?}: {:e}",
+                "{stencil:?} chain {max_chain_s:?}: {:e}",
                 (rec - bat).norm() / bat.norm()
             );
             // The batch residual is ‖y‖² − ‖Qᵀy‖², which cancels: agreement to 1e-4.
@@ -326,4 +332,62 @@ fn gyro_rotation_needs_gyro_rates() {
         .push(&run.samples[1])
         .expect_err("no rate on the first interval");
     assert_eq!(err, inertia::discrete::RowError::MissingGyroRate);
+}
+
+#[test]
+fn each_richardson_stencil_is_exact_for_its_wheel_model_and_the_pipeline_picks_it() {
+    // Truth attitude, no gyro noise, no disturbance: what is left is discretisation.
+    // Commands held over each 0.1 s step make ρ piecewise linear with kinks at the
+    // samples; the continuous controller makes it smooth.
+    for held in [false, true] {
+        let run = Scenario::slew()
+            .simulate(&Common {
+                gyro_noise_deg_s_rthz: 0.0,
+                disturbance_nm_rthz: 0.0,
+                realism: Realism {
+                    attitude: AttitudeSource::Truth,
+                    commands: held.then(|| CommandHold::at(10.0)),
+                    ..Default::default()
+                },
+                ..Common::paper()
+            })
+            .expect("sim");
+        let error = |stencil| {
+            let rows = MomentumRowSettings {
+                stencil,
+                ..Default::default()
+            };
+            final_error(&run.samples, rows, &run.inertia_kg_m2)
+        };
+        let (smooth, held_rows, plain) = (
+            error(Stencil::Smooth),
+            error(Stencil::Held),
+            error(Stencil::Plain),
+        );
+        eprintln!("held {held}: smooth {smooth:.2e}, held {held_rows:.2e}, plain {plain:.2e}");
+        let (right, wrong) = if held {
+            (held_rows, smooth)
+        } else {
+            (smooth, held_rows)
+        };
+        assert!(
+            right < 1e-7 && wrong > 20.0 * right && plain > 20.0 * right,
+            "held {held}: smooth {smooth:e}, held {held_rows:e}, plain {plain:e}"
+        );
+        let mut p = inertia::pipeline::Pipeline::new(&inertia::pipeline::PipelineSettings {
+            estimator: "discrete-momentum".into(),
+            constraints: ConstraintSet::positive_definite(),
+            ..Default::default()
+        })
+        .expect("pipeline");
+        for s in &run.samples {
+            p.push(s).expect("push");
+        }
+        let chosen = p.row_model().expect("row model").stencil;
+        assert_eq!(
+            chosen,
+            if held { Stencil::Held } else { Stencil::Smooth },
+            "held {held}"
+        );
+    }
 }

@@ -82,31 +82,71 @@ impl RotationSource {
     }
 }
 
-/// What the telemetry's rotor momentum does between samples: which rows fit.
+/// What the telemetry's rotor momentum does between samples: which rows fit (the
+/// pipeline's choice; [`Stencil`] is what one row model does).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum RhoModel {
-    /// Decide from the data: the row model with the smaller residual variance (default).
+    /// Decide from the data: of [`Stencil::Smooth`] and [`Stencil::Held`], the row model
+    /// with the smaller residual variance (default).
     #[default]
     Auto,
-    /// `ρ` is smooth across two steps (a continuous law, or commands faster than the
-    /// telemetry): Richardson rows.
+    /// `ρ` is smooth across two steps (a continuous law, or commands much faster than the
+    /// telemetry): [`Stencil::Smooth`].
     Smooth,
     /// `ρ` is linear within each step (wheel torque commands held over each telemetry
-    /// step, changing at the samples): plain rows, for which the trapezoid is exact.
+    /// step, changing at the samples): [`Stencil::Held`].
     Held,
+    /// Plain rows ([`Stencil::Plain`]), O(h²), whatever `ρ` does.
+    Plain,
 }
 
 impl RhoModel {
-    /// Name for reports and options (`auto`, `smooth`, `held`).
+    /// Name for reports and options (`auto`, `smooth`, `held`, `plain`).
     #[must_use]
     pub fn name(&self) -> &'static str {
         match self {
             RhoModel::Auto => "auto",
             RhoModel::Smooth => "smooth",
             RhoModel::Held => "held",
+            RhoModel::Plain => "plain",
         }
+    }
+}
+
+/// The rows' stencil: one interval, or a Richardson combination of two intervals and
+/// their double step.
+///
+/// The body momentum `Jω + ρ` is smooth even where the wheel torque jumps (the wheels'
+/// torque is internal), but `ω` and `ρ` separately have kinks there. The dynamics part of
+/// a row measures the *mean* of `ω` over its interval (`φ ≈ ∫ω`), so its `ρ` part must
+/// be the mean of `ρ` over the same interval for the kinks to cancel. Within one
+/// telemetry step the trapezoid `(ρ_k + ρ_{k+1})/2` is that mean when `ρ` is linear
+/// (commands held over the step). Over the double step the mean is the average of the two
+/// trapezoids ([`Stencil::Held`]), exact for kinks at the middle node; for smooth `ρ` it is
+/// off by `h²ρ̈/12`, which the Richardson combination does not remove, so smooth `ρ` uses
+/// the double step's own trapezoid `(ρ_{c−1} + ρ_{c+1})/2`, whose O(h²) term scales like
+/// the single steps' ([`Stencil::Smooth`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Stencil {
+    /// One interval per row: O(h²).
+    #[default]
+    Plain,
+    /// Richardson, double-step `ρ̄` its trapezoid: O(h⁴) for smooth `ρ`.
+    Smooth,
+    /// Richardson, double-step `ρ̄` the mean of its two steps' trapezoids: O(h⁴) for `ρ`
+    /// linear within each step.
+    Held,
+}
+
+impl Stencil {
+    /// Whether the rows are Richardson combinations.
+    #[must_use]
+    pub fn richardson(&self) -> bool {
+        !matches!(self, Stencil::Plain)
     }
 }
 
@@ -116,8 +156,8 @@ impl RhoModel {
 pub struct MomentumRowSettings {
     /// Source of `φ` (default [`RotationSource::Attitude`]).
     pub rotation: RotationSource,
-    /// Richardson rows (default `false`: plain rows).
-    pub richardson: bool,
+    /// The rows' stencil (default [`Stencil::Plain`]).
+    pub stencil: Stencil,
     /// Estimate a constant body-frame disturbance torque `τ_b` (default `true`).
     pub torque_bias: bool,
     /// Longest chain, s: a chain is restarted (its initial momentum becomes a new unknown)
@@ -131,41 +171,40 @@ impl Default for MomentumRowSettings {
     fn default() -> Self {
         Self {
             rotation: RotationSource::Attitude,
-            richardson: false,
+            stencil: Stencil::Plain,
             torque_bias: true,
             max_chain_s: None,
         }
     }
 }
 
-impl MomentumRowSettings {
-    /// One line for reports, e.g. `rotation from gyro, Richardson rows, torque bias`.
-    #[must_use]
-    pub fn describe(&self) -> &'static str {
-        match (self.rotation, self.richardson, self.torque_bias) {
-            (RotationSource::Attitude, false, true) => {
-                "rotation from attitude, plain rows, unknown constant torque"
-            }
-            (RotationSource::Attitude, true, true) => {
-                "rotation from attitude, Richardson rows, unknown constant torque"
-            }
-            (RotationSource::Gyro, false, true) => {
-                "rotation from gyro, plain rows, unknown constant torque"
-            }
-            (RotationSource::Gyro, true, true) => {
-                "rotation from gyro, Richardson rows, unknown constant torque"
-            }
-            (RotationSource::Attitude, false, false) => "rotation from attitude, plain rows",
-            (RotationSource::Attitude, true, false) => "rotation from attitude, Richardson rows",
-            (RotationSource::Gyro, false, false) => "rotation from gyro, plain rows",
-            (RotationSource::Gyro, true, false) => "rotation from gyro, Richardson rows",
-        }
+/// One line for reports, e.g. `rotation from gyro, Richardson rows (ρ held over each
+/// step), unknown constant torque`.
+impl core::fmt::Display for MomentumRowSettings {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let rotation = match self.rotation {
+            RotationSource::Attitude => "rotation from attitude",
+            RotationSource::Gyro => "rotation from gyro",
+        };
+        let stencil = match self.stencil {
+            Stencil::Plain => "plain rows",
+            Stencil::Smooth => "Richardson rows (smooth ρ)",
+            Stencil::Held => "Richardson rows (ρ held over each step)",
+        };
+        let torque = if self.torque_bias {
+            ", unknown constant torque"
+        } else {
+            ""
+        };
+        write!(f, "{rotation}, {stencil}{torque}")
     }
+}
 
+impl MomentumRowSettings {
     /// Unknowns besides `j` the rows involve in one chain.
     #[must_use]
     pub fn nuisance_per_chain(&self) -> usize {
-        if self.richardson {
+        if self.stencil.richardson() {
             6
         } else {
             3
@@ -389,7 +428,7 @@ impl MomentumRows {
         self.f_last = f;
         self.count += 1;
         let prev = self.prev.replace(plain);
-        if !self.settings.richardson {
+        if !self.settings.stencil.richardson() {
             return Ok(Some(self.assemble(&plain.a, &plain.rhs, &plain.s, ANCHOR0)));
         }
         // Richardson: centre c = nodes[1], needs the previous interval.
@@ -409,7 +448,11 @@ impl MomentumRows {
             }
         }
         let h2 = node.t_s - cm1.t_s;
-        let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &(0.5 * (cm1.rho_nms + node.rho_nms)), h2);
+        let rho2 = match self.settings.stencil {
+            Stencil::Held => (cm1.rho_nms + b.rho_nms * 2.0 + node.rho_nms) * 0.25,
+            _ => (cm1.rho_nms + node.rho_nms) * 0.5,
+        };
+        let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &rho2, h2);
         let (w, v) = (2.0 / 3.0, 1.0 / 3.0);
         let a = (prev.a + plain.a) * w - m2.a * v;
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;

@@ -2,12 +2,12 @@
 //! pipeline, with the row model chosen from the data.
 //!
 //! Where a setting leaves a choice open (the rotation source when the telemetry has gyro
-//! rates, plain or Richardson rows), every candidate row model folds every sample, and each
-//! solve uses the candidate whose residual variance `ρ²/(rows − unknowns)` is smallest:
-//! the model that explains the data best. A noisier rotation source, or a model of `ρ`
-//! between samples that does not fit (Richardson rows on wheel commands held over each
-//! telemetry step, plain rows on commands that change between samples), leaves larger
-//! residuals. Only the chosen candidate is solved.
+//! rates; the Richardson stencil for smooth `ρ` or for `ρ` held over each step), every
+//! candidate row model folds every sample, and each solve uses the candidate whose
+//! residual variance `ρ²/(rows − unknowns)` is smallest: the model that explains the data
+//! best. A noisier rotation source, or a model of `ρ` between samples that does not fit
+//! (the smooth stencil on wheel commands held over each telemetry step, the held stencil
+//! on a continuous law), leaves larger residuals. Only the chosen candidate is solved.
 
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
@@ -17,7 +17,7 @@ use crate::estimator::discrete_momentum::{
     reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
 use crate::estimator::excitation::{diagnose, Excitation};
-use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource};
+use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource, Stencil};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
 use crate::estimator::uncertainty::{combine, noise_sigma};
@@ -54,22 +54,21 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
         None if has_gyro => &[RotationSource::Gyro, RotationSource::Attitude],
         None => &[RotationSource::Attitude],
     };
-    let richardson: &[bool] = match c.rho_model {
-        RhoModel::Held => &[false],
-        RhoModel::Smooth => &[true],
-        RhoModel::Auto => &[false, true],
+    let stencils: &[Stencil] = match c.rho_model {
+        RhoModel::Plain => &[Stencil::Plain],
+        RhoModel::Held => &[Stencil::Held],
+        RhoModel::Smooth => &[Stencil::Smooth],
+        RhoModel::Auto => &[Stencil::Smooth, Stencil::Held],
     };
     rotations
         .iter()
         .flat_map(|&rotation| {
-            richardson
-                .iter()
-                .map(move |&richardson| MomentumRowSettings {
-                    rotation,
-                    richardson,
-                    torque_bias: c.torque_bias,
-                    max_chain_s: c.max_chain_s,
-                })
+            stencils.iter().map(move |&stencil| MomentumRowSettings {
+                rotation,
+                stencil,
+                torque_bias: c.torque_bias,
+                max_chain_s: c.max_chain_s,
+            })
         })
         .collect()
 }

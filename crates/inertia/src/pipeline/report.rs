@@ -216,7 +216,7 @@ impl fmt::Display for Report {
             self.t
         )?;
         if let Some(m) = &self.row_model {
-            writeln!(s, "rows: {}", m.describe())?;
+            writeln!(s, "rows: {m}")?;
         }
         writeln!(s, "status: {}", self.observability)?;
         let (Some(m), Some(j)) = (self.inertia, self.j) else {
