@@ -57,6 +57,24 @@ impl AugmentedQr {
         }
     }
 
+    /// Fold another state's rows into this one: afterwards this is the state of both sets
+    /// of rows (their unknowns identified column by column).
+    pub fn merge(&mut self, other: &AugmentedQr) {
+        for i in 0..UNKNOWNS {
+            let a: SVector<f64, UNKNOWNS> = other.r.row(i).transpose();
+            if a.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let left = fold_row(&mut self.r, &a, Some((&mut self.z, other.z[i])));
+            self.rss += left * left;
+        }
+        self.rss += other.rss;
+        self.y_energy += other.y_energy;
+        self.rows += other.rows;
+        self.weight += other.weight;
+        self.nuisance += other.nuisance;
+    }
+
     /// Count `n` more nuisance unknowns (a new chain's initial momenta).
     pub fn add_nuisance(&mut self, n: usize) {
         self.nuisance += n as f64;
@@ -88,6 +106,12 @@ impl AugmentedQr {
     #[must_use]
     pub fn rows(&self) -> usize {
         self.rows
+    }
+
+    /// Row weight folded in (rows, discounted by forgetting).
+    #[must_use]
+    pub fn weight(&self) -> f64 {
+        self.weight
     }
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.

@@ -9,6 +9,7 @@
 //!   the shared unknowns: an independent code path that must agree with the recursive one.
 
 use super::augmented_qr::AugmentedQr;
+use super::jackknife::ChainGroups;
 use super::momentum_rows::{AugmentedRow, MomentumRowSettings, MomentumRows};
 use super::qr::RecursiveQr;
 use super::recursive::{estimate_from, RecursiveSettings};
@@ -48,6 +49,7 @@ impl MomentumEstimatorSettings {
 pub struct DiscreteMomentumEstimator<B: Backend> {
     source: MomentumRows,
     qr: AugmentedQr,
+    groups: ChainGroups,
     svd: SvdTracker,
     sv: Vector6<f64>,
     reduced: RecursiveQr,
@@ -73,6 +75,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         Ok(Self {
             source: MomentumRows::new(*r),
             qr: AugmentedQr::new(r.shared_nuisance() + r.nuisance_per_chain()),
+            groups: ChainGroups::default(),
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
             reduced: RecursiveQr::new(),
@@ -109,12 +112,16 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             self.qr.eliminate_anchors();
             self.qr
                 .add_nuisance(self.settings.rows.nuisance_per_chain());
+            self.groups.end_chain();
         }
         if let (Some(m), Some(t0)) = (self.settings.recursive.memory_s, self.last_block_t_s) {
-            self.qr.scale(libm::exp(-(t_s - t0) / m));
+            let lambda = libm::exp(-(t_s - t0) / m);
+            self.qr.scale(lambda);
+            self.groups.scale(lambda);
         }
         self.last_block_t_s = Some(t_s);
         self.qr.add(row);
+        self.groups.add(row);
         self.since_solve += 1;
     }
 
@@ -152,6 +159,22 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {
         super::uncertainty::noise_sigma(&self.reduced, &self.sv, self.svd.v())
+    }
+
+    /// The delete-a-group jackknife σ per element over the completed chains
+    /// ([`super::jackknife`]), kg m²; `None` with too few chains.
+    pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
+        self.groups.sigma()
+    }
+
+    /// The noise σ per element: the larger of the least-squares and the jackknife σ
+    /// ([`super::jackknife`]), kg m².
+    pub fn robust_noise_sigma(&mut self) -> Option<[f64; 6]> {
+        let ls = self.noise_sigma()?;
+        Some(super::jackknife::robust_sigma(
+            &ls,
+            self.groups.sigma().as_ref(),
+        ))
     }
 
     /// The reduced least-squares state in `j` at the last solve.
@@ -202,14 +225,29 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 }
 
+/// The batch reduction: the reduced problem in `j` and what goes with it.
+#[cfg(feature = "std")]
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchReduction {
+    /// The reduced least-squares state in `j`.
+    pub qr: RecursiveQr,
+    /// Gaps in the time stamps.
+    pub gaps: usize,
+    /// The delete-a-group jackknife σ per element over the chains
+    /// ([`super::jackknife`]), kg m²; `None` with too few chains.
+    pub jackknife_sigma_kg_m2: Option<[f64; 6]>,
+}
+
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
 /// chain over `[X₀ X₁ τ_b j]`, keeping the rows free of the chain's initial momenta, then
-/// once over the stacked `[τ_b j]` rows of every chain.
+/// once over the stacked `[τ_b j]` rows of every chain (and, for the jackknife, of every
+/// chain but one group's).
 #[cfg(feature = "std")]
 pub fn reduce_batch(
     samples: &[Sample],
     settings: &MomentumRowSettings,
-) -> Result<(RecursiveQr, usize), EstimatorError> {
+) -> Result<BatchReduction, EstimatorError> {
+    use super::jackknife::{jackknife_sigma, GROUPS};
     use super::momentum_rows::{J, TORQUE, UNKNOWNS};
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
@@ -236,6 +274,7 @@ pub fn reduce_batch(
             }
         }
     }
+    chains.retain(|c| !c.is_empty());
     // Householder QR of an m×n system (zero-padded to at least n rows): (R, Qᵀy, ‖y‖²).
     let factor = |a: DMatrix<f64>, y: DVector<f64>| {
         let (m, n) = a.shape();
@@ -258,11 +297,11 @@ pub fn reduce_batch(
             J..UNKNOWNS
         })
         .collect();
-    let mut stacked_a: Vec<f64> = Vec::new();
-    let mut stacked_y: Vec<f64> = Vec::new();
+    // Per chain: its rows free of its initial momenta, in the shared unknowns.
+    let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
     let mut nuisance = settings.shared_nuisance() as f64;
-    for chain in chains.iter().filter(|c| !c.is_empty()) {
+    for chain in &chains {
         nuisance += anchors as f64;
         let m = 3 * chain.len();
         let a = DMatrix::from_fn(m, columns.len(), |i, k| chain[i / 3].a[(i % 3, columns[k])]);
@@ -271,29 +310,46 @@ pub fn reduce_batch(
         let (r, qty, energy) = factor(a, y);
         y_energy += energy;
         rss += (energy - qty.norm_squared()).max(0.0);
+        let mut block = (Vec::new(), Vec::new());
         for i in anchors..columns.len() {
-            stacked_a.extend((anchors..columns.len()).map(|k| r[(i, k)]));
-            stacked_y.push(qty[i]);
+            block.0.extend((anchors..columns.len()).map(|k| r[(i, k)]));
+            block.1.push(qty[i]);
         }
+        blocks.push(block);
     }
-    let m = stacked_y.len();
-    let a = DMatrix::from_row_slice(m, shared, &stacked_a);
-    let y = DVector::from_vec(stacked_y);
-    let (r, qty, energy) = factor(a, y);
-    rss += (energy - qty.norm_squared()).max(0.0);
-    let off = shared - 6;
-    let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
-    let mut z = Vector6::from_fn(|i, _| qty[off + i]);
-    for i in 0..6 {
-        if rr[(i, i)] < 0.0 {
-            for k in 0..6 {
-                rr[(i, k)] = -rr[(i, k)];
+    // The stacked shared rows of the chains `keep` selects: (R, z, rss) in j.
+    let solve_shared = |keep: &dyn Fn(usize) -> bool| {
+        let (mut a, mut y) = (Vec::new(), Vec::new());
+        for (_, block) in blocks.iter().enumerate().filter(|(c, _)| keep(*c)) {
+            a.extend_from_slice(&block.0);
+            y.extend_from_slice(&block.1);
+        }
+        let m = y.len();
+        let (r, qty, energy) = factor(DMatrix::from_row_slice(m, shared, &a), DVector::from_vec(y));
+        let off = shared - 6;
+        let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
+        let mut z = Vector6::from_fn(|i, _| qty[off + i]);
+        for i in 0..6 {
+            if rr[(i, i)] < 0.0 {
+                for k in 0..6 {
+                    rr[(i, k)] = -rr[(i, k)];
+                }
+                z[i] = -z[i];
             }
-            z[i] = -z[i];
         }
-    }
-    Ok((
-        RecursiveQr {
+        (rr, z, (energy - qty.norm_squared()).max(0.0))
+    };
+    let (rr, z, shared_rss) = solve_shared(&|_| true);
+    rss += shared_rss;
+    let used = chains.len().min(GROUPS);
+    let estimates: Option<Vec<_>> = (0..used)
+        .map(|g| {
+            let (r, z, _) = solve_shared(&|c| c % GROUPS != g);
+            crate::solver::unconstrained_minimiser(&r, &z)
+        })
+        .collect();
+    Ok(BatchReduction {
+        qr: RecursiveQr {
             r: rr,
             z,
             rss,
@@ -303,6 +359,7 @@ pub fn reduce_batch(
             noise_s: 0.0,
             nuisance,
         },
-        source.gaps(),
-    ))
+        gaps: source.gaps(),
+        jackknife_sigma_kg_m2: estimates.as_deref().and_then(jackknife_sigma),
+    })
 }

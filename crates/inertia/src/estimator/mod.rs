@@ -19,6 +19,7 @@ pub mod compensation;
 pub mod discrete_momentum;
 #[cfg(feature = "std")]
 pub mod excitation;
+pub mod jackknife;
 pub mod momentum;
 pub mod momentum_rows;
 pub mod observability;

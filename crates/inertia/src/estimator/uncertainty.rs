@@ -80,6 +80,14 @@ pub fn combine(
 ) -> Uncertainty {
     let bias: [f64; 6] =
         core::array::from_fn(|k| j_half.map_or(0.0, |h| crate::math::abs(j_full[k] - h[k]) / 3.0));
+    with_bias(noise, &bias, j_full)
+}
+
+/// Combine a noise part and a bias part per element, `σ = √(noise² + bias²)`, and
+/// propagate to the principal moments of `j`.
+#[must_use]
+pub fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> Uncertainty {
+    let bias = *bias;
     let sigma: [f64; 6] =
         core::array::from_fn(|k| crate::math::sqrt(noise[k] * noise[k] + bias[k] * bias[k]));
     let eig = crate::eigen3::symmetric_eigen3(&matrix_from_j(j_full));

@@ -14,16 +14,17 @@ use super::settings::PipelineConfig;
 use super::PipelineError;
 use crate::estimator::audit::audit;
 use crate::estimator::discrete_momentum::{
-    reduce_batch, DiscreteMomentumEstimator, MomentumEstimatorSettings,
+    reduce_batch, BatchReduction, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
 use crate::estimator::excitation::{diagnose, Excitation};
+use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource, Stencil};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
-use crate::estimator::uncertainty::{combine, noise_sigma};
+use crate::estimator::uncertainty::{noise_sigma, with_bias};
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::sample::Sample;
-use crate::solver::Backend;
+use crate::solver::{unconstrained_minimiser, Backend};
 use nalgebra::Vector3;
 use std::boxed::Box;
 use std::vec::Vec;
@@ -83,6 +84,49 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
             gyro_noise_rad_s_rthz: None,
         },
     }
+}
+
+/// Residual variances within this factor of the smallest: the data do not tell the row
+/// models apart.
+pub(crate) const AMBIGUOUS_RATIO: f64 = 2.0;
+
+/// Residual variance of a reduced state, `∞` without residual degrees of freedom.
+fn variance(qr: &RecursiveQr) -> f64 {
+    let dof = qr.residual_dof();
+    if dof > 0.0 {
+        qr.rss / dof
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The model-uncertainty part of σ: per element, the largest difference between the
+/// chosen candidate's unconstrained `ĵ` and that of any candidate whose residual variance
+/// is within [`AMBIGUOUS_RATIO`] of the chosen one's. When two models of the wheels (or
+/// two rotation sources) fit the data about equally well, neither is known to be right,
+/// and the answer is uncertain by at least their difference; a bias common to every
+/// chain (wheel commands held between samples, which neither stencil models) shows up
+/// there and not in the noise σ. Zero when the chosen model fits clearly best.
+fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
+    let mut out = [0.0; 6];
+    let Some(best) = states.get(chosen) else {
+        return out;
+    };
+    let v_best = variance(best);
+    let Some(j_best) = unconstrained_minimiser(&best.r, &best.z) else {
+        return out;
+    };
+    for (i, qr) in states.iter().enumerate() {
+        if i == chosen || !(variance(qr) <= AMBIGUOUS_RATIO * v_best) {
+            continue;
+        }
+        if let Some(j) = unconstrained_minimiser(&qr.r, &qr.z) {
+            for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
+                *o = o.max((a - b).abs());
+            }
+        }
+    }
+    out
 }
 
 /// Index of the smallest residual variance (the first on ties; `0` when none is finite).
@@ -158,11 +202,18 @@ impl Estimator for DiscreteMomentum {
         }
         self.since_solve = 0;
         let mut e = c.solve_now(s.t_s)?;
+        let noise = c.robust_noise_sigma();
         if self.config.uncertainty {
-            if let (Some(j), Some(noise)) = (e.j(), c.noise_sigma()) {
-                e.uncertainty = Some(combine(&noise, &j, None));
+            if let (Some(j), Some(noise)) = (e.j(), noise) {
+                let states: Vec<RecursiveQr> =
+                    self.candidates.iter().map(|c| c.qr().reduced()).collect();
+                let bias = model_spread(&states, self.chosen);
+                e.uncertainty = Some(with_bias(&noise, &bias, &j));
             }
         }
+        let Some(c) = self.candidates.get(self.chosen) else {
+            return Ok(Some(e));
+        };
         audit(
             &mut e,
             c.reduced(),
@@ -199,25 +250,17 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         source,
     };
     let has_gyro = samples.first().is_some_and(|s| s.omega_rad_s.is_some());
-    let mut reduced: Vec<(MomentumRowSettings, RecursiveQr, usize)> = Vec::new();
+    let mut reduced: Vec<(MomentumRowSettings, BatchReduction)> = Vec::new();
     for rows in candidates(c, has_gyro) {
-        let (qr, gaps) = reduce_batch(samples, &rows).map_err(wrap)?;
-        reduced.push((rows, qr, gaps));
+        reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
-    let variance = |qr: &RecursiveQr| {
-        let dof = qr.residual_dof();
-        if dof > 0.0 {
-            qr.rss / dof
-        } else {
-            f64::INFINITY
-        }
-    };
-    let chosen = best(reduced.iter().map(|(_, qr, _)| variance(qr)));
-    let Some((rows, qr, gaps)) = reduced.get(chosen) else {
+    let chosen = best(reduced.iter().map(|(_, b)| variance(&b.qr)));
+    let Some((rows, batch)) = reduced.get(chosen) else {
         return Err(PipelineError::NoBatch {
             estimator: DISCRETE_MOMENTUM.name,
         });
     };
+    let qr = &batch.qr;
     let mut backend = registry::build_backend(c.backend);
     let mut estimate = batch::solve_reduced(
         qr,
@@ -232,8 +275,11 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         let svd = qr.r.svd(false, true);
         if let (Some(j), Some(v_t)) = (estimate.j(), svd.v_t) {
             let sv = svd.singular_values;
-            if let Some(noise) = noise_sigma(qr, &sv, &v_t.transpose()) {
-                estimate.uncertainty = Some(combine(&noise, &j, None));
+            if let Some(ls) = noise_sigma(qr, &sv, &v_t.transpose()) {
+                let noise = robust_sigma(&ls, batch.jackknife_sigma_kg_m2.as_ref());
+                let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
+                let bias = model_spread(&states, chosen);
+                estimate.uncertainty = Some(with_bias(&noise, &bias, &j));
             }
         }
     }
@@ -246,7 +292,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     Ok(BatchOutput {
         estimate,
         excitation: Some(diagnose(qr, &c.observability)),
-        gaps: *gaps,
+        gaps: batch.gaps,
         row_model: Some(*rows),
     })
 }
