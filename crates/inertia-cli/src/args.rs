@@ -283,8 +283,9 @@ pub struct InputArgs {
 pub struct EstimateArgs {
     /// Telemetry CSV file (see README: t, q_x..q_w, rho_x..rho_z, optional tau_*, w_*).
     pub file: PathBuf,
-    /// Estimator.
-    #[arg(long, default_value = "variational", value_parser = registered(inertia::pipeline::registry::ESTIMATORS.iter().map(|e| (e.name, e.summary))))]
+    /// Estimator (default: the discrete momentum estimator, the most accurate in the
+    /// README's Monte Carlo matrix; `variational` is the paper's).
+    #[arg(long, default_value = "discrete-momentum", value_parser = registered(inertia::pipeline::registry::ESTIMATORS.iter().map(|e| (e.name, e.summary))))]
     pub estimator: String,
     /// One batch solve over all samples instead of the recursive estimator.
     #[arg(long)]

@@ -59,12 +59,13 @@ impl Panel {
 }
 
 /// A palette that stays readable in print.
-pub const COLORS: [RGBColor; 5] = [
+pub const COLORS: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(255, 127, 14),
+    RGBColor(0, 0, 0),
 ];
 
 /// Write `stem.png` and `stem.svg`: panels stacked vertically, sharing the x label.

@@ -32,7 +32,16 @@ struct Case {
     constraint_note: &'static str,
 }
 
-/// The variational estimator's 3σ envelope for element `k`, normalised like the errors.
+/// The runs whose 3σ envelopes are drawn: the paper's estimator (first) and the discrete
+/// momentum estimator.
+fn enveloped(case: &Case) -> impl Iterator<Item = (usize, &Run)> {
+    case.runs
+        .iter()
+        .enumerate()
+        .filter(|(n, r)| *n == 0 || r.file == "discrete_momentum")
+}
+
+/// The 3σ envelopes for element `k` ([`enveloped`]), normalised like the errors.
 fn sigma_series(case: &Case, k: usize, truth: &Matrix3<f64>) -> Vec<Series> {
     let (r, c) = inertia::tensor::COMPONENT_INDEX[k];
     let scale = if r == c {
@@ -40,22 +49,24 @@ fn sigma_series(case: &Case, k: usize, truth: &Matrix3<f64>) -> Vec<Series> {
     } else {
         (truth[(r, r)] * truth[(c, c)]).sqrt()
     };
-    vec![Series {
-        name: format!("{}: 3σ", case.runs[0].label),
-        points: case.runs[0]
-            .history
-            .iter()
-            .map(|h| {
-                (
-                    h.t_s,
-                    h.uncertainty
-                        .map_or(f64::NAN, |u| 3.0 * u.sigma_kg_m2[k] / scale),
-                )
-            })
-            .collect(),
-        color: COLORS[0],
-        width: 1,
-    }]
+    enveloped(case)
+        .map(|(n, run)| Series {
+            name: format!("{}: 3σ", run.label),
+            points: run
+                .history
+                .iter()
+                .map(|h| {
+                    (
+                        h.t_s,
+                        h.uncertainty
+                            .map_or(f64::NAN, |u| 3.0 * u.sigma_kg_m2[k] / scale),
+                    )
+                })
+                .collect(),
+            color: COLORS[n % COLORS.len()],
+            width: 1,
+        })
+        .collect()
 }
 
 /// One series per estimator run, plotting `metric` of each history row.
@@ -68,14 +79,14 @@ fn run_series(case: &Case, metric: impl Fn(&Estimate) -> f64) -> Vec<Series> {
             name: r.label.into(),
             points: r.history.iter().map(|h| (h.t_s, metric(h))).collect(),
             color,
-            width: main_width(n),
+            width: main_width(n, r),
         })
         .collect()
 }
 
-/// The paper's estimator (first) drawn thicker than the others.
-fn main_width(n: usize) -> u32 {
-    if n == 0 {
+/// The paper's estimator (first) and `estimate`'s default drawn thicker than the others.
+fn main_width(n: usize, run: &Run) -> u32 {
+    if n == 0 || run.file == "discrete_momentum" {
         3
     } else {
         2
@@ -168,24 +179,26 @@ fn error_figures(dir: &Path, case: &Case, first_fig: usize) -> Result<(), CliErr
     };
     // Total error.
     let series = run_series(case, |h| total_error(h, truth));
-    // The variational estimator's 3σ envelope: ‖ΔJ‖_F has variance Σ_diag σ² + 2 Σ_off σ².
+    // The 3σ envelopes: ‖ΔJ‖_F has variance Σ_diag σ² + 2 Σ_off σ².
     let jt_norm = truth.norm();
     let mut series = series;
-    series.push(Series {
-        name: format!("{}: 3σ", case.runs[0].label),
-        points: case.runs[0]
-            .history
-            .iter()
-            .map(|h| {
-                let v = h
-                    .uncertainty
-                    .map_or(f64::NAN, |u| u.frobenius_sigma_kg_m2());
-                (h.t_s, 3.0 * v / jt_norm)
-            })
-            .collect(),
-        color: COLORS[0],
-        width: 1,
-    });
+    for (n, run) in enveloped(case) {
+        series.push(Series {
+            name: format!("{}: 3σ", run.label),
+            points: run
+                .history
+                .iter()
+                .map(|h| {
+                    let v = h
+                        .uncertainty
+                        .map_or(f64::NAN, |u| u.frobenius_sigma_kg_m2());
+                    (h.t_s, 3.0 * v / jt_norm)
+                })
+                .collect(),
+            color: COLORS[n % COLORS.len()],
+            width: 1,
+        });
+    }
     let stem = format!("fig{:02}_{name}_total_error", first_fig);
     plot::figure(
         &dir.join(&stem),

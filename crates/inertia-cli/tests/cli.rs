@@ -62,17 +62,26 @@ fn simulate_then_estimate_recovers_j_true() {
         assert_eq!(v["j"].as_array().unwrap().len(), 6);
         assert_eq!(v["principal_moments"].as_array().unwrap().len(), 3);
     }
-    // The readable report.
+    // The readable report (J ⪰ εI: the paper's J lies just outside Σ ⪰ 0).
     let o = inertia(&[
         "estimate",
         csv.to_str().unwrap(),
         "--truth",
         truth.to_str().unwrap(),
+        "--constraints",
+        "positive-definite",
     ]);
     let text = stdout(&o);
     assert!(text.contains("J [kg m²] ="), "{text}");
     assert!(text.contains("principal moments"));
-    assert!(text.contains("status: determined"));
+    assert!(text.contains("status: determined"), "{text}");
+    // With the default physical set the default estimator is precise enough to see that
+    // the paper's J is not physically consistent, and says so instead of "determined".
+    let conflict = stdout(&inertia(&["estimate", csv.to_str().unwrap()]));
+    assert!(
+        conflict.contains("the data contradict the constraint set"),
+        "{conflict}"
+    );
     assert!(text.contains("relative Frobenius error vs truth"));
     // Batch agrees with recursive.
     let o = inertia(&["estimate", csv.to_str().unwrap(), "--batch", "--json"]);
@@ -540,7 +549,14 @@ fn jitter_gaps_and_iso_time_stamps() {
         std::fs::write(&p, s).unwrap();
         p
     };
-    let base = json(&inertia(&["estimate", csv.to_str().unwrap(), "--json"]));
+    let pd = ["--constraints", "positive-definite"];
+    let base = json(&inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--json",
+        pd[0],
+        pd[1],
+    ]));
     // Drop samples irregularly (steps of 0.1, 0.2 s) and one 10 s stretch (a gap).
     let jittered = write(
         "jit.csv",
@@ -551,6 +567,8 @@ fn jitter_gaps_and_iso_time_stamps() {
         "estimate",
         jittered.to_str().unwrap(),
         "--json",
+        pd[0],
+        pd[1],
     ]));
     assert_eq!(v["gaps"].as_u64().unwrap(), 1, "{v}");
     assert!((v["max_step_s"].as_f64().unwrap() - 10.1).abs() < 1e-6);
@@ -566,6 +584,8 @@ fn jitter_gaps_and_iso_time_stamps() {
         "--resample",
         "0.1",
         "--json",
+        pd[0],
+        pd[1],
     ]));
     assert_eq!(v["status"], "determined", "{v}");
     for k in 0..6 {
@@ -586,7 +606,13 @@ fn jitter_gaps_and_iso_time_stamps() {
             tenths % 10
         )
     });
-    let v = json(&inertia(&["estimate", iso.to_str().unwrap(), "--json"]));
+    let v = json(&inertia(&[
+        "estimate",
+        iso.to_str().unwrap(),
+        "--json",
+        pd[0],
+        pd[1],
+    ]));
     for k in 0..6 {
         let (x, y) = (v["j"][k].as_f64().unwrap(), base["j"][k].as_f64().unwrap());
         assert!((x - y).abs() < 1e-9 * (1.0 + y.abs()), "{k}: {x} vs {y}");

@@ -424,6 +424,15 @@ mod status {
                 },
                 "--scalar-first",
             ),
+            (
+                // A scalar-last file read with --scalar-first: (w, x, y, z) := (x, y, z, w).
+                "scalar last read as scalar first",
+                |q: &Quaternion| {
+                    let [x, y, z, w] = q.to_xyzw();
+                    Quaternion::from_wxyz([x, y, z, w])
+                },
+                "drop --scalar-first",
+            ),
         ] {
             let bad: Vec<Sample> = good.iter().map(|s| Sample { q: f(&s.q), ..*s }).collect();
             for estimator in ["discrete-momentum", "variational"] {

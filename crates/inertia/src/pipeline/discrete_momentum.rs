@@ -86,10 +86,6 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
     }
 }
 
-/// Residual variances within this factor of the smallest: the data do not tell the row
-/// models apart.
-pub(crate) const AMBIGUOUS_RATIO: f64 = 2.0;
-
 /// Residual variance of a reduced state, `∞` without residual degrees of freedom.
 fn variance(qr: &RecursiveQr) -> f64 {
     let dof = qr.residual_dof();
@@ -101,23 +97,29 @@ fn variance(qr: &RecursiveQr) -> f64 {
 }
 
 /// The model-uncertainty part of σ: per element, the largest difference between the
-/// chosen candidate's unconstrained `ĵ` and that of any candidate whose residual variance
-/// is within [`AMBIGUOUS_RATIO`] of the chosen one's. When two models of the wheels (or
-/// two rotation sources) fit the data about equally well, neither is known to be right,
-/// and the answer is uncertain by at least their difference; a bias common to every
-/// chain (wheel commands held between samples, which neither stencil models) shows up
-/// there and not in the noise σ. Zero when the chosen model fits clearly best.
+/// chosen candidate's unconstrained `ĵ` and that of any candidate the data cannot tell
+/// apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen one's, with `ν`
+/// the chosen one's residual degrees of freedom (three standard deviations of the ratio
+/// of two variance estimates with ν degrees of freedom each). When two models of the
+/// wheels, or two rotation sources, fit the data equally well, neither is known to be
+/// right, and the answer is uncertain by at least their difference. Zero when the chosen
+/// model fits significantly best.
 fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
     let mut out = [0.0; 6];
     let Some(best) = states.get(chosen) else {
         return out;
     };
     let v_best = variance(best);
+    let dof = best.residual_dof();
+    if !(dof > 0.0) {
+        return out;
+    }
+    let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
     let Some(j_best) = unconstrained_minimiser(&best.r, &best.z) else {
         return out;
     };
     for (i, qr) in states.iter().enumerate() {
-        if i == chosen || !(variance(qr) <= AMBIGUOUS_RATIO * v_best) {
+        if i == chosen || !(variance(qr) <= ratio * v_best) {
             continue;
         }
         if let Some(j) = unconstrained_minimiser(&qr.r, &qr.z) {

@@ -32,16 +32,23 @@ pub enum Reading {
     ScalarFirst,
     /// Both, fixed by `--scalar-first --jpl`.
     ScalarFirstConjugated,
+    /// The columns are scalar last but were read as scalar first (`--scalar-first` given
+    /// for a scalar-last file), fixed by dropping `--scalar-first`.
+    ScalarLast,
+    /// The same, conjugated: fixed by dropping `--scalar-first` and giving `--jpl`.
+    ScalarLastConjugated,
     /// The gyro rates have the opposite sign.
     GyroNegated,
 }
 
 impl Reading {
-    const ALL: [Reading; 5] = [
+    const ALL: [Reading; 7] = [
         Reading::AsRead,
         Reading::Conjugated,
         Reading::ScalarFirst,
         Reading::ScalarFirstConjugated,
+        Reading::ScalarLast,
+        Reading::ScalarLastConjugated,
         Reading::GyroNegated,
     ];
 
@@ -59,6 +66,12 @@ impl Reading {
             Reading::ScalarFirstConjugated => {
                 "the quaternions look scalar first and conjugated: use --scalar-first --jpl"
             }
+            Reading::ScalarLast => {
+                "the quaternion columns look scalar last ([x, y, z, w]) but were read as scalar first: drop --scalar-first"
+            }
+            Reading::ScalarLastConjugated => {
+                "the quaternions look scalar last and conjugated: drop --scalar-first and use --jpl"
+            }
             Reading::GyroNegated => {
                 "the gyro rates look negated relative to the attitude: check the sign of w_x, w_y, w_z"
             }
@@ -66,15 +79,24 @@ impl Reading {
     }
 
     fn apply(&self, q: &Quaternion) -> Quaternion {
+        // Scalar-first columns read as scalar last: the true (w, x, y, z) is the read
+        // (x, y, z, w). Scalar-last columns read as scalar first: the read (x, y, z, w) is
+        // the true (y, z, w, x), so the true (w, x, y, z) is the read (z, w, x, y).
         let sf = |q: &Quaternion| {
             let [x, y, z, w] = q.to_xyzw();
             Quaternion::from_wxyz([x, y, z, w])
+        };
+        let sl = |q: &Quaternion| {
+            let [x, y, z, w] = q.to_xyzw();
+            Quaternion::from_wxyz([z, w, x, y])
         };
         match self {
             Reading::AsRead | Reading::GyroNegated => *q,
             Reading::Conjugated => q.conjugate(),
             Reading::ScalarFirst => sf(q),
             Reading::ScalarFirstConjugated => sf(q).conjugate(),
+            Reading::ScalarLast => sl(q),
+            Reading::ScalarLastConjugated => sl(q).conjugate(),
         }
     }
 }
@@ -103,7 +125,7 @@ pub enum Verdict {
 #[derive(Debug, Clone)]
 pub struct ConventionCheck {
     prev: Option<Sample>,
-    mismatch: [[f64; STEPS_NEEDED]; 5],
+    mismatch: [[f64; STEPS_NEEDED]; 7],
     steps: usize,
 }
 
@@ -111,7 +133,7 @@ impl Default for ConventionCheck {
     fn default() -> Self {
         Self {
             prev: None,
-            mismatch: [[0.0; STEPS_NEEDED]; 5],
+            mismatch: [[0.0; STEPS_NEEDED]; 7],
             steps: 0,
         }
     }
@@ -161,7 +183,7 @@ impl ConventionCheck {
         if self.steps < STEPS_NEEDED {
             return Verdict::Undecided;
         }
-        let medians: [f64; 5] = core::array::from_fn(|k| {
+        let medians: [f64; 7] = core::array::from_fn(|k| {
             let mut m = self.mismatch[k];
             m.sort_unstable_by(f64::total_cmp);
             m[STEPS_NEEDED / 2]
