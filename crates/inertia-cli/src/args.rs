@@ -245,7 +245,9 @@ pub enum RotationArg {
 /// Models of the wheel momentum between samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
 pub enum RhoModelArg {
-    /// Decided from the data (the rows with the smaller residual variance).
+    /// Estimated from the data: Richardson rows, O(h^4), with the wheel momentum's mean
+    /// over each step corrected by a curvature coefficient estimated with J (smooth
+    /// wheel laws, commands held over each step, or commands that change between samples).
     #[default]
     Auto,
     /// Smooth across two steps (a continuous law): Richardson rows, O(h^4).
@@ -325,8 +327,9 @@ pub struct EstimateArgs {
     #[arg(long, value_enum, value_name = "SOURCE")]
     pub rotation_source: Option<RotationArg>,
     /// What the wheel momentum does between samples (discrete-momentum estimator):
-    /// `smooth` (Richardson O(h⁴) rows), `held` (torque commands held over each telemetry
-    /// step, changing at the samples: plain rows), or `auto` (decided from the data).
+    /// `auto` (estimated with J: smooth laws, commands held over each step, or commands
+    /// that change between samples), `smooth`, `held` (torque commands held over each
+    /// telemetry step, changing at the samples), or `plain` (O(h²) one-step rows).
     #[arg(long, value_enum, default_value = "auto")]
     pub rho_model: RhoModelArg,
     /// Do not estimate an unknown constant disturbance torque (discrete-momentum

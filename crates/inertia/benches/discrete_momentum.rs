@@ -22,7 +22,7 @@ fn bench(c: &mut Criterion) {
     let start = 2000;
     let set = || ConstraintSet::positive_definite().validate().unwrap();
     let mut g = c.benchmark_group("per_sample_slew");
-    for stencil in [Stencil::Plain, Stencil::Smooth] {
+    for stencil in [Stencil::Plain, Stencil::Smooth, Stencil::Adaptive] {
         let mut e = DiscreteMomentumEstimator::new(
             MomentumEstimatorSettings {
                 rows: MomentumRowSettings {
@@ -43,10 +43,10 @@ fn bench(c: &mut Criterion) {
             e.push(s).unwrap();
         }
         let mut k = 0;
-        let name = if stencil.richardson() {
-            "discrete_momentum_richardson"
-        } else {
-            "discrete_momentum_plain"
+        let name = match stencil {
+            Stencil::Plain => "discrete_momentum_plain",
+            Stencil::Smooth | Stencil::Held => "discrete_momentum_richardson",
+            Stencil::Adaptive => "discrete_momentum_adaptive",
         };
         g.bench_function(name, |b| {
             b.iter_batched_ref(

@@ -258,7 +258,12 @@ fn recursive_and_batch_agree_with_gaps_and_chains() {
     // A one-minute gap in the middle.
     let mut samples = run.samples.clone();
     samples.retain(|s| !(50.0..110.0).contains(&s.t_s));
-    for stencil in [Stencil::Plain, Stencil::Smooth, Stencil::Held] {
+    for stencil in [
+        Stencil::Plain,
+        Stencil::Smooth,
+        Stencil::Held,
+        Stencil::Adaptive,
+    ] {
         for max_chain_s in [None, Some(20.0)] {
             let rows = MomentumRowSettings {
                 stencil,
@@ -336,18 +341,29 @@ fn gyro_rotation_needs_gyro_rates() {
 }
 
 #[test]
-fn each_richardson_stencil_is_exact_for_its_wheel_model_and_the_pipeline_picks_it() {
-    // Truth attitude, no gyro noise, no disturbance: what is left is discretisation.
-    // Commands held over each 0.1 s step make ρ piecewise linear with kinks at the
-    // samples; the continuous controller makes it smooth.
-    for held in [false, true] {
+fn each_stencil_is_exact_for_its_wheel_model_and_the_adaptive_one_for_all() {
+    // Truth attitude, no gyro noise, no disturbance: what is left is discretisation and
+    // the model of ρ between samples. The continuous controller makes ρ smooth; commands
+    // held over each 0.1 s step make it piecewise linear with kinks at the samples;
+    // commands that change mid-way between samples put the kinks inside the steps.
+    for (name, commands) in [
+        ("continuous", None),
+        ("held, aligned", Some(CommandHold::at(10.0))),
+        (
+            "held, mid-way",
+            Some(CommandHold {
+                phase_s: 0.05,
+                ..CommandHold::at(10.0)
+            }),
+        ),
+    ] {
         let run = Scenario::slew()
             .simulate(&Common {
                 gyro_noise_deg_s_rthz: 0.0,
                 disturbance_nm_rthz: 0.0,
                 realism: Realism {
                     attitude: AttitudeSource::Truth,
-                    commands: held.then(|| CommandHold::at(10.0)),
+                    commands,
                     ..Default::default()
                 },
                 ..Common::paper()
@@ -360,21 +376,28 @@ fn each_richardson_stencil_is_exact_for_its_wheel_model_and_the_pipeline_picks_i
             };
             final_error(&run.samples, rows, &run.inertia_kg_m2)
         };
-        let (smooth, held_rows, plain) = (
-            error(Stencil::Smooth),
-            error(Stencil::Held),
-            error(Stencil::Plain),
+        let [smooth, held, adaptive, plain] = [
+            Stencil::Smooth,
+            Stencil::Held,
+            Stencil::Adaptive,
+            Stencil::Plain,
+        ]
+        .map(error);
+        eprintln!(
+            "{name}: smooth {smooth:.2e}, held {held:.2e}, adaptive {adaptive:.2e}, plain {plain:.2e}"
         );
-        eprintln!("held {held}: smooth {smooth:.2e}, held {held_rows:.2e}, plain {plain:.2e}");
-        let (right, wrong) = if held {
-            (held_rows, smooth)
-        } else {
-            (smooth, held_rows)
-        };
+        let fixed_best = smooth.min(held);
+        match name {
+            "continuous" => assert!(smooth < 1e-7 && held > 20.0 * smooth, "{name}"),
+            "held, aligned" => assert!(held < 1e-7 && smooth > 20.0 * held, "{name}"),
+            _ => assert!(fixed_best > 1e-6, "{name}: no fixed stencil fits"),
+        }
         assert!(
-            right < 1e-7 && wrong > 20.0 * right && plain > 20.0 * right,
-            "held {held}: smooth {smooth:e}, held {held_rows:e}, plain {plain:e}"
+            adaptive < 1e-9 && plain > 1000.0 * adaptive,
+            "{name}: adaptive {adaptive:e}"
         );
+        assert!(adaptive < 3.0 * fixed_best, "{name}");
+        // The pipeline's default is the adaptive stencil.
         let mut p = inertia::pipeline::Pipeline::new(&inertia::pipeline::PipelineSettings {
             estimator: "discrete-momentum".into(),
             constraints: ConstraintSet::positive_definite(),
@@ -384,12 +407,7 @@ fn each_richardson_stencil_is_exact_for_its_wheel_model_and_the_pipeline_picks_i
         for s in &run.samples {
             p.push(s).expect("push");
         }
-        let chosen = p.row_model().expect("row model").stencil;
-        assert_eq!(
-            chosen,
-            if held { Stencil::Held } else { Stencil::Smooth },
-            "held {held}"
-        );
+        assert_eq!(p.row_model().expect("row model").stencil, Stencil::Adaptive);
     }
 }
 

@@ -248,7 +248,7 @@ pub fn reduce_batch(
     settings: &MomentumRowSettings,
 ) -> Result<BatchReduction, EstimatorError> {
     use super::jackknife::{jackknife_sigma, GROUPS};
-    use super::momentum_rows::{J, TORQUE, UNKNOWNS};
+    use super::momentum_rows::{Stencil, J, KAPPA, TORQUE};
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
         return Err(EstimatorError::TooFewSamples {
@@ -292,10 +292,16 @@ pub fn reduce_batch(
     let shared = settings.shared_nuisance() + 6;
     let columns: Vec<usize> = (0..anchors)
         .chain(if settings.torque_bias {
-            TORQUE..UNKNOWNS
+            TORQUE..KAPPA
         } else {
-            J..UNKNOWNS
+            0..0
         })
+        .chain(if settings.stencil == Stencil::Adaptive {
+            KAPPA..J
+        } else {
+            0..0
+        })
+        .chain(J..J + 6)
         .collect();
     // Per chain: its rows free of its initial momenta, in the shared unknowns.
     let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();

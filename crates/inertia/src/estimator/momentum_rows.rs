@@ -3,10 +3,11 @@
 //!
 //! # Unknowns
 //!
-//! `x = [X₀; X₁; τ_b; j]` ([`UNKNOWNS`] = 15): two 3-vectors of initial momentum
+//! `x = [X₀; X₁; τ_b; κ; j]` ([`UNKNOWNS`] = 16): two 3-vectors of initial momentum
 //! (the plain rows use only `X₀ = L̄₀`), the constant body-frame disturbance torque `τ_b`
-//! (columns zero when [`MomentumRowSettings::torque_bias`] is off) and `j` last, so that
-//! the trailing 6×6 block of a QR factor is the reduced problem in `j` alone.
+//! (columns zero when [`MomentumRowSettings::torque_bias`] is off), the scalar `κ` of
+//! [`Stencil::Adaptive`] (zero column otherwise) and `j` last, so that the trailing 6×6
+//! block of a QR factor is the reduced problem in `j` alone.
 //!
 //! # Plain rows
 //!
@@ -27,8 +28,11 @@
 //!
 //! whose O(h²) bias cancels (the bias is even in h). Each parity p of `c−1` has its own
 //! subgrid and so its own initial momentum: the row's constant is
-//! `X_p = (4/3) L̄₀ − (1/3) L̄₀^{2h,p}`. It assumes `ρ` is smooth across the stencil; with
-//! commands held over each telemetry step the plain rows are the better model.
+//! `X_p = (4/3) L̄₀ − (1/3) L̄₀^{2h,p}`. What `ρ̄` of the double step is depends on what the
+//! wheels do between samples ([`Stencil`]): its trapezoid for smooth `ρ`, the mean of the
+//! two steps' trapezoids for commands held over each step, and that mean corrected by an
+//! estimated `κ Δ²ρ` for either, or for commands that change between samples
+//! ([`Stencil::Adaptive`], the default; `tests/discrete_momentum.rs` measures each).
 //!
 //! # Rotation source
 //!
@@ -50,15 +54,17 @@ use crate::sample::{is_gap, Sample};
 use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
 
 /// Number of unknowns: `[X₀ (3); X₁ (3); τ_b (3); j (6)]`.
-pub const UNKNOWNS: usize = 15;
+pub const UNKNOWNS: usize = 16;
 /// Column of the first initial-momentum unknown.
 pub const ANCHOR0: usize = 0;
 /// Column of the second initial-momentum unknown (Richardson rows, odd centres).
 pub const ANCHOR1: usize = 3;
 /// Column of the disturbance torque `τ_b`.
 pub const TORQUE: usize = 6;
+/// Column of the wheel-momentum curvature coefficient `κ` ([`Stencil::Adaptive`]).
+pub const KAPPA: usize = 9;
 /// Column of `j`.
-pub const J: usize = 9;
+pub const J: usize = 10;
 
 /// Where the incremental rotation `φ_k` comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -82,14 +88,13 @@ impl RotationSource {
     }
 }
 
-/// What the telemetry's rotor momentum does between samples: which rows fit (the
-/// pipeline's choice; [`Stencil`] is what one row model does).
+/// What the telemetry's rotor momentum does between samples: which rows to use (the
+/// pipeline's setting; [`Stencil`] is what one row model does).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum RhoModel {
-    /// Decide from the data: of [`Stencil::Smooth`] and [`Stencil::Held`], the row model
-    /// with the smaller residual variance (default).
+    /// Estimate it from the data: [`Stencil::Adaptive`] (default).
     #[default]
     Auto,
     /// `ρ` is smooth across two steps (a continuous law, or commands much faster than the
@@ -140,6 +145,14 @@ pub enum Stencil {
     /// Richardson, double-step `ρ̄` the mean of its two steps' trapezoids: O(h⁴) for `ρ`
     /// linear within each step.
     Held,
+    /// [`Stencil::Held`] with each step's `ρ̄` corrected by `κ Δ²ρ_c`, `κ` one unknown
+    /// estimated with `j`: the mean of `ρ` over a step minus its trapezoid is
+    /// `−(p(1−p)/2) Δ²ρ` for wheel torque commands that change a fraction `p` into each
+    /// step (to first order in how much consecutive command changes differ), and
+    /// `−Δ²ρ/12` for smooth `ρ`. One stencil for smooth `ρ` (κ = −1/12), commands held
+    /// over each step (κ = 0) and commands that change between samples (κ = −1/8
+    /// mid-way), without knowing which.
+    Adaptive,
 }
 
 impl Stencil {
@@ -190,6 +203,7 @@ impl core::fmt::Display for MomentumRowSettings {
             Stencil::Plain => "plain rows",
             Stencil::Smooth => "Richardson rows (smooth ρ)",
             Stencil::Held => "Richardson rows (ρ held over each step)",
+            Stencil::Adaptive => "Richardson rows (ρ curvature estimated)",
         };
         let torque = if self.torque_bias {
             ", unknown constant torque"
@@ -211,21 +225,18 @@ impl MomentumRowSettings {
         }
     }
 
-    /// Unknowns besides `j` shared by every chain (`τ_b`).
+    /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`).
     #[must_use]
     pub fn shared_nuisance(&self) -> usize {
-        if self.torque_bias {
-            3
-        } else {
-            0
-        }
+        let torque = if self.torque_bias { 3 } else { 0 };
+        torque + usize::from(self.stencil == Stencil::Adaptive)
     }
 }
 
 /// One 3-row block `a x = b` in the unknowns `x` ([`UNKNOWNS`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AugmentedRow {
-    /// Coefficients, 3×15.
+    /// Coefficients, 3×16.
     pub a: SMatrix<f64, 3, UNKNOWNS>,
     /// Right-hand side, N m s.
     pub b: Vector3<f64>,
@@ -435,6 +446,7 @@ impl MomentumRows {
         let (Some(prev), Some(cm1)) = (prev, self.nodes[0]) else {
             return Ok(None);
         };
+        let prev_phi = f_prev.v;
         let f2 = f_prev.mul(&f).positive_scalar();
         check_phi(&f2.v, cm1.t_s, node.t_s).inspect_err(|_| self.restart(Some(node)))?;
         // Index of c−1 in the chain: count − 3.
@@ -449,8 +461,8 @@ impl MomentumRows {
         }
         let h2 = node.t_s - cm1.t_s;
         let rho2 = match self.settings.stencil {
-            Stencil::Held => (cm1.rho_nms + b.rho_nms * 2.0 + node.rho_nms) * 0.25,
-            _ => (cm1.rho_nms + node.rho_nms) * 0.5,
+            Stencil::Smooth => (cm1.rho_nms + node.rho_nms) * 0.5,
+            _ => (cm1.rho_nms + b.rho_nms * 2.0 + node.rho_nms) * 0.25,
         };
         let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &rho2, h2);
         let (w, v) = (2.0 / 3.0, 1.0 / 3.0);
@@ -458,7 +470,24 @@ impl MomentumRows {
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
-        Ok(Some(self.assemble(&a, &rhs, &s, anchor)))
+        let mut row = self.assemble(&a, &rhs, &s, anchor);
+        if self.settings.stencil == Stencil::Adaptive {
+            // Every ρ̄ of the stencil moves by κ Δ²ρ_c (h̄² times the second divided
+            // difference at c): the κ column is minus the stencil's b for ρ̄ := Δ²ρ_c.
+            let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
+            let hbar = 0.5 * (h0 + h1);
+            let d2 =
+                (node.rho_nms - b.rho_nms) * (hbar / h1) - (b.rho_nms - cm1.rho_nms) * (hbar / h0);
+            let b_of = |c: &Matrix3<f64>, phi: &Vector3<f64>, h: f64| {
+                IntervalMomentum::new(c, phi, &d2, h).b
+            };
+            let col = (b_of(&cm1.c, &prev_phi, h0) + b_of(&b.c, &f.v, h1)) * w
+                - b_of(&cm1.c, &f2.v, h2) * v;
+            for i in 0..3 {
+                row.a[(i, KAPPA)] = -col[i];
+            }
+        }
+        Ok(Some(row))
     }
 
     fn assemble(

@@ -1,13 +1,12 @@
 //! The discrete momentum estimator ([`crate::estimator::discrete_momentum`]) in the
 //! pipeline, with the row model chosen from the data.
 //!
-//! Where a setting leaves a choice open (the rotation source when the telemetry has gyro
-//! rates; the Richardson stencil for smooth `ρ` or for `ρ` held over each step), every
-//! candidate row model folds every sample, and each solve uses the candidate whose
-//! residual variance `ρ²/(rows − unknowns)` is smallest: the model that explains the data
-//! best. A noisier rotation source, or a model of `ρ` between samples that does not fit
-//! (the smooth stencil on wheel commands held over each telemetry step, the held stencil
-//! on a continuous law), leaves larger residuals. Only the chosen candidate is solved.
+//! The wheel momentum between samples is estimated with `j` by default
+//! ([`Stencil::Adaptive`]). Where a setting leaves a choice open (the rotation source when
+//! the telemetry has gyro rates, or a stencil the user names), every candidate row model
+//! folds every sample, and each solve uses the candidate whose residual variance
+//! `ρ²/(rows − unknowns)` is smallest: the model that explains the data best (a noisier
+//! rotation source leaves larger residuals). Only the chosen candidate is solved.
 
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
@@ -59,7 +58,7 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
         RhoModel::Plain => &[Stencil::Plain],
         RhoModel::Held => &[Stencil::Held],
         RhoModel::Smooth => &[Stencil::Smooth],
-        RhoModel::Auto => &[Stencil::Smooth, Stencil::Held],
+        RhoModel::Auto => &[Stencil::Adaptive],
     };
     rotations
         .iter()
