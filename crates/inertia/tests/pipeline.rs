@@ -453,6 +453,64 @@ mod status {
     }
 
     #[test]
+    fn attitude_and_gyro_that_disagree_widen_sigma_or_are_not_determined() {
+        // A gyro scale factor error: the attitude (propagated from the true rates) and the
+        // gyro fit equally well but give J differing by the scale factor. Which is right
+        // the data cannot say: σ must cover both, and a gross disagreement is refused.
+        let good = slew();
+        let scaled = |f: f64| -> Vec<Sample> {
+            good.iter()
+                .map(|s| Sample {
+                    omega_rad_s: s.omega_rad_s.map(|w| w * f),
+                    ..*s
+                })
+                .collect()
+        };
+        let truth = inertia::tensor::j_from_matrix(&inertia::tensor::paper_j_true());
+        for recursive in [true, false] {
+            let last = |samples: &[Sample]| -> inertia::estimator::Estimate {
+                let s = settings("discrete-momentum");
+                if recursive {
+                    let mut p = Pipeline::new(&s).expect("pipeline");
+                    for x in samples {
+                        p.push(x).expect("push");
+                    }
+                    *p.last().expect("estimate")
+                } else {
+                    inertia::pipeline::batch(samples, &s.validate().expect("valid"))
+                        .expect("batch")
+                        .estimate
+                }
+            };
+            let e = last(&scaled(1.02));
+            assert!(
+                matches!(e.observability, Observability::Determined { .. }),
+                "{:?}",
+                e.observability
+            );
+            let (j, sigma) = (e.j().expect("j"), e.sigma_kg_m2().expect("σ"));
+            for k in 0..6 {
+                assert!(
+                    (j[k] - truth[k]).abs() <= 3.0 * sigma[k],
+                    "recursive {recursive}, element {k}: error {:e} vs σ {:e}",
+                    j[k] - truth[k],
+                    sigma[k]
+                );
+            }
+            assert!(sigma[2] > 0.005 * truth[2], "σ widened: {sigma:?}");
+            let e = last(&scaled(1.5));
+            assert!(
+                matches!(
+                    e.observability,
+                    Observability::NotObservable(Unobservable::SourcesDisagree { z }) if z > 5.0
+                ),
+                "recursive {recursive}: {:?}",
+                e.observability
+            );
+        }
+    }
+
+    #[test]
     fn a_reversed_wheel_momentum_sign_is_not_determined() {
         let bad: Vec<Sample> = slew()
             .iter()

@@ -95,6 +95,12 @@ pub enum Unobservable {
         /// satisfies the constraints.
         chi2: f64,
     },
+    /// Two row models that should agree (the rotation from the attitude and from the
+    /// gyro) give answers further apart than their stated σ allow.
+    SourcesDisagree {
+        /// Largest `|ĵ_a − ĵ_b| / √(σ_a² + σ_b²)` over the elements.
+        z: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -155,6 +161,10 @@ impl core::fmt::Display for Unobservable {
             Unobservable::ConflictsWithConstraints { chi2 } => write!(
                 f,
                 "the constraints moved the answer {chi2:.1e} noise variances away from the data's least-squares J: the data contradict the constraint set"
+            ),
+            Unobservable::SourcesDisagree { z } => write!(
+                f,
+                "the answers with the rotation from the attitude and from the gyro differ by {z:.1} standard deviations: the attitude and the gyro disagree beyond their noise (a gyro scale factor or misalignment, a time-tag skew, or a wrong frame)"
             ),
             Unobservable::IllConditioned {
                 condition,

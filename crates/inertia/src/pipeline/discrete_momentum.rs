@@ -18,12 +18,14 @@ use crate::estimator::discrete_momentum::{
 use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource, Stencil};
+use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
 use crate::estimator::uncertainty::{noise_sigma, with_bias};
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::sample::Sample;
 use crate::solver::{unconstrained_minimiser, Backend};
+use crate::tensor::{matrix_from_j, InertiaVector};
 use nalgebra::Vector3;
 use std::boxed::Box;
 use std::vec::Vec;
@@ -146,6 +148,65 @@ struct DiscreteMomentum {
     candidates: Vec<Candidate>,
     chosen: usize,
     since_solve: usize,
+    /// Per candidate: its last own estimate and noise σ, and the row blocks since.
+    checks: Vec<Option<CrossCheck>>,
+}
+
+/// A candidate's own answer, for the cross-check.
+#[derive(Clone, Copy)]
+struct CrossCheck {
+    j: InertiaVector,
+    sigma: [f64; 6],
+    age: usize,
+}
+
+/// Row blocks between refreshes of a candidate's own answer for the cross-check.
+const CROSS_CHECK_EVERY: usize = 50;
+
+/// `|ĵ_a − ĵ_b| / √(σ_a² + σ_b²)` (noise σ, without the model spread) beyond which two
+/// candidates disagree: far in the tail of any honest σ, so that only an inconsistency
+/// of the data trips it ([`reconcile`]).
+pub(crate) const DISAGREE_Z: f64 = 5.0;
+
+/// Reconcile a determined answer with the other candidates' own answers `(ĵ, noise σ)`.
+/// Where one differs by more than [`DISAGREE_Z`] noise σ, the data are inconsistent and
+/// either answer may be the right one: the difference joins the bias part of σ, so that
+/// the stated σ covers both. If σ then exceeds `max_relative_sigma · ‖Ĵ‖_F`, the answer
+/// is withdrawn ([`Unobservable::SourcesDisagree`]).
+fn reconcile(e: &mut Estimate, others: &[(InertiaVector, [f64; 6])], max_relative_sigma: f64) {
+    let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
+        return;
+    };
+    let mut bias = u.bias_kg_m2;
+    let mut worst: f64 = 0.0;
+    for (jb, sigma) in others {
+        let z = disagreement(&j, &u.noise_kg_m2, jb, sigma);
+        if z > DISAGREE_Z {
+            worst = worst.max(z);
+            for (b, (x, y)) in bias.iter_mut().zip(j.iter().zip(jb.iter())) {
+                *b = b.max((x - y).abs());
+            }
+        }
+    }
+    if worst == 0.0 {
+        return;
+    }
+    let u = with_bias(&u.noise_kg_m2, &bias, &j);
+    let relative = u.frobenius_sigma_kg_m2() / matrix_from_j(&j).norm();
+    if relative <= max_relative_sigma {
+        e.uncertainty = Some(u);
+    } else {
+        e.observability = Observability::NotObservable(Unobservable::SourcesDisagree { z: worst });
+        e.solution = None;
+        e.uncertainty = None;
+    }
+}
+
+/// Largest `|a − b| / √(σ_a² + σ_b²)` over the elements.
+fn disagreement(a: &InertiaVector, sa: &[f64; 6], b: &InertiaVector, sb: &[f64; 6]) -> f64 {
+    (0..6)
+        .map(|k| (a[k] - b[k]).abs() / (sa[k] * sa[k] + sb[k] * sb[k]).sqrt())
+        .fold(0.0, f64::max)
 }
 
 fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
@@ -161,6 +222,7 @@ fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
         candidates: Vec::new(),
         chosen: 0,
         since_solve: 0,
+        checks: Vec::new(),
     }))
 }
 
@@ -178,6 +240,43 @@ impl DiscreteMomentum {
     }
 }
 
+impl DiscreteMomentum {
+    /// Withdraw a determined answer that another candidate's own answer contradicts
+    /// beyond both σ ([`DISAGREE_Z`]); the other candidates' answers are refreshed every
+    /// [`CROSS_CHECK_EVERY`] row blocks.
+    fn cross_check(&mut self, e: &mut Estimate, t_s: f64) -> Result<(), EstimatorError> {
+        if self.candidates.len() < 2 || !matches!(e.observability, Observability::Determined { .. })
+        {
+            return Ok(());
+        }
+        if e.uncertainty.is_none() {
+            return Ok(());
+        }
+        self.checks.resize(self.candidates.len(), None);
+        let mut others: Vec<(InertiaVector, [f64; 6])> = Vec::new();
+        for (i, (c, check)) in self.candidates.iter_mut().zip(&mut self.checks).enumerate() {
+            if i == self.chosen || c.qr().rows() < 6 {
+                continue;
+            }
+            let stale = check.is_none_or(|k| k.age >= CROSS_CHECK_EVERY);
+            if stale {
+                let own = c.solve_now(t_s)?;
+                *check = match (own.observability, own.j(), c.robust_noise_sigma()) {
+                    (Observability::Determined { .. }, Some(j), Some(sigma)) => {
+                        Some(CrossCheck { j, sigma, age: 0 })
+                    }
+                    _ => None,
+                };
+            }
+            if let Some(k) = check {
+                others.push((k.j, k.sigma));
+            }
+        }
+        reconcile(e, &others, self.config.observability.max_relative_sigma);
+        Ok(())
+    }
+}
+
 impl Estimator for DiscreteMomentum {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         if self.candidates.is_empty() {
@@ -189,6 +288,9 @@ impl Estimator for DiscreteMomentum {
         }
         if !folded {
             return Ok(None);
+        }
+        for k in self.checks.iter_mut().flatten() {
+            k.age += 1;
         }
         self.since_solve += 1;
         if self.since_solve < self.config.solve_every {
@@ -212,6 +314,7 @@ impl Estimator for DiscreteMomentum {
                 e.uncertainty = Some(with_bias(&noise, &bias, &j));
             }
         }
+        self.cross_check(&mut e, s.t_s)?;
         let Some(c) = self.candidates.get(self.chosen) else {
             return Ok(Some(e));
         };
@@ -263,25 +366,45 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     };
     let qr = &batch.qr;
     let mut backend = registry::build_backend(c.backend);
-    let mut estimate = batch::solve_reduced(
-        qr,
-        samples.last().map_or(0.0, |s| s.t_s),
-        &c.constraints,
-        &mut *backend,
-        &c.observability,
-        None,
-    )
-    .map_err(wrap)?;
+    let t_s = samples.last().map_or(0.0, |s| s.t_s);
+    // One candidate's own answer and noise σ.
+    let mut own = |b: &BatchReduction| -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+        let e = batch::solve_reduced(
+            &b.qr,
+            t_s,
+            &c.constraints,
+            &mut *backend,
+            &c.observability,
+            None,
+        )
+        .map_err(wrap)?;
+        let svd = b.qr.r.svd(false, true);
+        let noise = svd.v_t.and_then(|v_t| {
+            noise_sigma(&b.qr, &svd.singular_values, &v_t.transpose())
+                .map(|ls| robust_sigma(&ls, b.jackknife_sigma_kg_m2.as_ref()))
+        });
+        Ok((e, noise))
+    };
+    let (mut estimate, noise) = own(batch)?;
     if c.uncertainty {
-        let svd = qr.r.svd(false, true);
-        if let (Some(j), Some(v_t)) = (estimate.j(), svd.v_t) {
-            let sv = svd.singular_values;
-            if let Some(ls) = noise_sigma(qr, &sv, &v_t.transpose()) {
-                let noise = robust_sigma(&ls, batch.jackknife_sigma_kg_m2.as_ref());
-                let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
-                let bias = model_spread(&states, chosen);
-                estimate.uncertainty = Some(with_bias(&noise, &bias, &j));
+        if let (Some(j), Some(noise)) = (estimate.j(), noise) {
+            let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
+            let bias = model_spread(&states, chosen);
+            estimate.uncertainty = Some(with_bias(&noise, &bias, &j));
+        }
+        if matches!(estimate.observability, Observability::Determined { .. }) {
+            let mut others = Vec::new();
+            for (i, (_, b)) in reduced.iter().enumerate() {
+                if i == chosen {
+                    continue;
+                }
+                if let (e, Some(sigma)) = own(b)? {
+                    if let (Observability::Determined { .. }, Some(jb)) = (e.observability, e.j()) {
+                        others.push((jb, sigma));
+                    }
+                }
             }
+            reconcile(&mut estimate, &others, c.observability.max_relative_sigma);
         }
     }
     audit(
