@@ -173,8 +173,9 @@ pub struct MomentumRowSettings {
     pub stencil: Stencil,
     /// Estimate a constant body-frame disturbance torque `τ_b` (default `true`).
     pub torque_bias: bool,
-    /// Longest chain, s: a chain is restarted (its initial momentum becomes a new unknown)
-    /// once it spans this long, so that a slowly drifting attitude error (a
+    /// Longest chain, s (the first [`super::jackknife::MIN_GROUPS`] chains a quarter of
+    /// it): a chain is restarted (its initial momentum becomes a new unknown) once it
+    /// spans this long, so that a slowly drifting attitude error (a
     /// gyro-propagated attitude's random walk) rotates the momentum by at most the drift
     /// within one chain. `None`: chains end only at gaps.
     pub max_chain_s: Option<f64>,
@@ -393,6 +394,14 @@ impl MomentumRows {
             }
         }
         if let Some(max) = self.settings.max_chain_s {
+            // The first chains are shorter, so that the jackknife over chains
+            // ([`super::jackknife`]) has its groups early.
+            let early = super::jackknife::MIN_GROUPS as u64;
+            let max = if self.epoch < early {
+                max / early as f64
+            } else {
+                max
+            };
             if b.t_s - self.chain_start_s >= max {
                 // A new chain from node b: no interval is lost.
                 self.restart(Some(b));
