@@ -26,6 +26,8 @@ pub struct AugmentedQr {
     weight: f64,
     /// Nuisance unknowns introduced so far (degrees of freedom the residual does not have).
     nuisance: f64,
+    /// Sum of the rows' errors-in-variables coefficients ([`AugmentedRow::noise_s`]).
+    noise_s: f64,
 }
 
 impl AugmentedQr {
@@ -41,6 +43,7 @@ impl AugmentedQr {
             rows: 0,
             weight: 0.0,
             nuisance: shared_nuisance as f64,
+            noise_s: 0.0,
         }
     }
 
@@ -55,6 +58,7 @@ impl AugmentedQr {
             self.rows += 1;
             self.weight += 1.0;
         }
+        self.noise_s += row.noise_s;
     }
 
     /// Fold another state's rows into this one: afterwards this is the state of both sets
@@ -73,6 +77,7 @@ impl AugmentedQr {
         self.rows += other.rows;
         self.weight += other.weight;
         self.nuisance += other.nuisance;
+        self.noise_s += other.noise_s;
     }
 
     /// Count `n` more nuisance unknowns (a new chain's initial momenta).
@@ -100,6 +105,7 @@ impl AugmentedQr {
         self.y_energy *= lambda;
         self.weight *= lambda;
         self.nuisance *= lambda;
+        self.noise_s *= lambda;
     }
 
     /// Scalar rows folded in.
@@ -136,7 +142,7 @@ impl AugmentedQr {
             y_energy: self.y_energy,
             rows: self.rows,
             weight: self.weight,
-            noise_s: 0.0,
+            noise_s: self.noise_s,
             nuisance: self.nuisance,
         }
     }

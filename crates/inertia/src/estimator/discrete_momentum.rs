@@ -25,22 +25,16 @@ use nalgebra::{Vector3, Vector6};
 pub struct MomentumEstimatorSettings {
     /// How rows are formed.
     pub rows: MomentumRowSettings,
-    /// Solve cadence, memory and observability thresholds (the errors-in-variables
-    /// compensation of the paper's rows does not apply and must be `None`).
+    /// Solve cadence, memory, observability thresholds, and the gyro rate-noise density
+    /// for errors-in-variables compensation ([`super::compensation`] with the rows'
+    /// [`super::momentum_rows::AugmentedRow::noise_s`]).
     pub recursive: RecursiveSettings,
 }
 
 impl MomentumEstimatorSettings {
     /// Check the settings.
     pub fn validate(&self) -> Result<(), EstimatorError> {
-        self.recursive.validate()?;
-        if self.recursive.gyro_noise_rad_s_rthz.is_some() {
-            return Err(EstimatorError::InvalidSetting {
-                field: "gyro_noise_rad_s_rthz",
-                why: "errors-in-variables compensation applies to the paper's rows only",
-            });
-        }
-        Ok(())
+        self.recursive.validate()
     }
 }
 
@@ -306,6 +300,7 @@ pub fn reduce_batch(
     // Per chain: its rows free of its initial momenta, in the shared unknowns.
     let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
+    let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
     let mut nuisance = settings.shared_nuisance() as f64;
     for chain in &chains {
         nuisance += anchors as f64;
@@ -362,7 +357,7 @@ pub fn reduce_batch(
             y_energy,
             rows,
             weight: rows as f64,
-            noise_s: 0.0,
+            noise_s,
             nuisance,
         },
         gaps: source.gaps(),

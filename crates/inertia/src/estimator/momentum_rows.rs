@@ -241,6 +241,13 @@ pub struct AugmentedRow {
     pub a: SMatrix<f64, 3, UNKNOWNS>,
     /// Right-hand side, N m s.
     pub b: Vector3<f64>,
+    /// Errors-in-variables coefficient, s⁻¹: a gyro rate-noise density σ (rad/s/√Hz),
+    /// entering `φ` as a white angle noise, adds `σ² · noise_s · D` to the expected
+    /// `AᵀA` of the block's `j` columns (`D` of [`super::compensation`]). Plain rows:
+    /// `noise_s = 1/h` (`φ` is a half angle, so its noise variance is `σ² h/4`, and
+    /// `A = (2/h) C N G(φ)`); Richardson rows: `Σ_i c_i² h_i/4` with `c_i` the stencil's
+    /// coefficient on `δφ_i` (`1/(2h)` for equal steps).
+    pub noise_s: f64,
 }
 
 /// A plain row's parts, kept for the Richardson combination.
@@ -449,7 +456,13 @@ impl MomentumRows {
         self.count += 1;
         let prev = self.prev.replace(plain);
         if !self.settings.stencil.richardson() {
-            return Ok(Some(self.assemble(&plain.a, &plain.rhs, &plain.s, ANCHOR0)));
+            return Ok(Some(self.assemble(
+                &plain.a,
+                &plain.rhs,
+                &plain.s,
+                ANCHOR0,
+                1.0 / h,
+            )));
         }
         // Richardson: centre c = nodes[1], needs the previous interval.
         let (Some(prev), Some(cm1)) = (prev, self.nodes[0]) else {
@@ -479,11 +492,14 @@ impl MomentumRows {
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
-        let mut row = self.assemble(&a, &rhs, &s, anchor);
+        let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
+        let c0 = 4.0 / (3.0 * h0) - 2.0 / (3.0 * h2);
+        let c1 = 4.0 / (3.0 * h1) - 2.0 / (3.0 * h2);
+        let noise_s = 0.25 * (c0 * c0 * h0 + c1 * c1 * h1);
+        let mut row = self.assemble(&a, &rhs, &s, anchor, noise_s);
         if self.settings.stencil == Stencil::Adaptive {
             // Every ρ̄ of the stencil moves by κ Δ²ρ_c (h̄² times the second divided
             // difference at c): the κ column is minus the stencil's b for ρ̄ := Δ²ρ_c.
-            let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
             let hbar = 0.5 * (h0 + h1);
             let d2 =
                 (node.rho_nms - b.rho_nms) * (hbar / h1) - (b.rho_nms - cm1.rho_nms) * (hbar / h0);
@@ -505,6 +521,7 @@ impl MomentumRows {
         rhs: &Vector3<f64>,
         s: &Matrix3<f64>,
         anchor: usize,
+        noise_s: f64,
     ) -> AugmentedRow {
         let mut out = SMatrix::<f64, 3, UNKNOWNS>::zeros();
         for i in 0..3 {
@@ -514,6 +531,10 @@ impl MomentumRows {
             out.fixed_view_mut::<3, 3>(0, TORQUE).copy_from(&(-s));
         }
         out.fixed_view_mut::<3, 6>(0, J).copy_from(a);
-        AugmentedRow { a: out, b: *rhs }
+        AugmentedRow {
+            a: out,
+            b: *rhs,
+            noise_s,
+        }
     }
 }

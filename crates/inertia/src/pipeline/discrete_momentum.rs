@@ -37,7 +37,7 @@ pub(crate) const DISCRETE_MOMENTUM: EstimatorEntry = EstimatorEntry {
     capabilities: Capabilities {
         needs_gyro: false,
         constraints: true,
-        compensation: false,
+        compensation: true,
         uncertainty: true,
         row_model: true,
     },
@@ -82,7 +82,7 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
             solve_every: 1,
             observability: c.observability,
             memory_s: c.memory_s,
-            gyro_noise_rad_s_rthz: None,
+            gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz,
         },
     }
 }
@@ -375,7 +375,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
             &c.constraints,
             &mut *backend,
             &c.observability,
-            None,
+            c.gyro_noise_rad_s_rthz,
         )
         .map_err(wrap)?;
         let svd = b.qr.r.svd(false, true);
