@@ -331,6 +331,8 @@ struct Stats {
     determined: usize,
     determined_outside: usize,
     failed: usize,
+    /// `σ_F / ‖Ĵ − J‖_F` of every answer with a σ.
+    sigma_ratios: Vec<f64>,
 }
 
 impl Stats {
@@ -344,6 +346,8 @@ impl Stats {
             return;
         };
         self.with_sigma += 1;
+        self.sigma_ratios
+            .push(u.frobenius_sigma_kg_m2() / (j - truth).norm());
         let t = inertia::tensor::j_from_matrix(truth);
         for k in 0..6 {
             if (jv[k] - t[k]).abs() <= 3.0 * sig[k] {
@@ -376,6 +380,13 @@ impl Stats {
         }
         let worst = self.element_within.iter().copied().min().unwrap_or(0);
         format!("{:.2}", worst as f64 / self.with_sigma as f64)
+    }
+
+    fn sigma_ratio(&self) -> String {
+        if self.sigma_ratios.is_empty() {
+            return "no σ".into();
+        }
+        format!("{:.1}", quantile(&self.sigma_ratios, 0.5))
     }
 
     fn determined_beyond(&self) -> String {
@@ -514,9 +525,9 @@ fn main() {
     let wall = start.elapsed();
 
     println!(
-        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ |"
+        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (c, cell) in cells.iter().enumerate() {
         let mut stats = vec![Stats::default(); 4];
         for r in runs
@@ -530,7 +541,7 @@ fn main() {
             }
         }
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
             cell.craft.name(),
             cell.attitude.name(cell.craft),
             cell.telemetry(),
@@ -539,6 +550,7 @@ fn main() {
             stats[2].errors(),
             quantile(&stats[0].errors, 0.5) / quantile(&stats[2].errors, 0.5),
             stats[0].coverage(),
+            stats[0].sigma_ratio(),
             stats[0].determined_beyond(),
             stats[1].determined_beyond(),
             stats[3].errors(),

@@ -133,22 +133,31 @@ fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
 }
 
 /// The discretisation-bias part of σ: the same rows on every other sample (step 2h) are
-/// biased `2^p` times as much as on every sample (order `p`: 4 for Richardson rows, 2
-/// for plain rows), so `|ĵ(h) − ĵ(2h)|/(2^p − 1)` measures the bias of `ĵ(h)` from the
-/// data (Richardson's error estimate; unconstrained solutions of both). It catches what
-/// the noise σ cannot: a bias shared by every chain, such as the O(h⁴) remainder at 1 Hz.
-fn discretisation_bias(
-    full: &RecursiveQr,
-    half: &RecursiveQr,
-    rows: &MomentumRowSettings,
-) -> [f64; 6] {
-    let divisor = if rows.stencil.richardson() { 15.0 } else { 3.0 };
+/// biased `2^p` times as much as on every sample for a method of order `p`, so
+/// `|ĵ(h) − ĵ(2h)|/(2^p − 1)` measures the bias of `ĵ(h)` from the data (Richardson's
+/// error estimate; unconstrained solutions of both). The order actually reached depends
+/// on the wheels between samples (O(h⁴) for the Richardson stencils when their model of
+/// `ρ` holds, less when the commands change several times per telemetry step), so the
+/// conservative `p = 2` is used: `|ĵ(h) − ĵ(2h)|/3`. It catches what the noise σ cannot:
+/// a bias shared by every chain, such as the remainder at 1 Hz telemetry.
+fn discretisation_bias(full: &RecursiveQr, half: &RecursiveQr) -> [f64; 6] {
     match (
         unconstrained_minimiser(&full.r, &full.z),
         unconstrained_minimiser(&half.r, &half.z),
     ) {
-        (Some(a), Some(b)) => core::array::from_fn(|k| (a[k] - b[k]).abs() / divisor),
+        (Some(a), Some(b)) => core::array::from_fn(|k| (a[k] - b[k]).abs() / 3.0),
         _ => [0.0; 6],
+    }
+}
+
+/// Sample `a` as a node of the stride-2 grid: its gyro rate (the average over the step
+/// to `b`) becomes the mean of `a`'s and `b`'s rates, the average over the double step
+/// when the two steps are equal (the step after `b` is not known when `b` arrives; with
+/// unequal steps the shadow's bias estimate is approximate, and only it uses this).
+fn double_step(a: &Sample, b: &Sample) -> Sample {
+    Sample {
+        omega_rad_s: a.omega_rad_s.zip(b.omega_rad_s).map(|(x, y)| (x + y) * 0.5),
+        ..*a
     }
 }
 
@@ -179,6 +188,8 @@ struct DiscreteMomentum {
     shadow: Option<Box<Candidate>>,
     /// Input samples so far.
     samples: usize,
+    /// The even sample waiting for its successor (the shadow's next sample).
+    held: Option<Sample>,
 }
 
 /// A candidate's own answer, for the cross-check.
@@ -231,6 +242,11 @@ fn reconcile(e: &mut Estimate, others: &[(InertiaVector, [f64; 6])], max_relativ
     }
 }
 
+/// Only candidates whose residual variance is within this factor of the chosen one's are
+/// cross-checked: one that fits much worse (a star tracker's differenced noise against a
+/// gyro) is the worse model, not evidence against the chosen one.
+pub(crate) const COMPARABLE_FIT: f64 = 2.0;
+
 /// Largest `|a − b| / √(σ_a² + σ_b²)` over the elements.
 fn disagreement(a: &InertiaVector, sa: &[f64; 6], b: &InertiaVector, sb: &[f64; 6]) -> f64 {
     (0..6)
@@ -254,6 +270,7 @@ fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
         checks: Vec::new(),
         shadow: None,
         samples: 0,
+        held: None,
     }))
 }
 
@@ -293,9 +310,16 @@ impl DiscreteMomentum {
             return Ok(());
         }
         self.checks.resize(self.candidates.len(), None);
+        let best_variance = self
+            .candidates
+            .get(self.chosen)
+            .map_or(f64::INFINITY, |c| c.qr().residual_variance());
         let mut others: Vec<(InertiaVector, [f64; 6])> = Vec::new();
         for (i, (c, check)) in self.candidates.iter_mut().zip(&mut self.checks).enumerate() {
-            if i == self.chosen || c.qr().rows() < 6 {
+            if i == self.chosen
+                || c.qr().rows() < 6
+                || !(c.qr().residual_variance() <= COMPARABLE_FIT * best_variance)
+            {
                 continue;
             }
             let stale = check.is_none_or(|k| k.age >= CROSS_CHECK_EVERY);
@@ -327,8 +351,12 @@ impl Estimator for DiscreteMomentum {
             folded |= c.fold(s)?;
         }
         if let Some(shadow) = self.shadow.as_mut() {
+            // Every other sample, its gyro rate averaged over the double step: fed one
+            // sample late, when the second rate is known.
             if self.samples.is_multiple_of(2) {
-                shadow.fold(s)?;
+                self.held = Some(*s);
+            } else if let Some(a) = self.held.take() {
+                shadow.fold(&double_step(&a, s))?;
             }
         }
         self.samples += 1;
@@ -358,11 +386,9 @@ impl Estimator for DiscreteMomentum {
                     self.candidates.iter().map(|c| c.qr().reduced()).collect();
                 let spread = model_spread(&states, self.chosen);
                 let discretisation = match (self.candidates.first(), self.shadow.as_deref()) {
-                    (Some(first), Some(shadow)) => discretisation_bias(
-                        &first.qr().reduced(),
-                        &shadow.qr().reduced(),
-                        first.row_settings(),
-                    ),
+                    (Some(first), Some(shadow)) => {
+                        discretisation_bias(&first.qr().reduced(), &shadow.qr().reduced())
+                    }
                     _ => [0.0; 6],
                 };
                 let bias = quadrature(&spread, &discretisation);
@@ -445,9 +471,12 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         if let (Some(j), Some(noise)) = (estimate.j(), noise) {
             let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
             let spread = model_spread(&states, chosen);
-            let half: Vec<Sample> = samples.iter().step_by(2).copied().collect();
+            let half: Vec<Sample> = samples
+                .chunks_exact(2)
+                .map(|p| double_step(&p[0], &p[1]))
+                .collect();
             let discretisation = match reduce_batch(&half, rows) {
-                Ok(h) => discretisation_bias(qr, &h.qr, rows),
+                Ok(h) => discretisation_bias(qr, &h.qr),
                 Err(_) => [0.0; 6],
             };
             let bias = quadrature(&spread, &discretisation);
@@ -456,7 +485,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         if matches!(estimate.observability, Observability::Determined { .. }) {
             let mut others = Vec::new();
             for (i, (_, b)) in reduced.iter().enumerate() {
-                if i == chosen {
+                if i == chosen || !(variance(&b.qr) <= COMPARABLE_FIT * variance(qr)) {
                     continue;
                 }
                 if let (e, Some(sigma)) = own(b)? {
