@@ -314,6 +314,14 @@ fn estimate(samples: &[Sample], estimator: &str, gyro_deg_s_rthz: Option<f64>) -
         },
         solve_every: 50,
         uncertainty: true,
+        max_chain_s: match std::env::var("CHAIN")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+        {
+            Some(c) if c > 0.0 => Some(c),
+            Some(_) => None,
+            None => PipelineSettings::default().max_chain_s,
+        },
         ..PipelineSettings::default()
     })
     .ok()?;

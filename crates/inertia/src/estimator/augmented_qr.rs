@@ -120,6 +120,12 @@ impl AugmentedQr {
         self.weight
     }
 
+    /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
+    #[must_use]
+    pub fn residual_dof(&self) -> f64 {
+        self.weight - 6.0 - self.nuisance
+    }
+
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
     pub fn residual_variance(&self) -> f64 {

@@ -62,18 +62,34 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
         RhoModel::Smooth => &[Stencil::Smooth],
         RhoModel::Auto => &[Stencil::Adaptive],
     };
-    rotations
-        .iter()
-        .flat_map(|&rotation| {
-            stencils.iter().map(move |&stencil| MomentumRowSettings {
-                rotation,
-                stencil,
-                torque_bias: c.torque_bias,
-                max_chain_s: c.max_chain_s,
-            })
-        })
-        .collect()
+    // A short and a long chain: the data choose ([`choose`]).
+    let chains: &[Option<f64>] = &match c.max_chain_s {
+        Some(l) => [Some(l), Some(LONG_CHAIN_FACTOR * l)],
+        None => [None, None],
+    };
+    let chains = if c.max_chain_s.is_some() {
+        chains
+    } else {
+        &chains[..1]
+    };
+    let mut out = Vec::new();
+    for &max_chain_s in chains {
+        for &rotation in rotations {
+            for &stencil in stencils {
+                out.push(MomentumRowSettings {
+                    rotation,
+                    stencil,
+                    torque_bias: c.torque_bias,
+                    max_chain_s,
+                });
+            }
+        }
+    }
+    out
 }
+
+/// The long chain's length, in short chains.
+pub(crate) const LONG_CHAIN_FACTOR: f64 = 4.0;
 
 fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorSettings {
     MomentumEstimatorSettings {
@@ -166,15 +182,38 @@ fn quadrature(a: &[f64; 6], b: &[f64; 6]) -> [f64; 6] {
     core::array::from_fn(|k| (a[k] * a[k] + b[k] * b[k]).sqrt())
 }
 
-/// Index of the smallest residual variance (the first on ties; `0` when none is finite).
-fn best(variances: impl Iterator<Item = f64>) -> usize {
-    let mut out = (0, f64::INFINITY);
-    for (i, v) in variances.enumerate() {
-        if v < out.1 {
-            out = (i, v);
+/// The candidate to solve, from `(residual variance, residual degrees of freedom, chain
+/// length)` per candidate: of those whose residual variance is within `1 + 3√(2/ν)` of
+/// the smallest (`ν` its degrees of freedom: the data cannot tell them apart), the one
+/// with the longest chains (more of the momentum's history ties `j` down), then the
+/// smallest variance. Chains that a drifting attitude or a varying torque would spoil
+/// fit worse, and lose. `0` when no variance is finite.
+fn choose(candidates: impl Iterator<Item = (f64, f64, Option<f64>)> + Clone) -> usize {
+    let (mut v_min, mut dof) = (f64::INFINITY, 0.0);
+    for (v, d, _) in candidates.clone() {
+        if v < v_min {
+            (v_min, dof) = (v, d);
         }
     }
-    out.0
+    if !v_min.is_finite() || !(dof > 0.0) {
+        return 0;
+    }
+    let limit = v_min * (1.0 + 3.0 * (2.0 / dof).sqrt());
+    let length = |c: Option<f64>| c.unwrap_or(f64::INFINITY);
+    let mut out: Option<(usize, f64, f64)> = None;
+    for (i, (v, _, chain)) in candidates.enumerate() {
+        if !(v <= limit) {
+            continue;
+        }
+        let better = match out {
+            None => true,
+            Some((_, l, vb)) => length(chain) > l || (length(chain) == l && v < vb),
+        };
+        if better {
+            out = Some((i, length(chain), v));
+        }
+    }
+    out.map_or(0, |o| o.0)
 }
 
 struct DiscreteMomentum {
@@ -370,7 +409,13 @@ impl Estimator for DiscreteMomentum {
         if self.since_solve < self.config.solve_every {
             return Ok(None);
         }
-        self.chosen = best(self.candidates.iter().map(|c| c.qr().residual_variance()));
+        self.chosen = choose(self.candidates.iter().map(|c| {
+            (
+                c.qr().residual_variance(),
+                c.qr().residual_dof(),
+                c.row_settings().max_chain_s,
+            )
+        }));
         let Some(c) = self.candidates.get_mut(self.chosen) else {
             return Ok(None);
         };
@@ -439,7 +484,11 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     for rows in candidates(c, has_gyro) {
         reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
-    let chosen = best(reduced.iter().map(|(_, b)| variance(&b.qr)));
+    let chosen = choose(
+        reduced
+            .iter()
+            .map(|(rows, b)| (variance(&b.qr), b.qr.residual_dof(), rows.max_chain_s)),
+    );
     let Some((rows, batch)) = reduced.get(chosen) else {
         return Err(PipelineError::NoBatch {
             estimator: DISCRETE_MOMENTUM.name,
