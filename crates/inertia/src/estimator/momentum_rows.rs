@@ -211,7 +211,11 @@ impl core::fmt::Display for MomentumRowSettings {
         } else {
             ""
         };
-        write!(f, "{rotation}, {stencil}{torque}")
+        write!(f, "{rotation}, {stencil}{torque}")?;
+        if let Some(max) = self.max_chain_s {
+            write!(f, ", chains of {max} s")?;
+        }
+        Ok(())
     }
 }
 
