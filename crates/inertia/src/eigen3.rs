@@ -20,7 +20,9 @@ pub fn symmetric_eigen3(f: &Matrix3<f64>) -> (Vector3<f64>, [Vector3<f64>; 3]) {
     let p1 = f[(0, 1)] * f[(0, 1)] + f[(0, 2)] * f[(0, 2)] + f[(1, 2)] * f[(1, 2)];
     let d = Vector3::new(f[(0, 0)] - q, f[(1, 1)] - q, f[(2, 2)] - q);
     let p2 = d.norm_squared() + 2.0 * p1;
-    let scale = f.iter().fold(0.0f64, |m, x| m.max(abs(*x)));
+    let scale = f
+        .iter()
+        .fold(0.0, |m, &x| if abs(x) > m { abs(x) } else { m });
     if p2 <= (1e-300f64).max(f64::EPSILON * f64::EPSILON * scale * scale) {
         // A multiple of the identity: any basis.
         return (

@@ -19,7 +19,7 @@
 //! overflow nor underflow. The singular values and `V` are those of the plain algorithm
 //! to rounding: the tolerance `TOL` on the columns' orthogonality is unchanged.
 
-use crate::math::sqrt;
+use crate::math::{abs, sqrt};
 use nalgebra::{Matrix6, Vector6};
 
 /// Sweeps at most per update.
@@ -82,7 +82,11 @@ impl SvdTracker {
         let mut v: Columns = core::array::from_fn(|k| core::array::from_fn(|i| self.v[(i, k)]));
         // B = R V · 2^-e with 2^e near the largest |r_ik|: exact, and keeps the squares
         // below in range.
-        let (scale, unscale) = power_of_two_scale(r.amax());
+        // (A plain fold: nalgebra's `amax` costs as much as a rotation round here.)
+        let amax = r
+            .iter()
+            .fold(0.0, |m, &x| if abs(x) > m { abs(x) } else { m });
+        let (scale, unscale) = power_of_two_scale(amax);
         let rs: Columns = core::array::from_fn(|k| core::array::from_fn(|i| r[(i, k)] * scale));
         let mut b: Columns = [[0.0; 6]; 6];
         for (bk, vk) in b.iter_mut().zip(&v) {
