@@ -26,10 +26,6 @@ mod imp {
     pub fn ln(x: f64) -> f64 {
         x.ln()
     }
-    #[inline]
-    pub fn acos(x: f64) -> f64 {
-        x.acos()
-    }
 }
 
 #[cfg(not(feature = "std"))]
@@ -54,13 +50,9 @@ mod imp {
     pub fn ln(x: f64) -> f64 {
         libm::log(x)
     }
-    #[inline]
-    pub fn acos(x: f64) -> f64 {
-        libm::acos(x)
-    }
 }
 
-pub(crate) use imp::{acos, atan2, cos, ln, sin, sqrt};
+pub(crate) use imp::{atan2, cos, ln, sin, sqrt};
 
 /// `|x|` without `std`.
 #[inline]

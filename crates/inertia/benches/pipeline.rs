@@ -1,0 +1,62 @@
+//! Per-sample cost of whole pipelines on the `slew` telemetry of
+//! `benches/discrete_momentum.rs`: the discrete momentum estimator's automatic path (the
+//! `Pipeline` with estimator `discrete-momentum` and default settings, which folds every
+//! candidate row model per sample: gyro and attitude rotations × plain and Richardson
+//! rows, four in all, and solves the best) beside the variational pipeline with the same
+//! defaults (physical constraint set, uncertainty, audit).
+//!
+//! A `Pipeline` cannot be cloned, so each measurement builds one, feeds it the first
+//! 200 s untimed, and times the samples after that (the estimate is determined and the
+//! state steady there), building a new one when they run out.
+//!
+//! Run: `cargo bench -p inertia --bench pipeline -- --warm-up-time 1 --measurement-time 3`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use inertia::pipeline::{Pipeline, PipelineSettings};
+use inertia::sim::scenario::{Common, Scenario};
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+fn bench(c: &mut Criterion) {
+    let run = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let samples = &run.samples;
+    let start = 2000;
+    let mut g = c.benchmark_group("pipeline_per_sample_slew");
+    for (name, estimator) in [
+        ("variational", "variational"),
+        ("discrete_momentum_auto", "discrete-momentum"),
+    ] {
+        let settings = PipelineSettings {
+            estimator: estimator.into(),
+            ..PipelineSettings::default()
+        };
+        g.bench_function(name, |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                let mut done = 0u64;
+                while done < iters {
+                    let mut p = Pipeline::new(&settings).unwrap();
+                    for s in &samples[..start] {
+                        p.push(s).unwrap();
+                    }
+                    let n = (iters - done).min((samples.len() - start) as u64) as usize;
+                    let t0 = Instant::now();
+                    for s in &samples[start..start + n] {
+                        black_box(p.push(black_box(s)).unwrap());
+                    }
+                    total += t0.elapsed();
+                    done += n as u64;
+                }
+                total
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30).measurement_time(Duration::from_secs(3));
+    targets = bench
+}
+criterion_main!(benches);
