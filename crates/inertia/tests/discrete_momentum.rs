@@ -397,7 +397,8 @@ fn each_stencil_is_exact_for_its_wheel_model_and_the_adaptive_one_for_all() {
             "{name}: adaptive {adaptive:e}"
         );
         assert!(adaptive < 3.0 * fixed_best, "{name}");
-        // The pipeline's default is the adaptive stencil.
+        // The pipeline's default (the adaptive stencil, its choice of rotation source and
+        // chain length, its σ) gets the same accuracy, and its σ covers it.
         let mut p = inertia::pipeline::Pipeline::new(&inertia::pipeline::PipelineSettings {
             estimator: "discrete-momentum".into(),
             constraints: ConstraintSet::positive_definite(),
@@ -408,6 +409,11 @@ fn each_stencil_is_exact_for_its_wheel_model_and_the_adaptive_one_for_all() {
             p.push(s).expect("push");
         }
         assert_eq!(p.row_model().expect("row model").stencil, Stencil::Adaptive);
+        let e = p.last().expect("estimate");
+        let pipeline_error =
+            relative_frobenius_error(&e.inertia().expect("answer"), &run.inertia_kg_m2);
+        assert!(pipeline_error < 1e-8, "{name}: pipeline {pipeline_error:e}");
+        assert_eq!(e.within_3sigma(&run.inertia_kg_m2), Some(true), "{name}");
     }
 }
 
@@ -479,6 +485,50 @@ fn jackknife_of_identical_groups_is_zero_and_of_known_spread_is_exact() {
     let sigma = jackknife_sigma(&spread).expect("four groups");
     for s in sigma {
         assert!((s - 3f64.sqrt() * d).abs() < 1e-15, "{s}");
+    }
+}
+
+#[test]
+fn recursive_and_batch_agree_with_constant_wheel_momentum_and_a_rowless_first_chain() {
+    // A constant ρ leaves the adaptive stencil's κ column zero; a first chain of two
+    // nodes and a gap give no Richardson row. Both paths must see the same problem.
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(120.0),
+            ..Common::paper()
+        })
+        .expect("sim");
+    let rho0 = Vector3::new(0.02, -0.01, 0.015);
+    let mut samples: Vec<Sample> = run
+        .samples
+        .iter()
+        .map(|s| Sample {
+            rho_nms: rho0,
+            ..*s
+        })
+        .collect();
+    // Two nodes, then a 5 s gap.
+    samples.retain(|s| !(0.15..5.0).contains(&s.t_s));
+    for max_chain_s in [None, Some(20.0)] {
+        let rows = MomentumRowSettings {
+            stencil: Stencil::Adaptive,
+            max_chain_s,
+            ..Default::default()
+        };
+        let mut e = estimator(rows);
+        for s in &samples {
+            e.push(s).expect("push");
+        }
+        let rec = inertia::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z)
+            .expect("regular");
+        let b = reduce_batch(&samples, &rows).expect("batch");
+        let bat = inertia::solver::unconstrained_minimiser(&b.qr.r, &b.qr.z).expect("regular");
+        assert!(
+            (rec - bat).norm() < 1e-8 * bat.norm(),
+            "chain {max_chain_s:?}: {:e}",
+            (rec - bat).norm() / bat.norm()
+        );
+        assert_eq!(b.qr.nuisance, e.reduced().nuisance, "chain {max_chain_s:?}");
     }
 }
 

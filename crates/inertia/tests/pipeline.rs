@@ -422,7 +422,7 @@ mod status {
                     let [w, x, y, z] = q.to_wxyz();
                     Quaternion::from_xyzw([w, x, y, z])
                 },
-                "--scalar-first",
+                "use --scalar-first",
             ),
             (
                 // A scalar-last file read with --scalar-first: (w, x, y, z) := (x, y, z, w).
@@ -507,6 +507,29 @@ mod status {
                 "recursive {recursive}: {:?}",
                 e.observability
             );
+        }
+    }
+
+    #[test]
+    fn a_half_rate_shadow_that_cannot_form_rows_does_not_stop_the_run() {
+        // 45°/s about z at 1 Hz: each step turns 45°, the shadow's double step 90°, and
+        // its Richardson stencil (two double steps) 180°, which no row can take.
+        let w = core::f64::consts::FRAC_PI_4;
+        let samples: Vec<Sample> = (0..60)
+            .map(|k| {
+                let t = f64::from(k);
+                Sample {
+                    t_s: t,
+                    q: Quaternion::exp(&nalgebra::Vector3::new(0.0, 0.0, w * t)),
+                    rho_nms: nalgebra::Vector3::new(0.01 * t.sin(), 0.0, 0.1),
+                    tau_nm: nalgebra::Vector3::zeros(),
+                    omega_rad_s: Some(nalgebra::Vector3::new(0.0, 0.0, w)),
+                }
+            })
+            .collect();
+        let mut p = Pipeline::new(&settings("discrete-momentum")).expect("pipeline");
+        for (i, s) in samples.iter().enumerate() {
+            p.push(s).unwrap_or_else(|e| panic!("sample {i}: {e}"));
         }
     }
 

@@ -15,7 +15,7 @@ use crate::givens::fold_row;
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
-/// `(R, z, ρ²)` over the 15 unknowns, and counters.
+/// `(R, z, ρ²)` over the 16 unknowns, and counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AugmentedQr {
     r: SMatrix<f64, UNKNOWNS, UNKNOWNS>,

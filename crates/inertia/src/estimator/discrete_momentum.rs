@@ -1,5 +1,5 @@
 //! The discrete momentum estimator (beyond the paper): the rows of
-//! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; j]`
+//! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; κ; j]`
 //! ([`super::augmented_qr`]), the nuisance unknowns minimised out exactly, and the same
 //! observability test, constraint sets and solvers as Algorithm 1 on the reduced problem
 //! in `j`.
@@ -54,6 +54,8 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     since_solve: usize,
     last_block_t_s: Option<f64>,
     epoch: u64,
+    /// Whether the chain in progress has had its initial momenta counted.
+    chain_counted: bool,
     last: Option<Estimate>,
 }
 
@@ -68,7 +70,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let r = &settings.rows;
         Ok(Self {
             source: MomentumRows::new(*r),
-            qr: AugmentedQr::new(r.shared_nuisance() + r.nuisance_per_chain()),
+            qr: AugmentedQr::new(r.shared_nuisance()),
             groups: ChainGroups::default(),
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
@@ -80,6 +82,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             since_solve: 0,
             last_block_t_s: None,
             epoch: 0,
+            chain_counted: false,
             last: None,
         })
     }
@@ -101,21 +104,32 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     fn fold_row(&mut self, row: &AugmentedRow, t_s: f64) {
+        let forgetting = self.settings.recursive.memory_s.is_some();
         if self.source.epoch() != self.epoch {
             self.epoch = self.source.epoch();
             self.qr.eliminate_anchors();
+            if !forgetting {
+                self.groups.end_chain();
+            }
+            self.chain_counted = false;
+        }
+        // A chain's initial momenta count as unknowns from its first row (a chain that
+        // ended before giving a row has none), as in the batch reduction.
+        if !self.chain_counted {
             self.qr
                 .add_nuisance(self.settings.rows.nuisance_per_chain());
-            self.groups.end_chain();
+            self.chain_counted = true;
         }
         if let (Some(m), Some(t0)) = (self.settings.recursive.memory_s, self.last_block_t_s) {
-            let lambda = libm::exp(-(t_s - t0) / m);
-            self.qr.scale(lambda);
-            self.groups.scale(lambda);
+            self.qr.scale(libm::exp(-(t_s - t0) / m));
         }
         self.last_block_t_s = Some(t_s);
         self.qr.add(row);
-        self.groups.add(row);
+        // The delete-a-group jackknife weighs its groups equally: with forgetting they
+        // are not, and it is not kept ([`super::jackknife`]).
+        if !forgetting {
+            self.groups.add(row);
+        }
         self.since_solve += 1;
     }
 
@@ -156,7 +170,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The delete-a-group jackknife σ per element over the completed chains
-    /// ([`super::jackknife`]), kg m²; `None` with too few chains.
+    /// ([`super::jackknife`]), kg m²; `None` with too few chains or with forgetting.
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
         self.groups.sigma()
     }
@@ -233,7 +247,7 @@ pub struct BatchReduction {
 }
 
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
-/// chain over `[X₀ X₁ τ_b j]`, keeping the rows free of the chain's initial momenta, then
+/// chain over `[X₀ X₁ τ_b κ j]` (the columns the rows use), keeping the rows free of the chain's initial momenta, then
 /// once over the stacked `[τ_b j]` rows of every chain (and, for the jackknife, of every
 /// chain but one group's).
 #[cfg(feature = "std")]
@@ -242,7 +256,7 @@ pub fn reduce_batch(
     settings: &MomentumRowSettings,
 ) -> Result<BatchReduction, EstimatorError> {
     use super::jackknife::{jackknife_sigma, GROUPS};
-    use super::momentum_rows::{Stencil, J, KAPPA, TORQUE};
+    use super::momentum_rows::{J, TORQUE};
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
         return Err(EstimatorError::TooFewSamples {
@@ -281,29 +295,27 @@ pub fn reduce_batch(
         (qr.r(), qty.rows(0, n).into_owned(), energy)
     };
     // Only the columns the rows use: a zero column would leave its row of R holding
-    // information about the others.
-    let anchors = settings.nuisance_per_chain();
-    let shared = settings.shared_nuisance() + 6;
-    let columns: Vec<usize> = (0..anchors)
-        .chain(if settings.torque_bias {
-            TORQUE..KAPPA
-        } else {
-            0..0
-        })
-        .chain(if settings.stencil == Stencil::Adaptive {
-            KAPPA..J
-        } else {
-            0..0
-        })
+    // information about the others, which dropping that row would lose. The shared
+    // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
+    // initial momenta chain by chain (a short Richardson chain may use only X₀).
+    let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
+    let shared_columns: Vec<usize> = (TORQUE..J)
+        .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
         .chain(J..J + 6)
         .collect();
+    let shared = shared_columns.len();
     // Per chain: its rows free of its initial momenta, in the shared unknowns.
     let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
     let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
     let mut nuisance = settings.shared_nuisance() as f64;
     for chain in &chains {
-        nuisance += anchors as f64;
+        nuisance += settings.nuisance_per_chain() as f64;
+        let columns: Vec<usize> = (0..settings.nuisance_per_chain())
+            .filter(|&k| chain.iter().any(|r| uses(r, k)))
+            .chain(shared_columns.iter().copied())
+            .collect();
+        let anchors = columns.len() - shared;
         let m = 3 * chain.len();
         let a = DMatrix::from_fn(m, columns.len(), |i, k| chain[i / 3].a[(i % 3, columns[k])]);
         let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);

@@ -25,7 +25,10 @@
 //! the data that includes the chain in progress; with fewer than [`MIN_GROUPS`] non-empty
 //! groups there is none. The noise σ reported is the larger of this and the
 //! least-squares σ, element by element. What it cannot see is a bias common to every
-//! chain (a wrong model of the wheels between samples, say).
+//! chain (a wrong model of the wheels between samples, say). With exponential forgetting
+//! the groups' weights differ by orders of magnitude and the equal-weight formula does
+//! not hold, so the estimator keeps no groups then and the noise σ is the least-squares
+//! one.
 
 use super::augmented_qr::AugmentedQr;
 use super::momentum_rows::AugmentedRow;
@@ -106,15 +109,6 @@ impl ChainGroups {
         }
         self.chain = AugmentedQr::new(0);
         self.chains += 1;
-    }
-
-    /// Weigh everything by `λ` (exponential forgetting).
-    pub fn scale(&mut self, lambda: f64) {
-        self.chain.scale(lambda);
-        for g in &mut self.groups {
-            g.scale(lambda);
-        }
-        self.cached = None;
     }
 
     /// Completed chains.

@@ -53,7 +53,7 @@ use crate::discrete_momentum::IntervalMomentum;
 use crate::sample::{is_gap, Sample};
 use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
 
-/// Number of unknowns: `[X₀ (3); X₁ (3); τ_b (3); j (6)]`.
+/// Number of unknowns: `[X₀ (3); X₁ (3); τ_b (3); κ (1); j (6)]`.
 pub const UNKNOWNS: usize = 16;
 /// Column of the first initial-momentum unknown.
 pub const ANCHOR0: usize = 0;
@@ -250,7 +250,7 @@ pub struct AugmentedRow {
     /// `AᵀA` of the block's `j` columns (`D` of [`super::compensation`]). Plain rows:
     /// `noise_s = 1/h` (`φ` is a half angle, so its noise variance is `σ² h/4`, and
     /// `A = (2/h) C N G(φ)`); Richardson rows: `Σ_i c_i² h_i/4` with `c_i` the stencil's
-    /// coefficient on `δφ_i` (`1/(2h)` for equal steps).
+    /// coefficient on `δφ_i` (`c_i = 1/h`, so `noise_s = 1/(2h)`, for equal steps).
     pub noise_s: f64,
 }
 
@@ -488,7 +488,11 @@ impl MomentumRows {
         let h2 = node.t_s - cm1.t_s;
         let rho2 = match self.settings.stencil {
             Stencil::Smooth => (cm1.rho_nms + node.rho_nms) * 0.5,
-            _ => (cm1.rho_nms + b.rho_nms * 2.0 + node.rho_nms) * 0.25,
+            // The mean over the double step of ρ linear within each step.
+            _ => {
+                let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
+                ((cm1.rho_nms + b.rho_nms) * h0 + (b.rho_nms + node.rho_nms) * h1) / (2.0 * h2)
+            }
         };
         let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &rho2, h2);
         let (w, v) = (2.0 / 3.0, 1.0 / 3.0);

@@ -2,16 +2,22 @@
 //! pipeline, with the row model chosen from the data.
 //!
 //! The wheel momentum between samples is estimated with `j` by default
-//! ([`Stencil::Adaptive`]). Where a setting leaves a choice open (the rotation source when
-//! the telemetry has gyro rates, or a stencil the user names), every candidate row model
-//! folds every sample, and each solve uses the candidate whose residual variance
-//! `ρ²/(rows − unknowns)` is smallest: the model that explains the data best (a noisier
-//! rotation source leaves larger residuals). Only the chosen candidate is solved.
+//! ([`Stencil::Adaptive`]). Where the settings leave a choice open (the rotation source
+//! when the telemetry has gyro rates, and the chain length: `--chain` and 4× as long),
+//! every candidate row model folds every sample, and each solve uses the candidate
+//! [`choose`] picks: of those whose residual variance `ρ²/(rows − unknowns)` the data
+//! cannot tell from the smallest, the one with the longest chains (a noisier rotation
+//! source, or chains long enough for an attitude drift to show, leave larger residuals).
+//! The σ of the answer is assembled here from the chosen candidate's noise σ
+//! ([`crate::estimator::jackknife`]) and three bias terms: the discretisation bias from a
+//! half-rate shadow of the first candidate, the spread of indistinguishable candidates,
+//! and the cross-check of the rotation sources ([`reconcile`]).
 
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
 use super::PipelineError;
 use crate::estimator::audit::audit;
+use crate::estimator::compensation::compensate;
 use crate::estimator::discrete_momentum::{
     reduce_batch, BatchReduction, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
@@ -63,17 +69,12 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
         RhoModel::Auto => &[Stencil::Adaptive],
     };
     // A short and a long chain: the data choose ([`choose`]).
-    let chains: &[Option<f64>] = &match c.max_chain_s {
-        Some(l) => [Some(l), Some(LONG_CHAIN_FACTOR * l)],
-        None => [None, None],
-    };
-    let chains = if c.max_chain_s.is_some() {
-        chains
-    } else {
-        &chains[..1]
+    let chains: Vec<Option<f64>> = match c.max_chain_s {
+        Some(l) => std::vec![Some(l), Some(LONG_CHAIN_FACTOR * l)],
+        None => std::vec![None],
     };
     let mut out = Vec::new();
-    for &max_chain_s in chains {
+    for max_chain_s in chains {
         for &rotation in rotations {
             for &stencil in stencils {
                 out.push(MomentumRowSettings {
@@ -121,7 +122,7 @@ fn variance(qr: &RecursiveQr) -> f64 {
 /// wheels, or two rotation sources, fit the data equally well, neither is known to be
 /// right, and the answer is uncertain by at least their difference. Zero when the chosen
 /// model fits significantly best.
-fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
+fn model_spread(states: &[RecursiveQr], chosen: usize, gyro: Option<f64>) -> [f64; 6] {
     let mut out = [0.0; 6];
     let Some(best) = states.get(chosen) else {
         return out;
@@ -132,14 +133,14 @@ fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
         return out;
     }
     let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
-    let Some(j_best) = unconstrained_minimiser(&best.r, &best.z) else {
+    let Some(j_best) = own_solution(best, gyro) else {
         return out;
     };
     for (i, qr) in states.iter().enumerate() {
         if i == chosen || !(variance(qr) <= ratio * v_best) {
             continue;
         }
-        if let Some(j) = unconstrained_minimiser(&qr.r, &qr.z) {
+        if let Some(j) = own_solution(qr, gyro) {
             for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
                 *o = o.max((a - b).abs());
             }
@@ -156,13 +157,21 @@ fn model_spread(states: &[RecursiveQr], chosen: usize) -> [f64; 6] {
 /// `ρ` holds, less when the commands change several times per telemetry step), so the
 /// conservative `p = 2` is used: `|ĵ(h) − ĵ(2h)|/3`. It catches what the noise σ cannot:
 /// a bias shared by every chain, such as the remainder at 1 Hz telemetry.
-fn discretisation_bias(full: &RecursiveQr, half: &RecursiveQr) -> [f64; 6] {
-    match (
-        unconstrained_minimiser(&full.r, &full.z),
-        unconstrained_minimiser(&half.r, &half.z),
-    ) {
+fn discretisation_bias(full: &RecursiveQr, half: &RecursiveQr, gyro: Option<f64>) -> [f64; 6] {
+    match (own_solution(full, gyro), own_solution(half, gyro)) {
         (Some(a), Some(b)) => core::array::from_fn(|k| (a[k] - b[k]).abs() / 3.0),
         _ => [0.0; 6],
+    }
+}
+
+/// The unconstrained least-squares `j` of a reduced state, errors-in-variables
+/// compensated like the estimate when a gyro noise density is given (the compensation's
+/// size depends on the step and the row model, so uncompensated solutions would differ
+/// by it and not by what is being measured).
+fn own_solution(qr: &RecursiveQr, gyro: Option<f64>) -> Option<InertiaVector> {
+    match gyro.and_then(|g| compensate(qr, g)) {
+        Some((r, z)) => unconstrained_minimiser(&r, &z),
+        None => unconstrained_minimiser(&qr.r, &qr.z),
     }
 }
 
@@ -395,7 +404,12 @@ impl Estimator for DiscreteMomentum {
             if self.samples.is_multiple_of(2) {
                 self.held = Some(*s);
             } else if let Some(a) = self.held.take() {
-                shadow.fold(&double_step(&a, s))?;
+                // The shadow's double step can turn too far for a row where the data's
+                // single steps do not: it is dropped, and with it the bias term, rather
+                // than stopping the run.
+                if shadow.fold(&double_step(&a, s)).is_err() {
+                    self.shadow = None;
+                }
             }
         }
         self.samples += 1;
@@ -429,11 +443,13 @@ impl Estimator for DiscreteMomentum {
             if let (Some(j), Some(noise)) = (e.j(), noise) {
                 let states: Vec<RecursiveQr> =
                     self.candidates.iter().map(|c| c.qr().reduced()).collect();
-                let spread = model_spread(&states, self.chosen);
+                let spread = model_spread(&states, self.chosen, self.config.gyro_noise_rad_s_rthz);
                 let discretisation = match (self.candidates.first(), self.shadow.as_deref()) {
-                    (Some(first), Some(shadow)) => {
-                        discretisation_bias(&first.qr().reduced(), &shadow.qr().reduced())
-                    }
+                    (Some(first), Some(shadow)) => discretisation_bias(
+                        &first.qr().reduced(),
+                        &shadow.qr().reduced(),
+                        self.config.gyro_noise_rad_s_rthz,
+                    ),
                     _ => [0.0; 6],
                 };
                 let bias = quadrature(&spread, &discretisation);
@@ -519,14 +535,18 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     if c.uncertainty {
         if let (Some(j), Some(noise)) = (estimate.j(), noise) {
             let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
-            let spread = model_spread(&states, chosen);
+            let spread = model_spread(&states, chosen, c.gyro_noise_rad_s_rthz);
+            // As in the recursive path: the first candidate on every other sample.
             let half: Vec<Sample> = samples
                 .chunks_exact(2)
                 .map(|p| double_step(&p[0], &p[1]))
                 .collect();
-            let discretisation = match reduce_batch(&half, rows) {
-                Ok(h) => discretisation_bias(qr, &h.qr),
-                Err(_) => [0.0; 6],
+            let discretisation = match (reduced.first(), c.gyro_noise_rad_s_rthz) {
+                (Some((first, full)), gyro) => match reduce_batch(&half, first) {
+                    Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro),
+                    Err(_) => [0.0; 6],
+                },
+                _ => [0.0; 6],
             };
             let bias = quadrature(&spread, &discretisation);
             estimate.uncertainty = Some(with_bias(&noise, &bias, &j));

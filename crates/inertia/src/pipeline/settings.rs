@@ -46,10 +46,12 @@ pub struct PipelineSettings {
     /// Estimate an unknown constant body-frame disturbance torque (discrete momentum
     /// estimator; default `true`).
     pub torque_bias: bool,
-    /// Longest momentum chain, s (discrete momentum estimator): bounds how far a
+    /// Short momentum chain, s (discrete momentum estimator): bounds how far a
     /// drifting attitude error can rotate the conserved momentum
-    /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Default
-    /// [`DEFAULT_MAX_CHAIN_S`].
+    /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
+    /// 4× as long are folded too, and each solve takes the longest that fits as well
+    /// (`pipeline::discrete_momentum`). Default [`DEFAULT_MAX_CHAIN_S`]; `None`: chains
+    /// end only at gaps.
     pub max_chain_s: Option<f64>,
 }
 
