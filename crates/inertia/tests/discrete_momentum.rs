@@ -270,27 +270,41 @@ fn recursive_and_batch_agree_with_gaps_and_chains() {
                 max_chain_s,
                 ..Default::default()
             };
-            let mut e = estimator(rows);
-            for s in &samples {
-                e.push(s).expect("push");
-            }
-            let rec = inertia::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z)
-                .expect("regular");
-            let b = reduce_batch(&samples, &rows).expect("batch");
-            let (qr, gaps) = (b.qr, b.gaps);
-            let bat = inertia::solver::unconstrained_minimiser(&qr.r, &qr.z).expect("regular");
-            assert_eq!(gaps, 1);
-            assert_eq!(e.gaps(), 1);
-            assert!(
-                (rec - bat).norm() < 1e-9 * bat.norm(),
-                "{stencil:?} chain {max_chain_s:?}: {:e}",
-                (rec - bat).norm() / bat.norm()
-            );
-            // The batch residual is ‖y‖² − ‖Qᵀy‖², which cancels: agreement to 1e-4.
-            assert!((qr.rss - e.reduced().rss).abs() < 1e-4 * qr.rss);
-            assert_eq!(qr.nuisance, e.reduced().nuisance);
+            let gaps = assert_recursive_matches_batch(&samples, rows, 1e-9);
+            assert_eq!(gaps, 1, "{stencil:?} chain {max_chain_s:?}");
         }
     }
+}
+
+/// Recursive and batch reductions of `samples` give the same unconstrained `j` (to
+/// `tolerance`, relative), residual (to 1e-4: the batch residual `‖y‖² − ‖Qᵀy‖²`
+/// cancels) and nuisance count, and see the same gaps; returns the gaps.
+fn assert_recursive_matches_batch(
+    samples: &[Sample],
+    rows: MomentumRowSettings,
+    tolerance: f64,
+) -> usize {
+    let mut e = estimator(rows);
+    for s in samples {
+        e.push(s).expect("push");
+    }
+    let rec =
+        inertia::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z).expect("regular");
+    let b = reduce_batch(samples, &rows).expect("batch");
+    let bat = inertia::solver::unconstrained_minimiser(&b.qr.r, &b.qr.z).expect("regular");
+    let what = format!("{:?} chain {:?}", rows.stencil, rows.max_chain_s);
+    assert!(
+        (rec - bat).norm() < tolerance * bat.norm(),
+        "{what}: {:e}",
+        (rec - bat).norm() / bat.norm()
+    );
+    assert!(
+        (b.qr.rss - e.reduced().rss).abs() < 1e-4 * b.qr.rss,
+        "{what}"
+    );
+    assert_eq!(b.qr.nuisance, e.reduced().nuisance, "{what}");
+    assert_eq!(b.gaps, e.gaps(), "{what}");
+    b.gaps
 }
 
 #[test]
@@ -515,20 +529,7 @@ fn recursive_and_batch_agree_with_constant_wheel_momentum_and_a_rowless_first_ch
             max_chain_s,
             ..Default::default()
         };
-        let mut e = estimator(rows);
-        for s in &samples {
-            e.push(s).expect("push");
-        }
-        let rec = inertia::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z)
-            .expect("regular");
-        let b = reduce_batch(&samples, &rows).expect("batch");
-        let bat = inertia::solver::unconstrained_minimiser(&b.qr.r, &b.qr.z).expect("regular");
-        assert!(
-            (rec - bat).norm() < 1e-8 * bat.norm(),
-            "chain {max_chain_s:?}: {:e}",
-            (rec - bat).norm() / bat.norm()
-        );
-        assert_eq!(b.qr.nuisance, e.reduced().nuisance, "chain {max_chain_s:?}");
+        assert_recursive_matches_batch(&samples, rows, 1e-8);
     }
 }
 
