@@ -129,7 +129,7 @@ impl AugmentedQr {
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
     pub fn residual_variance(&self) -> f64 {
-        let dof = self.weight - 6.0 - self.nuisance;
+        let dof = self.residual_dof();
         if dof > 0.0 {
             self.rss / dof
         } else {

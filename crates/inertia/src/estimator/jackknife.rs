@@ -111,12 +111,6 @@ impl ChainGroups {
         self.chains += 1;
     }
 
-    /// Completed chains.
-    #[must_use]
-    pub fn chains(&self) -> usize {
-        self.chains
-    }
-
     /// The jackknife σ per element, kg m², scaled to include the chain in progress
     /// (module docs); `None` with fewer than [`MIN_GROUPS`] groups or a delete-one-group
     /// problem without a unique solution.

@@ -85,6 +85,17 @@ impl RecursiveQr {
         self.weight - 6.0 - self.nuisance
     }
 
+    /// Residual sum of squares per residual degree of freedom, `∞` without any.
+    #[must_use]
+    pub fn residual_variance(&self) -> f64 {
+        let dof = self.residual_dof();
+        if dof > 0.0 {
+            self.rss / dof
+        } else {
+            f64::INFINITY
+        }
+    }
+
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
     pub fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);

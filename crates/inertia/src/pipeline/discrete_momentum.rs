@@ -104,16 +104,6 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
     }
 }
 
-/// Residual variance of a reduced state, `∞` without residual degrees of freedom.
-fn variance(qr: &RecursiveQr) -> f64 {
-    let dof = qr.residual_dof();
-    if dof > 0.0 {
-        qr.rss / dof
-    } else {
-        f64::INFINITY
-    }
-}
-
 /// The model-uncertainty part of σ: per element, the largest difference between the
 /// chosen candidate's unconstrained `ĵ` and that of any candidate the data cannot tell
 /// apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen one's, with `ν`
@@ -127,7 +117,7 @@ fn model_spread(states: &[RecursiveQr], chosen: usize, gyro: Option<f64>) -> [f6
     let Some(best) = states.get(chosen) else {
         return out;
     };
-    let v_best = variance(best);
+    let v_best = best.residual_variance();
     let dof = best.residual_dof();
     if !(dof > 0.0) {
         return out;
@@ -137,7 +127,7 @@ fn model_spread(states: &[RecursiveQr], chosen: usize, gyro: Option<f64>) -> [f6
         return out;
     };
     for (i, qr) in states.iter().enumerate() {
-        if i == chosen || !(variance(qr) <= ratio * v_best) {
+        if i == chosen || !(qr.residual_variance() <= ratio * v_best) {
             continue;
         }
         if let Some(j) = own_solution(qr, gyro) {
@@ -500,11 +490,13 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     for rows in candidates(c, has_gyro) {
         reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
-    let chosen = choose(
-        reduced
-            .iter()
-            .map(|(rows, b)| (variance(&b.qr), b.qr.residual_dof(), rows.max_chain_s)),
-    );
+    let chosen = choose(reduced.iter().map(|(rows, b)| {
+        (
+            b.qr.residual_variance(),
+            b.qr.residual_dof(),
+            rows.max_chain_s,
+        )
+    }));
     let Some((rows, batch)) = reduced.get(chosen) else {
         return Err(PipelineError::NoBatch {
             estimator: DISCRETE_MOMENTUM.name,
@@ -554,7 +546,9 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         if matches!(estimate.observability, Observability::Determined { .. }) {
             let mut others = Vec::new();
             for (i, (_, b)) in reduced.iter().enumerate() {
-                if i == chosen || !(variance(&b.qr) <= COMPARABLE_FIT * variance(qr)) {
+                if i == chosen
+                    || !(b.qr.residual_variance() <= COMPARABLE_FIT * qr.residual_variance())
+                {
                     continue;
                 }
                 if let (e, Some(sigma)) = own(b)? {
