@@ -65,7 +65,7 @@
 //! (`0`: none) for experiments; unset, the default.
 
 use inertia::constraints::ConstraintSet;
-use inertia::estimator::observability::Observability;
+use inertia::estimator::observability::{Observability, Unobservable};
 use inertia::estimator::Estimate;
 use inertia::pipeline::{Pipeline, PipelineSettings};
 use inertia::sample::Sample;
@@ -307,7 +307,13 @@ const ESTIMATORS: [(&str, bool); 4] = [
     ("discrete-momentum", true),
 ];
 
-fn estimate(samples: &[Sample], estimator: &str, gyro_deg_s_rthz: Option<f64>) -> Option<Estimate> {
+/// The final estimate and the largest residual variance ratio of a segment to the rest
+/// (`Pipeline::residual_consistency`).
+fn estimate(
+    samples: &[Sample],
+    estimator: &str,
+    gyro_deg_s_rthz: Option<f64>,
+) -> Option<(Option<Estimate>, Option<f64>)> {
     let mut p = Pipeline::new(&PipelineSettings {
         estimator: estimator.into(),
         gyro_noise_deg_s_rthz: gyro_deg_s_rthz,
@@ -333,7 +339,7 @@ fn estimate(samples: &[Sample], estimator: &str, gyro_deg_s_rthz: Option<f64>) -
     for s in samples {
         p.push(s).ok()?;
     }
-    p.last().copied()
+    Some((p.last().copied(), p.residual_consistency().map(|w| w.ratio)))
 }
 
 #[derive(Default, Clone)]
@@ -346,10 +352,24 @@ struct Stats {
     failed: usize,
     /// `σ_F / ‖Ĵ − J‖_F` of every answer with a σ.
     sigma_ratios: Vec<f64>,
+    /// The largest residual variance ratio of a segment to the rest, per run.
+    residual_ratios: Vec<f64>,
+    /// Runs whose answer was withdrawn for inconsistent residuals.
+    inconsistent: usize,
 }
 
 impl Stats {
-    fn record(&mut self, e: Option<&Estimate>, truth: &Matrix3<f64>) {
+    fn record(&mut self, run: Option<&(Option<Estimate>, Option<f64>)>, truth: &Matrix3<f64>) {
+        self.residual_ratios.extend(run.and_then(|r| r.1));
+        let e = run.and_then(|r| r.0.as_ref());
+        if e.is_some_and(|e| {
+            matches!(
+                e.observability,
+                Observability::NotObservable(Unobservable::Inconsistent { .. })
+            )
+        }) {
+            self.inconsistent += 1;
+        }
         let Some((e, j)) = e.and_then(|e| Some((e, e.inertia()?))) else {
             self.failed += 1;
             return;
@@ -402,6 +422,19 @@ impl Stats {
         format!("{:.1}", quantile(&self.sigma_ratios, 0.5))
     }
 
+    fn residual_ratio(&self) -> String {
+        if self.residual_ratios.is_empty() {
+            return "none".into();
+        }
+        let max = self.residual_ratios.iter().copied().fold(0.0, f64::max);
+        format!(
+            "{:.1} / {:.1} ({} withdrawn)",
+            quantile(&self.residual_ratios, 0.5),
+            max,
+            self.inconsistent
+        )
+    }
+
     fn determined_beyond(&self) -> String {
         if self.determined == 0 {
             return "none determined".into();
@@ -427,7 +460,7 @@ fn quantile(v: &[f64], q: f64) -> f64 {
 /// each estimator, s.
 struct Run {
     truth: Matrix3<f64>,
-    estimates: [Option<Estimate>; 4],
+    estimates: [Option<(Option<Estimate>, Option<f64>)>; 4],
     seconds: [f64; 5],
 }
 
@@ -538,9 +571,9 @@ fn main() {
     let wall = start.elapsed();
 
     println!(
-        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ |"
+        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ | DM residual ratio: median / max (withdrawn) | variational residual ratio: median / max (withdrawn) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (c, cell) in cells.iter().enumerate() {
         let mut stats = vec![Stats::default(); 4];
         for r in runs
@@ -554,7 +587,7 @@ fn main() {
             }
         }
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             cell.craft.name(),
             cell.attitude.name(cell.craft),
             cell.telemetry(),
@@ -569,6 +602,8 @@ fn main() {
             stats[3].errors(),
             stats[3].coverage(),
             stats[3].determined_beyond(),
+            stats[0].residual_ratio(),
+            stats[1].residual_ratio(),
         );
     }
     let busy: f64 = runs.iter().flat_map(|r| r.seconds).sum();

@@ -120,6 +120,12 @@ impl AugmentedQr {
         self.weight
     }
 
+    /// Residual sum of squares `ρ²` (weighted).
+    #[must_use]
+    pub fn rss(&self) -> f64 {
+        self.rss
+    }
+
     /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
     #[must_use]
     pub fn residual_dof(&self) -> f64 {

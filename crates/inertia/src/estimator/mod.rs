@@ -16,6 +16,7 @@ pub mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
 pub mod compensation;
+pub mod consistency;
 pub mod discrete_momentum;
 #[cfg(feature = "std")]
 pub mod excitation;

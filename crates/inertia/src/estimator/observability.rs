@@ -101,6 +101,16 @@ pub enum Unobservable {
         /// Largest `|ĵ_a − ĵ_b| / √(σ_a² + σ_b²)` over the elements.
         z: f64,
     },
+    /// One span of the record has residuals far larger than the rest: the model did not
+    /// hold there ([`super::consistency`]).
+    Inconsistent {
+        /// That span's residual variance over the rest's.
+        ratio: f64,
+        /// Its first sample's time, s.
+        t_start_s: f64,
+        /// Its last sample's time, s.
+        t_end_s: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -165,6 +175,14 @@ impl core::fmt::Display for Unobservable {
             Unobservable::SourcesDisagree { z } => write!(
                 f,
                 "the answers with the rotation from the attitude and from the gyro differ by {z:.1} standard deviations: the attitude and the gyro disagree beyond their noise (a gyro scale factor or misalignment, a time-tag skew, or a wrong frame)"
+            ),
+            Unobservable::Inconsistent {
+                ratio,
+                t_start_s,
+                t_end_s,
+            } => write!(
+                f,
+                "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {ratio:.1e} times the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or use --memory for a J that changes"
             ),
             Unobservable::IllConditioned {
                 condition,

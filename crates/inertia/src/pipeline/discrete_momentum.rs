@@ -18,6 +18,7 @@ use super::settings::PipelineConfig;
 use super::PipelineError;
 use crate::estimator::audit::audit;
 use crate::estimator::compensation::compensate;
+use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::discrete_momentum::{
     reduce_batch, BatchReduction, DiscreteMomentumEstimator, MomentumEstimatorSettings,
 };
@@ -224,6 +225,8 @@ struct DiscreteMomentum {
     checks: Vec<Option<CrossCheck>>,
     /// The first candidate's rows on every other sample, for the discretisation bias.
     shadow: Option<Box<Candidate>>,
+    /// Per candidate, its residual record (none under forgetting).
+    residuals: Vec<ResidualSegments>,
     /// Input samples so far.
     samples: usize,
     /// The even sample waiting for its successor (the shadow's next sample).
@@ -307,6 +310,7 @@ fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
         since_solve: 0,
         checks: Vec::new(),
         shadow: None,
+        residuals: Vec::new(),
         samples: 0,
         held: None,
     }))
@@ -385,8 +389,16 @@ impl Estimator for DiscreteMomentum {
             self.start(s)?;
         }
         let mut folded = false;
-        for c in &mut self.candidates {
-            folded |= c.fold(s)?;
+        let record = self.config.memory_s.is_none();
+        self.residuals
+            .resize(self.candidates.len(), ResidualSegments::new());
+        for (c, r) in self.candidates.iter_mut().zip(&mut self.residuals) {
+            if c.fold(s)? {
+                folded = true;
+                if record {
+                    r.record(c.qr().rss(), c.qr().residual_dof(), s.t_s);
+                }
+            }
         }
         if let Some(shadow) = self.shadow.as_mut() {
             // Every other sample, its gyro rate averaged over the double step: fed one
@@ -456,6 +468,9 @@ impl Estimator for DiscreteMomentum {
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
         );
+        if let Some(r) = self.residuals.get(self.chosen).filter(|_| record) {
+            consistency::check(&mut e, r);
+        }
         Ok(Some(e))
     }
 
@@ -474,6 +489,10 @@ impl Estimator for DiscreteMomentum {
 
     fn torque_bias_nm(&self) -> Option<Vector3<f64>> {
         self.candidates.get(self.chosen)?.torque_bias_nm()
+    }
+
+    fn residual_consistency(&self) -> Option<Worst> {
+        self.residuals.get(self.chosen)?.worst()
     }
 }
 

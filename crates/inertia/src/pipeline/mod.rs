@@ -289,6 +289,14 @@ impl Pipeline {
         self.estimator.torque_bias_nm()
     }
 
+    /// The span of the record whose residuals stand out most from the rest, with their
+    /// variance ratio ([`crate::estimator::consistency`]; estimators that test their
+    /// residuals, without forgetting).
+    #[must_use]
+    pub fn residual_consistency(&self) -> Option<crate::estimator::consistency::Worst> {
+        self.estimator.residual_consistency()
+    }
+
     /// The excitation report of the data so far (estimators with a least-squares state).
     #[must_use]
     pub fn excitation(&self) -> Option<Excitation> {

@@ -5,6 +5,7 @@
 
 use super::settings::PipelineConfig;
 use super::PipelineError;
+use crate::estimator::consistency::Worst;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::{Estimate, EstimatorError};
@@ -31,6 +32,11 @@ pub trait Estimator: Send {
     }
     /// The estimated constant body-frame disturbance torque, N m, where estimated.
     fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
+        None
+    }
+    /// The span of the record whose residuals stand out most, where the estimator tests
+    /// its residuals ([`crate::estimator::consistency`]).
+    fn residual_consistency(&self) -> Option<Worst> {
         None
     }
 }

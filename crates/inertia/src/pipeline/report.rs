@@ -8,11 +8,14 @@
 //! `samples`, `gaps`, `t`, `status` ([`Observability::code`]), `reason`, `condition`,
 //! `inertia` (3×3, kg m²), `j`, `sigma`, `principal_moments`, `principal_moments_sigma`,
 //! `principal_axes` (columns), `solver_status`, `iterations`, `relative_error` (against a
-//! given truth), `excitation`. Absent values are `null`.
+//! given truth), `excitation`, `residual_consistency` (the span whose residuals stand out
+//! most: `ratio`, `t_start_s`, `t_end_s`; [`crate::estimator::consistency`]). Absent
+//! values are `null`.
 //!
 //! [`Observability::code`]: crate::estimator::observability::Observability::code
 
 use super::settings::PipelineConfig;
+use crate::estimator::consistency::{Worst, INCONSISTENT_RATIO};
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
@@ -96,6 +99,8 @@ pub struct Report {
     pub row_model: Option<MomentumRowSettings>,
     /// The estimated constant body-frame disturbance torque, N m.
     pub torque_bias_nm: Option<[f64; 3]>,
+    /// The span whose residuals stand out most from the rest.
+    pub residual_consistency: Option<Worst>,
     #[serde(skip)]
     observability: Observability,
 }
@@ -147,6 +152,7 @@ impl Report {
             excitation: None,
             row_model: None,
             torque_bias_nm: None,
+            residual_consistency: None,
             observability: estimate.observability,
         }
     }
@@ -175,6 +181,13 @@ impl Report {
     ) -> Self {
         self.row_model = row_model;
         self.torque_bias_nm = torque_bias_nm.map(|t| [t.x, t.y, t.z]);
+        self
+    }
+
+    /// With the residual-consistency test's worst span, where the estimator makes it.
+    #[must_use]
+    pub fn with_residual_consistency(mut self, worst: Option<Worst>) -> Self {
+        self.residual_consistency = worst;
         self
     }
 
@@ -264,6 +277,13 @@ impl fmt::Display for Report {
         }
         if let Some(e) = self.relative_error {
             writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;
+        }
+        if let Some(w) = self.residual_consistency {
+            writeln!(
+                s,
+                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {:.1e} times the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
+                w.t_start_s, w.t_end_s, w.ratio
+            )?;
         }
         if let Some(x) = &self.excitation {
             let mut line = String::from("excitation: singular values of R");

@@ -6,6 +6,7 @@ use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry
 use super::settings::PipelineConfig;
 use super::PipelineError;
 use crate::estimator::audit::audit;
+use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use crate::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
@@ -52,6 +53,8 @@ struct Sdp<S: RowSource> {
     main: Recursive<S>,
     shadow: Option<Box<Recursive<S>>>,
     samples: usize,
+    /// The main estimator's residual record (none under forgetting).
+    residuals: Option<ResidualSegments>,
     observability: crate::estimator::observability::ObservabilitySettings,
     epsilon_kg_m2: f64,
 }
@@ -98,6 +101,7 @@ fn build<S: RowSource + Default + Send + 'static>(
         main,
         shadow,
         samples: 0,
+        residuals: c.memory_s.is_none().then(ResidualSegments::new),
         observability: c.observability,
         epsilon_kg_m2: c.constraints.set().epsilon_kg_m2,
     }))
@@ -111,7 +115,12 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
             }
         }
         self.samples += 1;
-        let Some(mut e) = self.main.push(s)? else {
+        let pushed = self.main.push(s)?;
+        if let Some(r) = self.residuals.as_mut() {
+            let qr = self.main.qr();
+            r.record(qr.rss, qr.residual_dof(), s.t_s);
+        }
+        let Some(mut e) = pushed else {
             return Ok(None);
         };
         if let (Some(half), Some(j), Some(noise)) = (&self.shadow, e.j(), self.main.noise_sigma()) {
@@ -124,6 +133,9 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
             self.epsilon_kg_m2,
             self.observability.max_relative_sigma,
         );
+        if let Some(r) = &self.residuals {
+            consistency::check(&mut e, r);
+        }
         Ok(Some(e))
     }
 
@@ -133,6 +145,10 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
 
     fn excitation(&self) -> Option<Excitation> {
         (self.main.qr().rows > 0).then(|| diagnose(self.main.qr(), &self.observability))
+    }
+
+    fn residual_consistency(&self) -> Option<Worst> {
+        self.residuals.as_ref()?.worst()
     }
 }
 
