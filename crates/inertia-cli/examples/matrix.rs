@@ -307,13 +307,19 @@ const ESTIMATORS: [(&str, bool); 4] = [
     ("discrete-momentum", true),
 ];
 
-/// The final estimate and the largest residual variance ratio of a segment to the rest
-/// (`Pipeline::residual_consistency`).
-fn estimate(
-    samples: &[Sample],
-    estimator: &str,
-    gyro_deg_s_rthz: Option<f64>,
-) -> Option<(Option<Estimate>, Option<f64>)> {
+/// One estimator's outcome on one run.
+struct Outcome {
+    /// The final estimate.
+    estimate: Option<Estimate>,
+    /// The largest residual variance ratio of a span to the rest
+    /// (`Pipeline::residual_consistency`).
+    residual_ratio: Option<f64>,
+    /// The residual variance over the part the stated gyro density implies
+    /// (`Pipeline::gyro_density_ratio`).
+    density_ratio: Option<f64>,
+}
+
+fn estimate(samples: &[Sample], estimator: &str, gyro_deg_s_rthz: Option<f64>) -> Option<Outcome> {
     let mut p = Pipeline::new(&PipelineSettings {
         estimator: estimator.into(),
         gyro_noise_deg_s_rthz: gyro_deg_s_rthz,
@@ -339,7 +345,11 @@ fn estimate(
     for s in samples {
         p.push(s).ok()?;
     }
-    Some((p.last().copied(), p.residual_consistency().map(|w| w.ratio)))
+    Some(Outcome {
+        estimate: p.last().copied(),
+        residual_ratio: p.residual_consistency().map(|w| w.ratio),
+        density_ratio: p.gyro_density_ratio(),
+    })
 }
 
 #[derive(Default, Clone)]
@@ -356,16 +366,23 @@ struct Stats {
     residual_ratios: Vec<f64>,
     /// Runs whose answer was withdrawn for inconsistent residuals.
     inconsistent: usize,
+    /// The residual variance over the part the stated gyro density implies, per run.
+    density_ratios: Vec<f64>,
 }
 
 impl Stats {
-    fn record(&mut self, run: Option<&(Option<Estimate>, Option<f64>)>, truth: &Matrix3<f64>) {
-        self.residual_ratios.extend(run.and_then(|r| r.1));
-        let e = run.and_then(|r| r.0.as_ref());
+    fn record(&mut self, run: Option<&Outcome>, truth: &Matrix3<f64>) {
+        self.residual_ratios
+            .extend(run.and_then(|r| r.residual_ratio));
+        self.density_ratios
+            .extend(run.and_then(|r| r.density_ratio));
+        let e = run.and_then(|r| r.estimate.as_ref());
         if e.is_some_and(|e| {
             matches!(
                 e.observability,
-                Observability::NotObservable(Unobservable::Inconsistent { .. })
+                Observability::NotObservable(
+                    Unobservable::Inconsistent { .. } | Unobservable::DensityOverstated { .. }
+                )
             )
         }) {
             self.inconsistent += 1;
@@ -435,6 +452,18 @@ impl Stats {
         )
     }
 
+    fn density_ratio(&self) -> String {
+        if self.density_ratios.is_empty() {
+            return "none".into();
+        }
+        let min = self
+            .density_ratios
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        format!("{:.2} / {:.2}", quantile(&self.density_ratios, 0.5), min)
+    }
+
     fn determined_beyond(&self) -> String {
         if self.determined == 0 {
             return "none determined".into();
@@ -460,7 +489,7 @@ fn quantile(v: &[f64], q: f64) -> f64 {
 /// each estimator, s.
 struct Run {
     truth: Matrix3<f64>,
-    estimates: [Option<(Option<Estimate>, Option<f64>)>; 4],
+    estimates: [Option<Outcome>; 4],
     seconds: [f64; 5],
 }
 
@@ -571,9 +600,9 @@ fn main() {
     let wall = start.elapsed();
 
     println!(
-        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ | DM residual ratio: median / max (withdrawn) | variational residual ratio: median / max (withdrawn) |"
+        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ | DM residual ratio: median / max (withdrawn) | variational residual ratio: median / max (withdrawn) | DM given the density: residual / density variance, median / min (withdrawn) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (c, cell) in cells.iter().enumerate() {
         let mut stats = vec![Stats::default(); 4];
         for r in runs
@@ -587,7 +616,7 @@ fn main() {
             }
         }
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) |",
             cell.craft.name(),
             cell.attitude.name(cell.craft),
             cell.telemetry(),
@@ -604,6 +633,8 @@ fn main() {
             stats[3].determined_beyond(),
             stats[0].residual_ratio(),
             stats[1].residual_ratio(),
+            stats[3].density_ratio(),
+            stats[3].inconsistent,
         );
     }
     let busy: f64 = runs.iter().flat_map(|r| r.seconds).sum();

@@ -63,7 +63,8 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     });
     let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
     let mut first_times = [f64::NAN; 2];
-    let (last, excitation, samples, gaps, row_model, torque, residuals) = if a.batch {
+    let (last, excitation, samples, gaps, row_model, torque, residuals, density_ratio) = if a.batch
+    {
         let mut all = Vec::new();
         let mut lines = Vec::new();
         while let Some(item) = reader.next() {
@@ -92,6 +93,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             all.len(),
             out.gaps,
             out.row_model,
+            None,
             None,
             None,
         )
@@ -127,6 +129,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             p.row_model(),
             p.torque_bias_nm(),
             p.residual_consistency(),
+            p.gyro_density_ratio(),
         )
     };
     if let Some(p) = progress {
@@ -161,7 +164,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         })
         .with_excitation(excitation)
         .with_row_model(row_model, torque)
-        .with_residual_consistency(residuals)
+        .with_residual_tests(residuals, density_ratio)
         .with_truth(truth.as_ref());
     if a.json {
         println!(

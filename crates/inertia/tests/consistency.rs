@@ -4,6 +4,7 @@
 
 use inertia::attitude::Quaternion;
 use inertia::constraints::ConstraintSet;
+use inertia::estimator::consistency::DENSITY_OVERSTATED_RATIO;
 use inertia::estimator::momentum_rows::RotationSource;
 use inertia::estimator::observability::{Observability, Unobservable};
 use inertia::estimator::Estimate;
@@ -165,4 +166,47 @@ fn an_attitude_glitch_is_caught_or_ignored() {
     assert!(matches!(e.observability, Observability::Determined { .. }));
     let err = relative_frobenius_error(&e.inertia().unwrap(), &paper_j_true());
     assert!(err < 1e-5, "{err:e}");
+}
+
+/// The gyro density given with the telemetry: right, the residual variance is what it
+/// implies (the errors-in-variables noise model, `noise_s`, predicts it); three times too
+/// large, the compensation would over-correct, and the answer is withdrawn with a message
+/// that names the option and the units.
+#[test]
+fn an_overstated_gyro_density_is_caught() {
+    let mems = 2.5e-3;
+    let s = samples(None, mems, 2);
+    // The discrete momentum estimator's test (its rows' noise is white from row to row).
+    for name in ["discrete-momentum"] {
+        for (factor, expect_ok) in [(1.0, true), (3.0, false)] {
+            let mut p = Pipeline::new(&PipelineSettings {
+                gyro_noise_deg_s_rthz: Some(factor * mems),
+                constraints: ConstraintSet::positive_definite(),
+                solve_every: 50,
+                ..estimator(name)
+            })
+            .unwrap();
+            for x in &s {
+                p.push(x).unwrap();
+            }
+            let e = p.last().unwrap();
+            let ratio = p.gyro_density_ratio();
+            eprintln!(
+                "{name}, density x{factor}: ratio {ratio:.3?}, {:?}",
+                e.observability
+            );
+            if expect_ok {
+                assert!(ratio.is_some_and(|r| (0.8..1.5).contains(&r)), "{ratio:?}");
+            } else {
+                let ratio = ratio.unwrap();
+                assert!(ratio < DENSITY_OVERSTATED_RATIO, "{ratio}");
+                assert!(matches!(
+                    e.observability,
+                    Observability::NotObservable(Unobservable::DensityOverstated { .. })
+                ));
+                let reason = e.observability.reason().unwrap().to_string();
+                assert!(reason.contains("--gyro-noise") && reason.contains("60"));
+            }
+        }
+    }
 }

@@ -30,8 +30,11 @@
 //! 90° attitude glitch). Under exponential forgetting the increments are reweighted and
 //! the test is not made.
 
+use super::compensation::NOISE_GRAM_DIAGONAL;
 use super::observability::{Observability, Unobservable};
+use super::qr::RecursiveQr;
 use super::Estimate;
+use crate::tensor::InertiaVector;
 
 /// Largest number of complete segments kept.
 pub const MAX_SEGMENTS: usize = 32;
@@ -210,25 +213,57 @@ impl ResidualSegments {
     }
 }
 
-/// Withdraw the answer of `e` when `segments` are inconsistent
-/// ([`Unobservable::Inconsistent`]): a model that failed for part of the record leaves
-/// an answer that is no mixture's truth, and σ does not know it.
-pub fn check(e: &mut Estimate, segments: &ResidualSegments) {
+/// Below this ratio of the residual variance to the part the stated gyro density alone
+/// implies ([`gyro_density_ratio`]), the density is overstated.
+pub const DENSITY_OVERSTATED_RATIO: f64 = 0.5;
+
+/// Withdraw the answer of `e` when its residuals contradict the model or the noise: a
+/// span of the record inconsistent with the rest ([`ResidualSegments::inconsistent`],
+/// [`Unobservable::Inconsistent`]), or residuals smaller than the stated gyro density
+/// implies ([`DENSITY_OVERSTATED_RATIO`], [`Unobservable::DensityOverstated`]). A model
+/// that failed for part of the record leaves an answer that is no mixture's truth, and an
+/// overstated density an over-compensated one; σ knows neither.
+pub fn check(e: &mut Estimate, segments: Option<&ResidualSegments>, density_ratio: Option<f64>) {
     if !matches!(
         e.observability,
         Observability::Determined { .. } | Observability::FromPrior(_)
     ) {
         return;
     }
-    if let Some(w) = segments.inconsistent() {
-        e.observability = Observability::NotObservable(Unobservable::Inconsistent {
+    let why = if let Some(w) = segments.and_then(ResidualSegments::inconsistent) {
+        Unobservable::Inconsistent {
             ratio: w.ratio,
             t_start_s: w.t_start_s,
             t_end_s: w.t_end_s,
-        });
-        e.solution = None;
-        e.uncertainty = None;
-    }
+        }
+    } else if let Some(ratio) = density_ratio.filter(|r| *r < DENSITY_OVERSTATED_RATIO) {
+        Unobservable::DensityOverstated { ratio }
+    } else {
+        return;
+    };
+    e.observability = Observability::NotObservable(why);
+    e.solution = None;
+    e.uncertainty = None;
+}
+
+/// The residual variance per degree of freedom of `qr` over the part a gyro of rate-noise
+/// density `gyro_noise_rad_s_rthz` alone would put into its rows at `j`:
+/// `σ² c jᵀDj / rows`, with `c = Σ noise_s` and `D` of [`super::compensation`] (the
+/// expected energy of `δH j`, white from row to row). Every other error source (the
+/// wheels, the disturbance torque, the star tracker, the model) only adds to the
+/// residuals, so a ratio well below one says that the stated density is too large, and
+/// the errors-in-variables compensation built on it removes information the rows do not
+/// lack. `None` without residual degrees of freedom or modelled noise.
+#[must_use]
+pub fn gyro_density_ratio(
+    qr: &RecursiveQr,
+    j: &InertiaVector,
+    gyro_noise_rad_s_rthz: f64,
+) -> Option<f64> {
+    let d: f64 = (0..6).map(|k| NOISE_GRAM_DIAGONAL[k] * j[k] * j[k]).sum();
+    let predicted = gyro_noise_rad_s_rthz * gyro_noise_rad_s_rthz * qr.noise_s * d / qr.rows as f64;
+    let ratio = qr.residual_variance() / predicted;
+    (predicted > 0.0 && ratio.is_finite()).then_some(ratio)
 }
 
 #[cfg(test)]

@@ -111,6 +111,13 @@ pub enum Unobservable {
         /// Its last sample's time, s.
         t_end_s: f64,
     },
+    /// The residuals are smaller than the stated gyro noise density alone implies: the
+    /// density is overstated, and the errors-in-variables compensation built on it
+    /// over-corrects ([`super::consistency::gyro_density_ratio`]).
+    DensityOverstated {
+        /// Residual variance over the part the stated density implies.
+        ratio: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -183,6 +190,10 @@ impl core::fmt::Display for Unobservable {
             } => write!(
                 f,
                 "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {ratio:.1e} times the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or use --memory for a J that changes"
+            ),
+            Unobservable::DensityOverstated { ratio } => write!(
+                f,
+                "the residuals are {ratio:.1e} times the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (--gyro-noise is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)"
             ),
             Unobservable::IllConditioned {
                 condition,

@@ -227,6 +227,8 @@ struct DiscreteMomentum {
     shadow: Option<Box<Candidate>>,
     /// Per candidate, its residual record (none under forgetting).
     residuals: Vec<ResidualSegments>,
+    /// The residuals' ratio to the stated gyro density at the last solve.
+    density_ratio: Option<f64>,
     /// Input samples so far.
     samples: usize,
     /// The even sample waiting for its successor (the shadow's next sample).
@@ -311,6 +313,7 @@ fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
         checks: Vec::new(),
         shadow: None,
         residuals: Vec::new(),
+        density_ratio: None,
         samples: 0,
         held: None,
     }))
@@ -468,9 +471,22 @@ impl Estimator for DiscreteMomentum {
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
         );
-        if let Some(r) = self.residuals.get(self.chosen).filter(|_| record) {
-            consistency::check(&mut e, r);
-        }
+        // The density describes the gyro: its rows are the ones to compare with it (with
+        // an attitude better than the gyro, the attitude's rows are quieter).
+        let described = self
+            .candidates
+            .iter()
+            .find(|c| c.row_settings().rotation == RotationSource::Gyro)
+            .unwrap_or(c);
+        self.density_ratio = match (self.config.gyro_noise_rad_s_rthz, e.j()) {
+            (Some(g), Some(j)) => consistency::gyro_density_ratio(&described.qr().reduced(), &j, g),
+            _ => None,
+        };
+        consistency::check(
+            &mut e,
+            self.residuals.get(self.chosen).filter(|_| record),
+            self.density_ratio,
+        );
         Ok(Some(e))
     }
 
@@ -493,6 +509,10 @@ impl Estimator for DiscreteMomentum {
 
     fn residual_consistency(&self) -> Option<Worst> {
         self.residuals.get(self.chosen)?.worst()
+    }
+
+    fn gyro_density_ratio(&self) -> Option<f64> {
+        self.density_ratio
     }
 }
 

@@ -297,6 +297,15 @@ impl Pipeline {
         self.estimator.residual_consistency()
     }
 
+    /// At the last solve with a stated gyro density, the residual variance over the part
+    /// that density alone implies (below
+    /// [`crate::estimator::consistency::DENSITY_OVERSTATED_RATIO`] the density is
+    /// overstated).
+    #[must_use]
+    pub fn gyro_density_ratio(&self) -> Option<f64> {
+        self.estimator.gyro_density_ratio()
+    }
+
     /// The excitation report of the data so far (estimators with a least-squares state).
     #[must_use]
     pub fn excitation(&self) -> Option<Excitation> {

@@ -39,6 +39,11 @@ pub trait Estimator: Send {
     fn residual_consistency(&self) -> Option<Worst> {
         None
     }
+    /// At the last solve with a stated gyro density, the residual variance over the part
+    /// that density alone implies ([`crate::estimator::consistency::gyro_density_ratio`]).
+    fn gyro_density_ratio(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The answer of a batch run.

@@ -9,13 +9,14 @@
 //! `inertia` (3×3, kg m²), `j`, `sigma`, `principal_moments`, `principal_moments_sigma`,
 //! `principal_axes` (columns), `solver_status`, `iterations`, `relative_error` (against a
 //! given truth), `excitation`, `residual_consistency` (the span whose residuals stand out
-//! most: `ratio`, `t_start_s`, `t_end_s`; [`crate::estimator::consistency`]). Absent
-//! values are `null`.
+//! most: `ratio`, `t_start_s`, `t_end_s`; [`crate::estimator::consistency`]),
+//! `gyro_density_ratio` (the residual variance over the part the stated gyro density
+//! implies). Absent values are `null`.
 //!
 //! [`Observability::code`]: crate::estimator::observability::Observability::code
 
 use super::settings::PipelineConfig;
-use crate::estimator::consistency::{Worst, INCONSISTENT_RATIO};
+use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO};
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
@@ -101,6 +102,8 @@ pub struct Report {
     pub torque_bias_nm: Option<[f64; 3]>,
     /// The span whose residuals stand out most from the rest.
     pub residual_consistency: Option<Worst>,
+    /// The residual variance over the part the stated gyro density alone implies.
+    pub gyro_density_ratio: Option<f64>,
     #[serde(skip)]
     observability: Observability,
 }
@@ -153,6 +156,7 @@ impl Report {
             row_model: None,
             torque_bias_nm: None,
             residual_consistency: None,
+            gyro_density_ratio: None,
             observability: estimate.observability,
         }
     }
@@ -184,10 +188,12 @@ impl Report {
         self
     }
 
-    /// With the residual-consistency test's worst span, where the estimator makes it.
+    /// With the residual tests' findings, where the estimator makes them: the worst span
+    /// and the ratio to the stated gyro density.
     #[must_use]
-    pub fn with_residual_consistency(mut self, worst: Option<Worst>) -> Self {
+    pub fn with_residual_tests(mut self, worst: Option<Worst>, density_ratio: Option<f64>) -> Self {
         self.residual_consistency = worst;
+        self.gyro_density_ratio = density_ratio;
         self
     }
 
@@ -283,6 +289,12 @@ impl fmt::Display for Report {
                 s,
                 "residuals: the most distinct span, t = {:.1}–{:.1} s, has {:.1e} times the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
                 w.t_start_s, w.t_end_s, w.ratio
+            )?;
+        }
+        if let Some(r) = self.gyro_density_ratio {
+            writeln!(
+                s,
+                "residuals: {r:.2} times the variance the stated gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
             )?;
         }
         if let Some(x) = &self.excitation {
