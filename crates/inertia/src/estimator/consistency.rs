@@ -11,24 +11,34 @@
 //! (Brown, Durbin & Evans, 1975), so the increment of `ρ²` over a span of the record
 //! with `d` residual degrees of freedom is `s²χ²_d`, independent of the rest, whatever
 //! `s` is: the ratio of its mean square to the rest's is `F(d, D − d)`-distributed, and
-//! no noise level has to be known.
+//! no noise level has to be known. That is the idea; the rows here are not white (the
+//! Richardson rows average neighbouring steps, the paper's rows difference them, and the
+//! momentum's random walk correlates a chain), so the thresholds below are empirical.
 //!
-//! **Segments.** The record is cut into consecutive segments of at least
+//! **Spans.** The record is cut into consecutive segments of at least
 //! [`FIRST_SEGMENT_DOF`] residual degrees of freedom; when [`MAX_SEGMENTS`] are complete,
 //! neighbours are merged pairwise and the segment length doubles, so that memory is fixed
-//! and any record has between `MAX_SEGMENTS/2` and `MAX_SEGMENTS` segments. The
-//! statistic is the largest ratio of a segment's residual variance to that of all the
-//! other segments, [`Worst::ratio`].
+//! and a long record has between `MAX_SEGMENTS/2` and `MAX_SEGMENTS` complete segments
+//! (the test starts at [`MIN_SEGMENTS`]; the open segment, the newest data, is not
+//! tested until it completes). A span is
+//! one segment (against all the others: a glitch), or the record after a segment
+//! boundary (against the record before it: a change that persists), or before it
+//! (against after). Its statistic is the ratio of its residual variance to the rest's.
 //!
-//! **Threshold.** Row errors are not white in practice: an unmodelled disturbance torque
-//! integrates into a random walk of the momentum along each chain, a propagated attitude
-//! drifts, and at a slow telemetry rate the discretisation remainder grows with the
-//! angular rate, so honest residual variances vary from segment to segment by more than
-//! `F` allows. The threshold [`INCONSISTENT_RATIO`] is set from the honest cells of the
-//! Monte Carlo matrix (README), far above their largest ratio; what it catches is a model
-//! that fails outright for part of the record (tests: a 20 % change of J mid-run, one
-//! 90° attitude glitch). Under exponential forgetting the increments are reweighted and
-//! the test is not made.
+//! **Threshold, and what a span must have done.** Row errors are not white in practice:
+//! an unmodelled disturbance torque integrates into a random walk of the momentum along
+//! each chain, a propagated attitude drifts, and the discretisation remainder grows with
+//! the angular rate (at 1 Hz, at a wheel pulse, or on noise-free data, where it is all
+//! there is), so honest residual variances differ between spans by far more than `F`
+//! allows: ratios up to 92 in the Monte Carlo matrix (README), 970 on a noise-free spin.
+//! Such a span is harmless when the answer does not depend on it. So a span is
+//! inconsistent when its ratio exceeds [`INCONSISTENT_RATIO`] *and* the answer moved, with
+//! or without it, beyond [`SHIFT_Z`] of its own stated σ: the estimate now is compared
+//! with the last answer before the span (its σ), or, for a span at the start of the
+//! record, with the first one after it. A change of J moves the answer by many σ,
+//! a glitch that the rows feel does too; a noisier stretch of honest data does not.
+//! Without any stated σ (no uncertainty model) the ratio alone decides. Under exponential
+//! forgetting the increments are reweighted and the test is not made.
 
 use super::compensation::NOISE_GRAM_DIAGONAL;
 use super::observability::{Observability, Unobservable};
@@ -45,17 +55,33 @@ pub const MIN_SEGMENTS: usize = 8;
 /// Residual degrees of freedom of a segment before the first merge.
 pub const FIRST_SEGMENT_DOF: f64 = 60.0;
 
-/// Ratio of one segment's residual variance to the rest's beyond which the residuals are
-/// inconsistent with one model and noise level.
+/// Ratio of a span's residual variance to the rest's beyond which it may be inconsistent
+/// with one model and noise level.
 pub const INCONSISTENT_RATIO: f64 = 300.0;
 
-/// A span of the record: its share of `ρ²` and of the residual degrees of freedom.
+/// Shift of the answer, in its own stated σ (largest over the elements), that makes a
+/// span beyond [`INCONSISTENT_RATIO`] inconsistent. On a noise-free spin, whose spans
+/// reach ratios of 970 from the discretisation remainder alone, the answers moved by up
+/// to 10.1 of their early σ (which, without noise, is too small); in the broken runs of
+/// `tests/consistency.rs`, by at least 52.
+pub const SHIFT_Z: f64 = 20.0;
+
+/// An answer and its stated σ per element.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Snapshot {
+    j: InertiaVector,
+    sigma: [f64; 6],
+}
+
+/// A span of the record: its share of `ρ²` and of the residual degrees of freedom, and
+/// the last answer before it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct Segment {
     rss: f64,
     dof: f64,
     t_start_s: f64,
     t_end_s: f64,
+    before: Option<Snapshot>,
 }
 
 impl Segment {
@@ -65,20 +91,34 @@ impl Segment {
             dof: self.dof + next.dof,
             t_start_s: self.t_start_s,
             t_end_s: next.t_end_s,
+            before: self.before,
+        }
+    }
+
+    fn open() -> Segment {
+        Segment {
+            t_start_s: f64::NAN,
+            ..Segment::default()
         }
     }
 }
 
-/// The segment whose residuals stand out most from the rest.
+/// The span whose residuals stand out most from the rest.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Worst {
-    /// Its residual variance over that of all the other segments.
+    /// Its residual variance over that of the rest of the record.
     pub ratio: f64,
     /// Its first sample's time, s.
     pub t_start_s: f64,
     /// Its last sample's time, s.
     pub t_end_s: f64,
+}
+
+/// A span, its ratio, and the answer to compare the present one with.
+struct Span {
+    worst: Worst,
+    reference: Option<Snapshot>,
 }
 
 /// The residual record of one least-squares state, in segments ([module docs](self)).
@@ -90,6 +130,7 @@ pub struct ResidualSegments {
     open: Segment,
     last_rss: f64,
     last_dof: f64,
+    latest: Option<Snapshot>,
 }
 
 impl Default for ResidualSegments {
@@ -106,12 +147,10 @@ impl ResidualSegments {
             done: [Segment::default(); MAX_SEGMENTS],
             len: 0,
             target_dof: FIRST_SEGMENT_DOF,
-            open: Segment {
-                t_start_s: f64::NAN,
-                ..Segment::default()
-            },
+            open: Segment::open(),
             last_rss: 0.0,
             last_dof: 0.0,
+            latest: None,
         }
     }
 
@@ -119,13 +158,17 @@ impl ResidualSegments {
     /// sum of squares and residual degrees of freedom. Increments before the state has
     /// any residual degree of freedom (the rows that fix the unknowns) are not counted.
     pub fn record(&mut self, rss: f64, dof: f64, t_s: f64) {
+        if !rss.is_finite() || !dof.is_finite() {
+            return;
+        }
         let (d_rss, d_dof) = (rss - self.last_rss, dof - self.last_dof);
         (self.last_rss, self.last_dof) = (rss, dof);
-        if !(dof > 0.0) || !d_rss.is_finite() {
+        if !(dof > 0.0) {
             return;
         }
         if self.open.t_start_s.is_nan() {
             self.open.t_start_s = t_s;
+            self.open.before = self.latest;
         }
         self.open.rss += d_rss.max(0.0);
         self.open.dof += d_dof;
@@ -142,10 +185,18 @@ impl ResidualSegments {
         }
         self.done[self.len] = self.open;
         self.len += 1;
-        self.open = Segment {
-            t_start_s: f64::NAN,
-            ..Segment::default()
-        };
+        self.open = Segment::open();
+    }
+
+    /// Note an answer (determined, or leaning on the prior) and its stated σ per element
+    /// (kg m²), for the spans that start after it.
+    pub fn note(&mut self, j: &InertiaVector, sigma_kg_m2: &[f64; 6]) {
+        if j.iter().chain(sigma_kg_m2).all(|v| v.is_finite()) {
+            self.latest = Some(Snapshot {
+                j: *j,
+                sigma: *sigma_kg_m2,
+            });
+        }
     }
 
     /// Complete segments so far.
@@ -154,63 +205,91 @@ impl ResidualSegments {
         self.len
     }
 
-    /// The span that stands out most, with at least [`MIN_SEGMENTS`] complete segments:
-    /// one segment against all the others (a glitch), or the record after a segment
-    /// boundary against the record before it, and the reverse (a change that persists).
-    #[must_use]
-    pub fn worst(&self) -> Option<Worst> {
-        if self.len < MIN_SEGMENTS {
-            return None;
-        }
-        let done = &self.done[..self.len];
-        let total = done.iter().fold(Segment::default(), |a, s| Segment {
-            rss: a.rss + s.rss,
-            dof: a.dof + s.dof,
-            ..a
-        });
-        let mut out: Option<Worst> = None;
-        let mut consider = |span: Segment, rest_rss: f64, rest_dof: f64| {
-            let ratio = (span.rss / span.dof) / (rest_rss / rest_dof);
-            if ratio.is_finite() && out.is_none_or(|w| ratio > w.ratio) {
-                out = Some(Worst {
-                    ratio,
-                    t_start_s: span.t_start_s,
-                    t_end_s: span.t_end_s,
-                });
-            }
-        };
-        let mut before = Segment {
-            t_start_s: done[0].t_start_s,
-            ..Segment::default()
-        };
-        for (i, s) in done.iter().enumerate() {
-            consider(*s, total.rss - s.rss, total.dof - s.dof);
-            before = Segment {
-                rss: before.rss + s.rss,
-                dof: before.dof + s.dof,
-                t_end_s: s.t_end_s,
-                ..before
+    /// Every span with at least [`MIN_SEGMENTS`] complete segments (none before).
+    fn spans(&self) -> impl Iterator<Item = Span> + '_ {
+        let n = if self.len < MIN_SEGMENTS { 0 } else { self.len };
+        let done = &self.done[..n];
+        let total = sum(done);
+        // The first answer after segment `i`.
+        let after = move |i: usize| done.get(i + 1).and_then(|s| s.before);
+        let mut prefix = (0.0, 0.0);
+        (0..n).flat_map(move |i| {
+            let s = &done[i];
+            prefix = (prefix.0 + s.rss, prefix.1 + s.dof);
+            let span = |(rss, dof): (f64, f64), t_start_s, t_end_s, reference| {
+                let rest = (total.0 - rss) / (total.1 - dof);
+                // Residuals where the rest has none (exact data): infinitely distinct.
+                let ratio = if rest == 0.0 && rss > 0.0 {
+                    f64::INFINITY
+                } else {
+                    (rss / dof) / rest
+                };
+                (!ratio.is_nan()).then_some(Span {
+                    worst: Worst {
+                        ratio,
+                        t_start_s,
+                        t_end_s,
+                    },
+                    reference,
+                })
             };
-            let after = Segment {
-                rss: total.rss - before.rss,
-                dof: total.dof - before.dof,
-                t_start_s: done.get(i + 1).map_or(f64::NAN, |n| n.t_start_s),
-                t_end_s: done[self.len - 1].t_end_s,
-            };
-            // Each side at least two segments long.
-            if (2..=self.len - 2).contains(&(i + 1)) {
-                consider(before, after.rss, after.dof);
-                consider(after, before.rss, before.dof);
-            }
-        }
-        out
+            let one = span(
+                (s.rss, s.dof),
+                s.t_start_s,
+                s.t_end_s,
+                s.before.or(after(i)),
+            );
+            // Each side of a boundary at least two segments long.
+            let split = (2..=n - 2).contains(&(i + 1));
+            let before = split
+                .then(|| span(prefix, done[0].t_start_s, s.t_end_s, after(i)))
+                .flatten();
+            let rest = (total.0 - prefix.0, total.1 - prefix.1);
+            let later = split
+                .then(|| span(rest, done[i + 1].t_start_s, done[n - 1].t_end_s, after(i)))
+                .flatten();
+            [one, before, later].into_iter().flatten()
+        })
     }
 
-    /// [`Self::worst`] when its ratio exceeds [`INCONSISTENT_RATIO`].
+    /// The span that stands out most, with at least [`MIN_SEGMENTS`] complete segments.
     #[must_use]
-    pub fn inconsistent(&self) -> Option<Worst> {
-        self.worst().filter(|w| w.ratio > INCONSISTENT_RATIO)
+    pub fn worst(&self) -> Option<Worst> {
+        self.spans()
+            .map(|s| s.worst)
+            .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
     }
+
+    /// The most distinct span beyond [`INCONSISTENT_RATIO`] that moved the answer `j` by
+    /// more than [`SHIFT_Z`] of its reference's σ (by its ratio alone when no answer
+    /// was ever noted).
+    #[must_use]
+    pub fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
+        let noted = self.latest.is_some();
+        self.spans()
+            .filter(|s| s.worst.ratio > INCONSISTENT_RATIO)
+            .filter(|s| match s.reference {
+                Some(r) => shift_z(j, &r) > SHIFT_Z,
+                None => !noted,
+            })
+            .map(|s| s.worst)
+            .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
+    }
+}
+
+/// `(Σ ρ², Σ dof)` of segments.
+fn sum(segments: &[Segment]) -> (f64, f64) {
+    segments
+        .iter()
+        .fold((0.0, 0.0), |(r, d), s| (r + s.rss, d + s.dof))
+}
+
+/// `max_k |j_k − r.j_k| / r.σ_k`.
+fn shift_z(j: &InertiaVector, r: &Snapshot) -> f64 {
+    (0..6)
+        .map(|k| (j[k] - r.j[k]).abs() / r.sigma[k])
+        .filter(|z| !z.is_nan())
+        .fold(0.0, f64::max)
 }
 
 /// Below this ratio of the residual variance to the part the stated gyro density alone
@@ -230,7 +309,8 @@ pub fn check(e: &mut Estimate, segments: Option<&ResidualSegments>, density_rati
     ) {
         return;
     }
-    let why = if let Some(w) = segments.and_then(ResidualSegments::inconsistent) {
+    let Some(j) = e.j() else { return };
+    let why = if let Some(w) = segments.and_then(|r| r.inconsistent(&j)) {
         Unobservable::Inconsistent {
             ratio: w.ratio,
             t_start_s: w.t_start_s,
@@ -303,7 +383,7 @@ mod tests {
             let w = r.worst().unwrap();
             assert!(r.segments() >= MAX_SEGMENTS / 2 && r.segments() <= MAX_SEGMENTS);
             assert!(w.ratio < 1.5, "ratio {}", w.ratio);
-            assert!(r.inconsistent().is_none());
+            assert!(r.inconsistent(&InertiaVector::zeros()).is_none());
         }
     }
 
@@ -311,9 +391,23 @@ mod tests {
     fn one_wild_residual_names_its_segment() {
         // One residual of 1e7 s² at row 20,000 (t = 1999.9 s).
         let r = white(50_000, 1.0, Some((20_000, 1e7)));
-        let w = r.inconsistent().expect("flagged");
+        let w = r.inconsistent(&InertiaVector::zeros()).expect("flagged");
         assert!(w.t_start_s <= 1999.9 && 1999.9 <= w.t_end_s, "{w:?}");
         assert!(w.ratio > 3.0 * INCONSISTENT_RATIO);
+    }
+
+    #[test]
+    fn a_residual_in_exact_data_is_infinitely_distinct() {
+        let mut r = ResidualSegments::new();
+        for k in 0..2000 {
+            let rss = if k >= 1000 { 1e-30 } else { 0.0 };
+            r.record(rss, k as f64 + 1.0, k as f64);
+        }
+        let w = r.inconsistent(&InertiaVector::zeros()).expect("flagged");
+        assert!(
+            w.ratio.is_infinite() && w.t_start_s <= 999.0 && 999.0 <= w.t_end_s,
+            "{w:?}"
+        );
     }
 
     #[test]

@@ -473,15 +473,24 @@ impl Estimator for DiscreteMomentum {
         );
         // The density describes the gyro: its rows are the ones to compare with it (with
         // an attitude better than the gyro, the attitude's rows are quieter).
+        // Under forgetting the counts are discounted and the test is not made.
         let described = self
             .candidates
             .iter()
-            .find(|c| c.row_settings().rotation == RotationSource::Gyro)
-            .unwrap_or(c);
-        self.density_ratio = match (self.config.gyro_noise_rad_s_rthz, e.j()) {
-            (Some(g), Some(j)) => consistency::gyro_density_ratio(&described.qr().reduced(), &j, g),
+            .find(|c| c.row_settings().rotation == RotationSource::Gyro);
+        self.density_ratio = match (self.config.gyro_noise_rad_s_rthz, e.j(), described) {
+            (Some(g), Some(j), Some(d)) if record => {
+                consistency::gyro_density_ratio(&d.qr().reduced(), &j, g)
+            }
             _ => None,
         };
+        // The answer as the data gave it, withdrawn or not, is the reference of the spans
+        // that start after it.
+        if let (Some(j), Some(sigma)) = (e.j(), e.sigma_kg_m2()) {
+            for r in &mut self.residuals {
+                r.note(&j, &sigma);
+            }
+        }
         consistency::check(
             &mut e,
             self.residuals.get(self.chosen).filter(|_| record),

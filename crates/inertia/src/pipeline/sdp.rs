@@ -136,6 +136,10 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
         // The density test is the discrete momentum estimator's: the paper's rows share
         // their noise between neighbours, and their residual variance came out at 0.46 of
         // `gyro_density_ratio`'s prediction with the right density (a MEMS slew).
+        // The answer as the data gave it is the reference of the spans after it.
+        if let (Some(r), Some(j), Some(sigma)) = (self.residuals.as_mut(), e.j(), e.sigma_kg_m2()) {
+            r.note(&j, &sigma);
+        }
         consistency::check(&mut e, self.residuals.as_ref(), None);
         Ok(Some(e))
     }
