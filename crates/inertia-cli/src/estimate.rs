@@ -12,7 +12,11 @@ use inertia::pipeline::report::{InputSummary, Report};
 use inertia::pipeline::{self, Pipeline, PipelineConfig, PipelineError};
 use inertia::telemetry::csv::TelemetryReader;
 use inertia::text::Num;
+use std::collections::VecDeque;
 use std::io::{IsTerminal, Read};
+
+/// How many recent samples' lines are kept to name the line of an error.
+const RECENT: usize = 8;
 
 /// Most resampled samples per input step (`--resample`).
 pub const MAX_RESAMPLE_FACTOR: f64 = 100.0;
@@ -51,6 +55,28 @@ fn check_against_step(config: &PipelineConfig, dt: f64, at: &str) -> Result<(), 
         }
     }
     Ok(())
+}
+
+/// The line of the sample that ends a step too large for |φ| < 1, among the recent
+/// `(time, line)` pairs: the reader may be ahead of the estimator (resampling reads the
+/// next samples first, and the half-rate shadow's step ends at a later sample).
+fn step_end_line(e: &PipelineError, recent: &VecDeque<(f64, u64)>) -> Option<u64> {
+    let PipelineError::Estimator {
+        source:
+            EstimatorError::Row {
+                source: RowError::StepTooLarge { t1_s, .. },
+                ..
+            },
+        ..
+    } = e
+    else {
+        return None;
+    };
+    let tol = 1e-9 * (1.0 + t1_s.abs());
+    recent
+        .iter()
+        .find(|(t, _)| *t >= t1_s - tol)
+        .map(|&(_, line)| line)
 }
 
 /// Run the command.
@@ -148,8 +174,13 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     } else {
         let mut p = Pipeline::from_config(config).map_err(settings_error)?;
         let mut write_error = None;
+        let mut recent = VecDeque::with_capacity(RECENT);
         while let Some(item) = reader.next() {
             let s = item.map_err(telemetry)?;
+            if recent.len() == RECENT {
+                recent.pop_front();
+            }
+            recent.push_back((s.t_s, reader.last_line()));
             let n = p.input_samples();
             if n < 2 {
                 first_times[n] = s.t_s;
@@ -163,7 +194,10 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
                     write_error = h.write(e).err();
                 }
             })
-            .map_err(|e| data_error(e, Some(reader.last_line())))?;
+            .map_err(|e| {
+                let line = step_end_line(&e, &recent).unwrap_or(reader.last_line());
+                data_error(e, Some(line))
+            })?;
             if let Some(e) = write_error.take() {
                 return Err(e);
             }

@@ -380,6 +380,15 @@ fn step_too_large() {
         field(&l, 4, "0")
     });
     assert_bad(&p, &[], &["step.csv:8", "q_x,q_y,q_z,q_w", "too long"]);
+    // The line is the one that ends the step, also when resampling reads ahead, and the
+    // step's times print without float noise.
+    for e in ["variational", "discrete-momentum"] {
+        assert_bad(
+            &p,
+            &["--resample", "0.1", "--estimator", e],
+            &["step.csv:8", "s to t = 0.6 s gives"],
+        );
+    }
 }
 
 #[test]
