@@ -5,7 +5,8 @@
 //! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
 //! at each sample (ignored by `estimate`, which reads columns by name).
 //!
-//! A run is held in memory (at most [`MAX_SAMPLES`] samples, about 0.3 kB each) and the
+//! A run is held in memory (at most [`MAX_SAMPLES`] samples, about 0.25 kB each; at most
+//! [`MAX_INTEGRATION_STEPS`] integrator steps) and the
 //! files are put in place when it is complete ([`Pending`]). `-o -` writes the CSV to
 //! standard output and no truth file.
 
@@ -22,6 +23,11 @@ use inertia::text::Num;
 use nalgebra::Vector3;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// Most integrator steps of one run: [`MAX_SAMPLES`] samples at the default 0.1 s period
+/// and 5 ms steps. Beyond it a run would take hours (`--dt 1e6` integrates each node in
+/// 2·10⁸ steps).
+const MAX_INTEGRATION_STEPS: f64 = MAX_SAMPLES as f64 * 20.0;
 
 /// The truth file next to a telemetry file: `X.csv` → `X.truth.json`.
 pub fn truth_path(csv: &Path) -> PathBuf {
@@ -142,6 +148,19 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
             Num(duration),
             Num(period),
             Num((MAX_SAMPLES - 1) as f64 * period)
+        )));
+    }
+    let samples = SimConfig::samples_for(duration, period);
+    let steps = samples as f64 * r.telemetry_every as f64 * common.substeps as f64;
+    if steps > MAX_INTEGRATION_STEPS {
+        return Err(input(format!(
+            "--dt {} with a duration of {} s: {} integration steps ({samples} samples, {} nodes per sample, {} steps of at most 5 ms per node); at most {}",
+            Num(a.dt),
+            Num(duration),
+            Num(steps),
+            r.telemetry_every,
+            common.substeps,
+            Num(MAX_INTEGRATION_STEPS)
         )));
     }
     if let Some(b) = vector("--gyro-bias-deg-h", &a.gyro_bias_deg_h)? {

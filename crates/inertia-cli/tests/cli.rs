@@ -967,6 +967,24 @@ fn resources_are_bounded() {
         assert_eq!(stderr(&o).lines().count(), 1);
     }
     assert!(!out.exists());
+    // Node periods that would take hours: 2·10⁸ steps per node, 10⁵ nodes per sample.
+    for args in [
+        &["--dt=1e6", "--duration=4e6"][..],
+        &["--dt=1e-6", "--telemetry-dt=0.1"][..],
+    ] {
+        let mut all = vec![
+            "simulate",
+            "--scenario",
+            "slew",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        let o = inertia(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("integration steps"), "{}", stderr(&o));
+    }
+    assert!(!out.exists());
 }
 
 #[test]

@@ -168,7 +168,7 @@ pub struct SimConfig {
 }
 
 /// The most telemetry samples one run produces: the run is held in memory (samples,
-/// truth and filter states, about 0.3 kB per sample).
+/// truth and filter states, about 0.25 kB per sample).
 pub const MAX_SAMPLES: usize = 10_000_000;
 
 impl SimConfig {
@@ -265,7 +265,7 @@ impl SimConfig {
             return bad(
                 "samples",
                 self.samples as f64,
-                "must be at most 10^7 (the run is held in memory, about 0.3 kB per sample)",
+                "must be at most 10^7 (the run is held in memory, about 0.25 kB per sample)",
             );
         }
         if self.substeps == 0 {
