@@ -1,7 +1,7 @@
 //! Arguments validated into configurations.
 
 use crate::args::{ConstraintArg, EstimateArgs, InputArgs, RhoModelArg, RotationArg};
-use crate::error::{input, CliError};
+use crate::error::{input, read_failed, CliError};
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{PipelineError, PipelineSettings};
@@ -33,8 +33,19 @@ impl InertiaFile {
 
     /// Read and check a file.
     pub fn read(path: &Path) -> Result<Matrix3<f64>, CliError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| input(format!("{}: {e}", path.display())))?;
+        use std::io::Read;
+        // A small JSON file: read at most 1 MiB of it.
+        const LIMIT: u64 = 1 << 20;
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(LIMIT + 1).read_to_string(&mut text))
+            .map_err(|e| read_failed(path, e))?;
+        if text.len() as u64 > LIMIT {
+            return Err(input(format!(
+                "{}: longer than {LIMIT} bytes: not an inertia file",
+                path.display()
+            )));
+        }
         let f: InertiaFile = serde_json::from_str(&text).map_err(|e| {
             input(format!(
                 "{}:{}:{}: {e} (expected {{\"inertia_kg_m2\": [[..],[..],[..]]}})",
@@ -182,7 +193,11 @@ pub fn settings_error(e: PipelineError) -> CliError {
             field,
             value,
             expected,
-        } => input(format!("{} {value}: expected {expected}", option_of(field))),
+        } => input(format!(
+            "{} {}: expected {expected}",
+            option_of(field),
+            inertia::text::Num(value)
+        )),
         PipelineError::NotApplicable { setting, estimator } => input(format!(
             "{} does not apply to the {estimator} estimator",
             option_of(setting)

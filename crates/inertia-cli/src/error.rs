@@ -1,12 +1,21 @@
-//! Errors with exit codes: 2 for bad usage or bad data, 1 for internal failures.
+//! Errors with exit codes: 2 for bad usage or bad data, 3 for I/O failures, 1 for
+//! internal failures (a bug: nothing in a user's data or arguments leads there).
 
+use inertia::telemetry::csv::TelemetryError;
+use inertia::text::Clipped;
 use std::fmt;
+use std::path::Path;
+
+/// The longest message printed, characters (longer ones are cut with an ellipsis).
+pub const MAX_MESSAGE_CHARS: usize = 1000;
 
 /// A failure of the command.
 #[derive(Debug)]
 pub enum CliError {
     /// Bad arguments or bad input data (exit code 2).
     Input(String),
+    /// A file or stream could not be read or written (exit code 3).
+    Io(String),
     /// Something went wrong inside (exit code 1).
     Internal(String),
 }
@@ -16,15 +25,19 @@ impl CliError {
     pub fn code(&self) -> u8 {
         match self {
             CliError::Input(_) => 2,
+            CliError::Io(_) => 3,
             CliError::Internal(_) => 1,
         }
     }
 }
 
 impl fmt::Display for CliError {
+    /// One line of at most [`MAX_MESSAGE_CHARS`] characters.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Input(m) | CliError::Internal(m) => f.write_str(m),
+            CliError::Input(m) | CliError::Io(m) | CliError::Internal(m) => {
+                write!(f, "{}", Clipped::with_limit(m, MAX_MESSAGE_CHARS))
+            }
         }
     }
 }
@@ -40,6 +53,19 @@ pub fn internal(e: impl fmt::Display) -> CliError {
 }
 
 /// An I/O failure writing `path`.
-pub fn write_failed(path: &std::path::Path, e: impl fmt::Display) -> CliError {
-    CliError::Internal(format!("cannot write {}: {e}", path.display()))
+pub fn write_failed(path: &Path, e: impl fmt::Display) -> CliError {
+    CliError::Io(format!("cannot write {}: {e}", path.display()))
+}
+
+/// An I/O failure reading `path`.
+pub fn read_failed(path: &Path, e: impl fmt::Display) -> CliError {
+    CliError::Io(format!("cannot read {}: {e}", path.display()))
+}
+
+/// A telemetry error: I/O failures are [`CliError::Io`], the rest bad input.
+pub fn telemetry(e: TelemetryError) -> CliError {
+    match e {
+        TelemetryError::Io { .. } => CliError::Io(e.to_string()),
+        other => input(other),
+    }
 }

@@ -3,22 +3,96 @@
 
 use crate::args::EstimateArgs;
 use crate::config::{self, settings_error, InertiaFile};
-use crate::error::{input, internal, CliError};
+use crate::error::{input, internal, read_failed, telemetry, CliError};
 use crate::history::HistoryFile;
+use crate::output::{is_stdio, to_stdout};
 use inertia::discrete::RowError;
 use inertia::estimator::EstimatorError;
 use inertia::pipeline::report::{InputSummary, Report};
-use inertia::pipeline::{self, Pipeline, PipelineError};
+use inertia::pipeline::{self, Pipeline, PipelineConfig, PipelineError};
 use inertia::telemetry::csv::TelemetryReader;
-use std::io::IsTerminal;
+use inertia::text::Num;
+use std::collections::VecDeque;
+use std::io::{IsTerminal, Read};
+
+/// How many recent samples' lines are kept to name the line of an error.
+const RECENT: usize = 8;
+
+/// Most resampled samples per input step (`--resample`).
+pub const MAX_RESAMPLE_FACTOR: f64 = 100.0;
+
+/// The telemetry: a file, or standard input for `-`.
+fn open(path: &std::path::Path) -> Result<(Box<dyn Read>, String), CliError> {
+    if is_stdio(path) {
+        return Ok((Box::new(std::io::stdin().lock()), "<stdin>".into()));
+    }
+    let f = std::fs::File::open(path).map_err(|e| read_failed(path, e))?;
+    Ok((Box::new(f), path.display().to_string()))
+}
+
+/// Settings that the first step of the data shows to be meaningless: a memory shorter
+/// than the step, or resampling to more than [`MAX_RESAMPLE_FACTOR`] samples per step.
+fn check_against_step(config: &PipelineConfig, dt: f64, at: &str) -> Result<(), CliError> {
+    if let Some(m) = config.memory_s() {
+        let step = config.resample_s().unwrap_or(dt);
+        if m < step {
+            return Err(input(format!(
+                "--memory {}: shorter than the sample period {} s ({at}); the memory must span several samples",
+                Num(m),
+                Num(step)
+            )));
+        }
+    }
+    if let Some(r) = config.resample_s() {
+        if dt / r > MAX_RESAMPLE_FACTOR {
+            return Err(input(format!(
+                "--resample {}: {} resampled samples per input step of {} s ({at}); at most {}",
+                Num(r),
+                Num((dt / r).round()),
+                Num(dt),
+                Num(MAX_RESAMPLE_FACTOR)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The line of the sample that ends a step too large for |φ| < 1, among the recent
+/// `(time, line)` pairs: the reader may be ahead of the estimator (resampling reads the
+/// next samples first, and the half-rate shadow's step ends at a later sample).
+fn step_end_line(e: &PipelineError, recent: &VecDeque<(f64, u64)>) -> Option<u64> {
+    let PipelineError::Estimator {
+        source:
+            EstimatorError::Row {
+                source: RowError::StepTooLarge { t1_s, .. },
+                ..
+            },
+        ..
+    } = e
+    else {
+        return None;
+    };
+    let tol = 1e-9 * (1.0 + t1_s.abs());
+    recent
+        .iter()
+        .find(|(t, _)| *t >= t1_s - tol)
+        .map(|&(_, line)| line)
+}
 
 /// Run the command.
 pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
+    if a.output.as_deref().is_some_and(is_stdio) {
+        return Err(input(
+            "-o -: the report goes to standard output; give the history a file name (e.g. -o history.csv)",
+        ));
+    }
     let options = config::csv_options(&a.input)?;
     let settings = config::pipeline_settings(a)?;
     let config = settings.validate().map_err(settings_error)?;
     let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
-    let mut reader = TelemetryReader::open(&a.file, options).map_err(input)?;
+    let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
+    let (source, name) = open(&a.file)?;
+    let mut reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
     let file = reader.file().to_string();
     let entry = config.estimator();
     if entry.capabilities.needs_gyro && !reader.has_gyro() {
@@ -35,7 +109,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             PipelineError::Estimator {
                 source: EstimatorError::Solve(s),
                 ..
-            } => internal(format!("{at} {s}")),
+            } => input(format!("{at} the solver failed on these data: {s}")),
             PipelineError::Estimator {
                 source:
                     EstimatorError::Row {
@@ -52,7 +126,11 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             other => input(format!("{at} {other}")),
         }
     };
-    let size = std::fs::metadata(&a.file).map(|m| m.len()).unwrap_or(0);
+    let size = if is_stdio(&a.file) {
+        0
+    } else {
+        std::fs::metadata(&a.file).map_or(0, |m| m.len())
+    };
     let progress = (std::io::stderr().is_terminal() && !a.json && size > 1 << 20).then(|| {
         let p = indicatif::ProgressBar::new(size);
         p.set_style(
@@ -61,14 +139,13 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         );
         p
     });
-    let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
     let mut first_times = [f64::NAN; 2];
     let (last, excitation, samples, gaps, row_model, torque, residuals, density_ratio) = if a.batch
     {
         let mut all = Vec::new();
         let mut lines = Vec::new();
         while let Some(item) = reader.next() {
-            all.push(item.map_err(input)?);
+            all.push(item.map_err(telemetry)?);
             lines.push(reader.last_line());
         }
         for (t, s) in first_times.iter_mut().zip(&all) {
@@ -100,18 +177,30 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     } else {
         let mut p = Pipeline::from_config(config).map_err(settings_error)?;
         let mut write_error = None;
+        let mut recent = VecDeque::with_capacity(RECENT);
         while let Some(item) = reader.next() {
-            let s = item.map_err(input)?;
+            let s = item.map_err(telemetry)?;
+            if recent.len() == RECENT {
+                recent.pop_front();
+            }
+            recent.push_back((s.t_s, reader.last_line()));
             let n = p.input_samples();
             if n < 2 {
                 first_times[n] = s.t_s;
+            }
+            if n == 1 {
+                let at = format!("{file}:{}", reader.last_line());
+                check_against_step(&config, first_times[1] - first_times[0], &at)?;
             }
             p.push_each(&s, |e| {
                 if let (Some(h), None) = (history.as_mut(), &write_error) {
                     write_error = h.write(e).err();
                 }
             })
-            .map_err(|e| data_error(e, Some(reader.last_line())))?;
+            .map_err(|e| {
+                let line = step_end_line(&e, &recent).unwrap_or(reader.last_line());
+                data_error(e, Some(line))
+            })?;
             if let Some(e) = write_error.take() {
                 return Err(e);
             }
@@ -140,15 +229,19 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     }
     let stats = reader.stats();
     let Some(last) = last else {
+        let need = if entry.capabilities.needs_gyro && !entry.capabilities.constraints {
+            2
+        } else {
+            inertia::estimator::MIN_SAMPLES
+        };
+        let resampled = if samples == stats.rows {
+            String::new()
+        } else {
+            format!(" ({} read, {samples} on the --resample grid)", stats.rows)
+        };
         return Err(input(format!(
-            "{file}: too few samples for an estimate ({} read; the {} estimator needs at least {})",
-            stats.rows,
+            "{file}: too few samples for an estimate: the {} estimator needs at least {need}, got {samples}{resampled}",
             entry.name,
-            if entry.capabilities.needs_gyro && !entry.capabilities.constraints {
-                2
-            } else {
-                inertia::estimator::MIN_SAMPLES
-            }
         )));
     };
     let report = Report::new(&last, &config, a.batch, samples, gaps)
@@ -167,12 +260,9 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         .with_residual_tests(residuals, density_ratio)
         .with_truth(truth.as_ref());
     if a.json {
-        println!(
-            "{}",
-            serde_json::to_string(&report).map_err(|e| internal(format!("JSON: {e}")))?
-        );
+        let json = serde_json::to_string(&report).map_err(|e| internal(format!("JSON: {e}")))?;
+        to_stdout(|w| writeln!(w, "{json}"))
     } else {
-        print!("{report}");
+        to_stdout(|w| write!(w, "{report}"))
     }
-    Ok(())
 }

@@ -1,40 +1,42 @@
 //! The estimate history file (`-o`): the library's CSV history
-//! ([`inertia::pipeline::history`]) written to a file.
+//! ([`inertia::pipeline::history`]) written to a file, put in place only when the run
+//! succeeds ([`crate::output::Pending`]).
 
 use crate::error::{write_failed, CliError};
+use crate::output::Pending;
 use inertia::estimator::Estimate;
 use inertia::pipeline::history::HistoryWriter;
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A history file being written.
 pub struct HistoryFile {
     w: HistoryWriter<BufWriter<File>>,
-    path: PathBuf,
+    pending: Pending,
 }
 
 impl HistoryFile {
-    /// Create the file and write the header.
+    /// Create the (temporary) file and write the header.
     pub fn create(path: &Path) -> Result<Self, CliError> {
-        let f = File::create(path).map_err(|e| write_failed(path, e))?;
-        let w = HistoryWriter::new(BufWriter::new(f)).map_err(|e| write_failed(path, e))?;
-        Ok(Self {
-            w,
-            path: path.to_path_buf(),
-        })
+        let (pending, f) = Pending::create(path)?;
+        let w = HistoryWriter::new(f).map_err(|e| write_failed(path, e))?;
+        Ok(Self { w, pending })
     }
 
     /// Append one estimate.
     pub fn write(&mut self, e: &Estimate) -> Result<(), CliError> {
-        self.w.write(e).map_err(|err| write_failed(&self.path, err))
+        self.w
+            .write(e)
+            .map_err(|err| write_failed(self.pending.path(), err))
     }
 
-    /// Flush to disk.
+    /// Flush and move the file into place.
     pub fn finish(self) -> Result<(), CliError> {
-        self.w
+        let f = self
+            .w
             .finish()
-            .map(drop)
-            .map_err(|e| write_failed(&self.path, e))
+            .map_err(|e| write_failed(self.pending.path(), e))?;
+        self.pending.commit(f)
     }
 }

@@ -1,6 +1,16 @@
 //! The `inertia` command: thin glue over the `inertia` library.
 //!
-//! Exit codes: 0 success, 2 bad usage or bad data, 1 internal failure.
+//! Exit codes:
+//!
+//! - 0: success;
+//! - 2: bad input data or bad usage: one line on standard error, `FILE:LINE: …` naming
+//!   the column when the data are at fault, or naming the option;
+//! - 3: an I/O failure: an input that cannot be read, an output that cannot be written
+//!   (named with its path);
+//! - 1: an internal failure (a bug; nothing in a user's data or arguments leads there).
+//!
+//! Every message is one line of at most [`error::MAX_MESSAGE_CHARS`] characters. Output
+//! files appear only when a run succeeds ([`output`]).
 
 mod args;
 mod config;
@@ -8,6 +18,7 @@ mod error;
 mod estimate;
 mod history;
 mod monte_carlo;
+mod output;
 mod plot;
 mod reproduce;
 mod runner;

@@ -4,17 +4,30 @@
 //! (`inertia::sim::Realism`) from the command line. With gravity gradient on, the CSV
 //! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
 //! at each sample (ignored by `estimate`, which reads columns by name).
+//!
+//! A run is held in memory (at most [`MAX_SAMPLES`] samples, about 0.25 kB each; at most
+//! [`MAX_INTEGRATION_STEPS`] integrator steps) and the
+//! files are put in place when it is complete ([`Pending`]). `-o -` writes the CSV to
+//! standard output and no truth file.
 
 use crate::args::{AttitudeArg, PresetArg, ScenarioArg, SimulateArgs};
 use crate::config::InertiaFile;
 use crate::error::{input, write_failed, CliError};
+use crate::output::{is_stdio, to_stdout, Pending};
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{AttitudeSource, CommandHold, Orbit, SimOutput};
-use inertia::telemetry::csv::write_samples;
+use inertia::sim::{AttitudeSource, CommandHold, Orbit, SimConfig, SimOutput, MAX_SAMPLES};
+use inertia::telemetry::csv::{write_samples, write_samples_with};
+use inertia::text::Num;
 use nalgebra::Vector3;
+use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// Most integrator steps of one run: [`MAX_SAMPLES`] samples at the default 0.1 s period
+/// and 5 ms steps. Beyond it a run would take hours (`--dt 1e6` integrates each node in
+/// 2·10⁸ steps).
+const MAX_INTEGRATION_STEPS: f64 = MAX_SAMPLES as f64 * 20.0;
 
 /// The truth file next to a telemetry file: `X.csv` → `X.truth.json`.
 pub fn truth_path(csv: &Path) -> PathBuf {
@@ -70,7 +83,10 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
     };
     if let Some(d) = a.duration {
         if !(d.is_finite() && d > 0.0) {
-            return Err(input(format!("--duration {d}: must be finite and > 0")));
+            return Err(input(format!(
+                "--duration {}: must be finite and > 0",
+                Num(d)
+            )));
         }
     }
     if !(a.dt.is_finite() && a.dt > 0.0) {
@@ -123,6 +139,29 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
             )));
         }
         r.telemetry_every = every as usize;
+    }
+    let period = a.dt * r.telemetry_every as f64;
+    let duration = a.duration.unwrap_or_else(|| sc.default_duration_s());
+    if SimConfig::samples_for(duration, period) > MAX_SAMPLES {
+        return Err(input(format!(
+            "--duration {}: more than {MAX_SAMPLES} samples at the telemetry period {} s (a run is held in memory); at most {} s",
+            Num(duration),
+            Num(period),
+            Num((MAX_SAMPLES - 1) as f64 * period)
+        )));
+    }
+    let samples = SimConfig::samples_for(duration, period);
+    let steps = samples as f64 * r.telemetry_every as f64 * common.substeps as f64;
+    if steps > MAX_INTEGRATION_STEPS {
+        return Err(input(format!(
+            "--dt {} with a duration of {} s: {} integration steps ({samples} samples, {} nodes per sample, {} steps of at most 5 ms per node); at most {}",
+            Num(a.dt),
+            Num(duration),
+            Num(steps),
+            r.telemetry_every,
+            common.substeps,
+            Num(MAX_INTEGRATION_STEPS)
+        )));
     }
     if let Some(b) = vector("--gyro-bias-deg-h", &a.gyro_bias_deg_h)? {
         r.gyro.bias_deg_h = b;
@@ -192,49 +231,52 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
 }
 
 /// Write the telemetry CSV, with the orbit position columns when there is an orbit.
-fn write_csv(path: &Path, out: &SimOutput) -> Result<(), CliError> {
-    let Some(orbit) = out.orbit else {
-        let file = std::fs::File::create(path).map_err(|e| write_failed(path, e))?;
-        return write_samples(std::io::BufWriter::new(file), &out.samples)
-            .map_err(|e| write_failed(path, e));
-    };
-    let mut buf = Vec::new();
-    write_samples(&mut buf, &out.samples).map_err(|e| write_failed(path, e))?;
-    let text = String::from_utf8(buf).map_err(crate::error::internal)?;
-    let mut csv = String::with_capacity(text.len() + 64 * out.samples.len());
-    let mut lines = text.lines();
-    if let Some(header) = lines.next() {
-        csv.push_str(header);
-        csv.push_str(",r_x,r_y,r_z\n");
+fn write_csv(w: &mut dyn Write, out: &SimOutput) -> std::io::Result<()> {
+    match out.orbit {
+        None => write_samples(w, &out.samples),
+        Some(orbit) => write_samples_with(w, &out.samples, ["r_x", "r_y", "r_z"], |s| {
+            orbit.position_m(s.t_s).into()
+        }),
     }
-    for (line, s) in lines.zip(&out.samples) {
-        let r = orbit.position_m(s.t_s);
-        csv.push_str(&format!("{line},{:?},{:?},{:?}\n", r.x, r.y, r.z));
-    }
-    std::fs::write(path, csv).map_err(|e| write_failed(path, e))
 }
 
 /// Run the command.
 pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     let (sc, common) = settings(a)?;
+    let stdout = is_stdio(&a.output);
+    // Create both files first: an unwritable destination fails before the simulation.
+    let csv = (!stdout).then(|| Pending::create(&a.output)).transpose()?;
+    let truth_file = truth_path(&a.output);
+    let truth = (!stdout)
+        .then(|| Pending::create(&truth_file))
+        .transpose()?;
     let out = sc.simulate(&common).map_err(input)?;
-    write_csv(&a.output, &out)?;
-    let truth = truth_path(&a.output);
-    // The truth file holds the inertia at the end of the run (after any change).
-    let t_end = out.samples.last().map_or(0.0, |s| s.t_s);
-    let json = serde_json::to_string_pretty(&InertiaFile::new(&out.inertia_at(t_end)))
-        .map_err(crate::error::internal)?;
-    std::fs::write(&truth, json + "\n").map_err(|e| write_failed(&truth, e))?;
+    match csv {
+        Some((pending, mut w)) => {
+            write_csv(&mut w, &out).map_err(|e| write_failed(&a.output, e))?;
+            pending.commit(w)?;
+        }
+        None => to_stdout(|w| write_csv(w, &out))?,
+    }
+    let written = if let Some((pending, mut w)) = truth {
+        // The truth file holds the inertia at the end of the run (after any change).
+        let t_end = out.samples.last().map_or(0.0, |s| s.t_s);
+        let json = serde_json::to_string_pretty(&InertiaFile::new(&out.inertia_at(t_end)))
+            .map_err(crate::error::internal)?;
+        writeln!(w, "{json}").map_err(|e| write_failed(&truth_file, e))?;
+        pending.commit(w)?;
+        format!("{} and {}", a.output.display(), truth_file.display())
+    } else {
+        "standard output (no truth file)".into()
+    };
     eprintln!(
-        "wrote {} ({} samples, {} scenario, h = {} s) and {}",
-        a.output.display(),
+        "wrote {} samples ({} scenario, h = {} s) to {written}",
         out.samples.len(),
         a.preset.map_or(sc.name(), |p| match p {
             PresetArg::SmallSat => "small-sat",
             PresetArg::Microsat => "microsat",
         }),
-        common.dt_s * common.realism.telemetry_every as f64,
-        truth.display()
+        Num(common.dt_s * common.realism.telemetry_every as f64),
     );
     Ok(())
 }

@@ -296,6 +296,17 @@ fn field(line: &str, col: usize, value: &str) -> String {
     f.join(",")
 }
 
+/// Exit code 3 and one line naming what could not be read or written.
+fn assert_io_error(args: &[&str], needles: &[&str]) {
+    let o = inertia(args);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(3), "{e}");
+    assert_eq!(e.lines().count(), 1, "one line: {e}");
+    for n in needles {
+        assert!(e.contains(n), "{e:?} lacks {n:?}");
+    }
+}
+
 fn assert_bad(p: &Path, extra: &[&str], needles: &[&str]) {
     let mut args = vec!["estimate", p.to_str().unwrap()];
     args.extend_from_slice(extra);
@@ -369,6 +380,15 @@ fn step_too_large() {
         field(&l, 4, "0")
     });
     assert_bad(&p, &[], &["step.csv:8", "q_x,q_y,q_z,q_w", "too long"]);
+    // The line is the one that ends the step, also when resampling reads ahead, and the
+    // step's times print without float noise.
+    for e in ["variational", "discrete-momentum"] {
+        assert_bad(
+            &p,
+            &["--resample", "0.1", "--estimator", e],
+            &["step.csv:8", "s to t = 0.6 s gives"],
+        );
+    }
 }
 
 #[test]
@@ -382,7 +402,10 @@ fn malformed_row() {
 fn missing_file_and_bad_options() {
     let d = tempfile::tempdir().unwrap();
     let p = d.path().join("nope.csv");
-    assert_bad(&p, &[], &["nope.csv"]);
+    assert_io_error(
+        &["estimate", p.to_str().unwrap()],
+        &["cannot read", "nope.csv"],
+    );
     let ok = simulate(d.path(), "ok", "slew", "2");
     assert_bad(&ok, &["--bound", "J33=3.3:2.7"], &["J33", "contradict"]);
     assert_bad(
@@ -760,4 +783,349 @@ fn simulate_realism_options() {
     ] {
         assert!(help.contains(opt), "{opt} missing from --help");
     }
+}
+
+// Issue 11: never hang, never NaN, never a silent drop.
+
+/// The files in `dir` (names), sorted.
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn io_failures_exit_3_and_name_the_path() {
+    let d = tempfile::tempdir().unwrap();
+    let ok = simulate(d.path(), "ok", "slew", "2");
+    let ok = ok.to_str().unwrap();
+    // An unreadable input: a directory.
+    assert_io_error(
+        &["estimate", d.path().to_str().unwrap()],
+        &["Is a directory"],
+    );
+    // An unwritable output, found before the data are read: bad data and a bad -o give 3.
+    let bad = bad_file(d.path(), "bad", 5, &|l| field(l, 2, "abc"));
+    let nowhere = d.path().join("no/such/dir/h.csv");
+    assert_io_error(
+        &[
+            "estimate",
+            bad.to_str().unwrap(),
+            "-o",
+            nowhere.to_str().unwrap(),
+        ],
+        &["cannot write", "no/such/dir/h.csv"],
+    );
+    assert_io_error(
+        &["estimate", ok, "-o", d.path().to_str().unwrap()],
+        &["is a directory"],
+    );
+    assert_io_error(
+        &[
+            "simulate",
+            "--scenario",
+            "slew",
+            "-o",
+            nowhere.to_str().unwrap(),
+        ],
+        &["cannot write", "h.csv"],
+    );
+    // --truth that cannot be read is I/O; one that is not an inertia file is bad input.
+    let missing = d.path().join("missing.json");
+    assert_io_error(
+        &["estimate", ok, "--truth", missing.to_str().unwrap()],
+        &["missing.json"],
+    );
+    assert_bad(Path::new(ok), &["--truth", ok], &["ok.csv:1:"]);
+}
+
+#[test]
+fn duplicated_columns_and_comment_lines_are_errors() {
+    let d = tempfile::tempdir().unwrap();
+    // A second rho_x column at the end: which one is meant?
+    let src = simulate(d.path(), "src", "slew", "2");
+    let text: String = std::fs::read_to_string(&src)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(i, l)| format!("{l},{}\n", if i == 0 { "rho_x" } else { "5" }))
+        .collect();
+    let dup = d.path().join("dup.csv");
+    std::fs::write(&dup, text).unwrap();
+    assert_bad(
+        &dup,
+        &[],
+        &[
+            "dup.csv:1",
+            "column `rho_x` appears twice (columns 6 and 15)",
+        ],
+    );
+    // A data line starting with `#` was skipped silently; now it is an error.
+    let p = bad_file(d.path(), "hash", 6, &|l| format!("#{l}"));
+    assert_bad(&p, &[], &["hash.csv:6", "starts with `#`"]);
+}
+
+#[test]
+fn iso_time_stamps_across_a_leap_second() {
+    let d = tempfile::tempdir().unwrap();
+    let src = simulate(d.path(), "src", "slew", "30");
+    // Stamps 0.1 s apart, through 2016-12-31T23:59:60.
+    let start = 86_399.0 - 10.0; // seconds of 2016-12-31
+    let text: String = std::fs::read_to_string(&src)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                return format!("{l}\n");
+            }
+            let tenths = (start * 10.0) as u64 + i as u64 - 1;
+            let (s, f) = (tenths / 10, tenths % 10);
+            let stamp = if s < 86_400 {
+                format!("2016-12-31T23:59:{:02}.{f}Z", s - 86_340)
+            } else if s == 86_400 {
+                format!("2016-12-31T23:59:60.{f}Z")
+            } else {
+                let s = s - 86_401;
+                format!("2017-01-01T00:{:02}:{:02}.{f}Z", s / 60, s % 60)
+            };
+            let rest = l.split_once(',').unwrap().1;
+            format!("{stamp},{rest}\n")
+        })
+        .collect();
+    assert!(text.contains("23:59:60.5Z"));
+    let leap = d.path().join("leap.csv");
+    std::fs::write(&leap, text).unwrap();
+    let o = inertia(&["estimate", leap.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = json(&o);
+    assert_eq!(v["samples"], 301);
+    for k in ["min_step_s", "max_step_s"] {
+        let h = v[k].as_f64().unwrap();
+        assert!((h - 0.1).abs() < 1e-6, "{k} {h}");
+    }
+    assert_eq!(v["gaps"], 0);
+}
+
+#[test]
+fn resources_are_bounded() {
+    let d = tempfile::tempdir().unwrap();
+    // 3 MiB without a line break, and a 10 MB header: one short line.
+    let flat = d.path().join("flat.csv");
+    std::fs::write(&flat, vec![b'7'; 3 << 20]).unwrap();
+    assert_bad(
+        &flat,
+        &[],
+        &["flat.csv:1", "line longer than 1048576 bytes"],
+    );
+    let ok = simulate(d.path(), "ok", "slew", "2");
+    let text = std::fs::read_to_string(&ok).unwrap();
+    let header = format!("{}{}", "x".repeat(10_000_000), text);
+    let wide = d.path().join("wide.csv");
+    std::fs::write(&wide, header).unwrap();
+    let o = inertia(&["estimate", wide.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).len() < 200, "{}", stderr(&o));
+    // A 500 kB header without the columns: the message quotes a bounded part of it.
+    let names: Vec<String> = (0..50_000).map(|i| format!("c{i}")).collect();
+    let header = format!("{}\n1\n", names.join(","));
+    std::fs::write(&wide, header).unwrap();
+    let o = inertia(&["estimate", wide.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).len() < 400, "{}", stderr(&o));
+    // Resampling to 1000 samples per step, a memory shorter than the step.
+    let ok = ok.to_str().unwrap();
+    let o = inertia(&["estimate", ok, "--resample", "0.0001"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--resample 0.0001: 1000 resampled samples per input step of 0.1 s"),
+        "{}",
+        stderr(&o)
+    );
+    let o = inertia(&[
+        "estimate",
+        ok,
+        "--memory",
+        "0.01",
+        "--estimator",
+        "variational",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--memory 0.01: shorter than the sample period 0.1 s"),
+        "{}",
+        stderr(&o)
+    );
+    // Durations that cannot be simulated: exit 2 naming --duration, no file.
+    let out = d.path().join("long.csv");
+    for dur in ["1e12", "1e30", "NaN", "-5", "inf"] {
+        let o = inertia(&[
+            "simulate",
+            "--scenario",
+            "slew",
+            &format!("--duration={dur}"),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{dur}: {}", stderr(&o));
+        assert!(stderr(&o).contains("--duration"), "{dur}: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1);
+    }
+    assert!(!out.exists());
+    // Node periods that would take hours: 2·10⁸ steps per node, 10⁵ nodes per sample.
+    for args in [
+        &["--dt=1e6", "--duration=4e6"][..],
+        &["--dt=1e-6", "--telemetry-dt=0.1"][..],
+    ] {
+        let mut all = vec![
+            "simulate",
+            "--scenario",
+            "slew",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        let o = inertia(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains("integration steps"), "{}", stderr(&o));
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn standard_streams() {
+    use std::io::{Read, Write};
+    use std::process::Stdio;
+    let d = tempfile::tempdir().unwrap();
+    // simulate -o - writes the CSV to standard output, and no file named `-`.
+    let o = Command::new(env!("CARGO_BIN_EXE_inertia"))
+        .args([
+            "simulate",
+            "--scenario",
+            "slew",
+            "--duration",
+            "20",
+            "-o",
+            "-",
+        ])
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).starts_with("t,q_x"));
+    assert!(listing(d.path()).is_empty(), "{:?}", listing(d.path()));
+    // estimate - reads standard input.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_inertia"))
+        .args(["estimate", "-", "--json"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(&o.stdout).unwrap();
+    let e = child.wait_with_output().unwrap();
+    assert!(e.status.success(), "{}", stderr(&e));
+    assert_eq!(json(&e)["samples"], 201);
+    // estimate -o -: the report is on standard output, so it is refused.
+    let csv = simulate(d.path(), "ok", "slew", "2");
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "-o", "-"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-o -"), "{}", stderr(&o));
+    // A reader that stops early (`| head`) ends the output quietly, not with a panic.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_inertia"))
+        .args(["simulate", "--scenario", "slew", "-o", "-"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 16];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+}
+
+#[test]
+fn failed_runs_leave_no_output() {
+    let d = tempfile::tempdir().unwrap();
+    // Bad data late in the file: the history written so far is not left behind, and a
+    // history from an earlier run is untouched.
+    let bad = bad_file(d.path(), "late", 18, &|l| field(l, 6, "NaN"));
+    let hist = d.path().join("h.csv");
+    std::fs::write(&hist, "earlier\n").unwrap();
+    let before = listing(d.path());
+    assert_bad(&bad, &["-o", hist.to_str().unwrap()], &["late.csv:18"]);
+    assert_eq!(std::fs::read_to_string(&hist).unwrap(), "earlier\n");
+    assert_eq!(listing(d.path()), before);
+    // A simulation whose truth file cannot be written leaves no CSV either (it used to
+    // write the CSV, then fail on the truth file).
+    std::fs::create_dir(d.path().join("sim.truth.json")).unwrap();
+    let before = listing(d.path());
+    let out = d.path().join("sim.csv");
+    assert_io_error(
+        &[
+            "simulate",
+            "--scenario",
+            "slew",
+            "--duration",
+            "2",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &["sim.truth.json", "is a directory"],
+    );
+    assert_eq!(listing(d.path()), before);
+}
+
+#[test]
+fn messages_are_compact_and_true() {
+    let d = tempfile::tempdir().unwrap();
+    // Times print in at most 12 significant digits.
+    let p = bad_file(d.path(), "big", 5, &|l| field(l, 0, "1e308"));
+    assert_bad(
+        &p,
+        &[],
+        &["big.csv:6", "s does not increase (previous row: 1e308 s)"],
+    );
+    // One gap (lines 6-10 removed), in the singular.
+    let src = simulate(d.path(), "gap_src", "slew", "2");
+    let text: Vec<String> = std::fs::read_to_string(&src)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .filter(|(i, _)| !(5..10).contains(i))
+        .map(|(_, l)| l.to_string())
+        .collect();
+    let p2 = d.path().join("gap2.csv");
+    std::fs::write(&p2, text.join("\n") + "\n").unwrap();
+    let o = inertia(&[
+        "estimate",
+        p2.to_str().unwrap(),
+        "--estimator",
+        "variational",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains(", 1 gap)"), "{}", stdout(&o));
+    // Times in the report without float noise (the file's last time is 0.7000000000000001).
+    let csv = simulate(d.path(), "seven", "slew", "0.7");
+    let o = inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--estimator",
+        "variational",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("t = 0.7 s"), "{}", stdout(&o));
+    // Too few samples: the count the estimator needs and the count it got are true.
+    let csv = simulate(d.path(), "short", "slew", "0.3");
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--resample", "0.1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("needs at least 4, got 2 (4 read, 2 on the --resample grid)"),
+        "{}",
+        stderr(&o)
+    );
 }

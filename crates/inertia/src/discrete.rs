@@ -62,7 +62,7 @@ pub enum RowError {
         norm: f64,
     },
     /// The rotation over one step is too large for eq. 37 (`|φ| < 1`).
-    #[error("the rotation over the step from t = {t0_s} s to t = {t1_s} s gives |φ| = {phi_norm:.6} ≥ {MAX_PHI_NORM} (a step of {angle_deg:.1}°): the sample period is too long for the motion")]
+    #[error("the rotation over the step from t = {} s to t = {} s gives |φ| = {phi_norm:.6} ≥ {MAX_PHI_NORM} (a step of {angle_deg:.1}°): the sample period is too long for the motion", crate::text::Num(*.t0_s), crate::text::Num(*.t1_s))]
     StepTooLarge {
         /// Start of the step, s.
         t0_s: f64,

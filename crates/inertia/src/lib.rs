@@ -101,3 +101,4 @@ pub mod sim;
 pub mod solver;
 pub mod telemetry;
 pub mod tensor;
+pub mod text;

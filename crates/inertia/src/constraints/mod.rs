@@ -89,7 +89,7 @@ pub enum ConstraintError {
     #[error("epsilon must be > 0 kg m², got {0}")]
     NonPositiveEpsilon(f64),
     /// A lower bound above its upper bound.
-    #[error("bounds on {component} contradict each other: lower {lower} > upper {upper} kg m²")]
+    #[error("bounds on {component} contradict each other: lower {} > upper {} kg m²", crate::text::Num(*.lower), crate::text::Num(*.upper))]
     CrossedBounds {
         /// Component name (J11 … J23).
         component: &'static str,

@@ -92,7 +92,7 @@ pub enum PipelineError {
         why: &'static str,
     },
     /// A setting is out of range.
-    #[error("setting `{field}` = {value} is invalid: expected {expected}")]
+    #[error("setting `{field}` = {} is invalid: expected {expected}", crate::text::Num(*.value))]
     InvalidSetting {
         /// The setting.
         field: &'static str,

@@ -23,6 +23,7 @@ use crate::estimator::observability::Observability;
 use crate::estimator::Estimate;
 use crate::solver::SolveStatus;
 use crate::tensor::{principal, relative_frobenius_error, COMPONENT_NAMES};
+use crate::text::{Counted, Num};
 use core::fmt::{self, Write};
 use nalgebra::Matrix3;
 use std::string::{String, ToString};
@@ -215,14 +216,18 @@ impl fmt::Display for Report {
     fn fmt(&self, s: &mut fmt::Formatter<'_>) -> fmt::Result {
         if let Some(i) = &self.input {
             let steps = if (i.max_step_s - i.min_step_s) <= 1e-9 * i.max_step_s {
-                std::format!("h = {:.6} s", i.sample_period_s)
+                std::format!("h = {} s", Num(i.sample_period_s))
             } else {
-                std::format!("steps {:.6}–{:.6} s", i.min_step_s, i.max_step_s)
+                std::format!("steps {}–{} s", Num(i.min_step_s), Num(i.max_step_s))
             };
             writeln!(
                 s,
-                "{}: {} samples, {steps} ({} renormalised, {} sign flips, {} gaps)",
-                i.file, self.samples, i.renormalised, i.sign_flips, self.gaps
+                "{}: {}, {steps} ({} renormalised, {}, {})",
+                i.file,
+                Counted(self.samples, "sample"),
+                i.renormalised,
+                Counted(i.sign_flips, "sign flip"),
+                Counted(self.gaps, "gap")
             )?;
         }
         writeln!(
@@ -232,7 +237,7 @@ impl fmt::Display for Report {
             if self.batch { "batch" } else { "recursive" },
             self.solver,
             self.constraints,
-            self.t
+            Num(self.t)
         )?;
         if let Some(m) = &self.row_model {
             writeln!(s, "rows: {m}")?;

@@ -167,11 +167,17 @@ pub struct SimConfig {
     pub realism: Realism,
 }
 
+/// The most telemetry samples one run produces: the run is held in memory (samples,
+/// truth and filter states, about 0.25 kB per sample).
+pub const MAX_SAMPLES: usize = 10_000_000;
+
 impl SimConfig {
-    /// Number of nodes for a duration: `round(duration/dt) + 1`.
+    /// Number of nodes for a duration: `round(duration/dt) + 1`, saturating (a NaN or
+    /// negative ratio gives 1; [`SimConfig::validate`] refuses more than
+    /// [`MAX_SAMPLES`]).
     #[must_use]
     pub fn samples_for(duration_s: f64, dt_s: f64) -> usize {
-        (duration_s / dt_s).round() as usize + 1
+        ((duration_s / dt_s).round() as usize).saturating_add(1)
     }
 }
 
@@ -234,7 +240,7 @@ impl SimOutput {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// A setting is out of its range.
-    #[error("simulation setting `{field}` = {value} is invalid: {why}")]
+    #[error("simulation setting `{field}` = {} is invalid: {why}", crate::text::Num(*.value))]
     InvalidSetting {
         /// The field name.
         field: &'static str,
@@ -254,6 +260,13 @@ impl SimConfig {
         }
         if self.samples < 3 {
             return bad("samples", self.samples as f64, "must be at least 3");
+        }
+        if self.samples > MAX_SAMPLES {
+            return bad(
+                "samples",
+                self.samples as f64,
+                "must be at most 10^7 (the run is held in memory, about 0.25 kB per sample)",
+            );
         }
         if self.substeps == 0 {
             return bad("substeps", 0.0, "must be at least 1");

@@ -16,27 +16,43 @@
 //! # Validation
 //!
 //! Every error names the file, the line and the column: unparsable numbers, NaN or
-//! infinite values, missing columns, quaternions whose norm differs from 1 by more than
+//! infinite values, missing or duplicated columns, lines longer than [`MAX_LINE_BYTES`]
+//! (checked while reading, so a file without line breaks fails fast), lines starting with
+//! `#` (there are no comment lines: every non-blank line is data), quaternions whose norm differs from 1 by more than
 //! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
 //! non-increasing time, and, only when [`CsvOptions::period_tolerance`] is set, a step
 //! that differs from the first one by more than that (relative). What concerns pairs of
 //! samples as rows (the rotation of a step, gaps) is the estimators' to check and count,
 //! once ([`crate::estimator::rows`]).
 //!
+//! Messages are one line of bounded length: quoted file content is cut after
+//! [`crate::text::MAX_QUOTED_CHARS`] characters, numbers use [`crate::text::Num`].
+//!
+//! ISO time stamps are converted to elapsed seconds across UTC leap seconds
+//! (`23:59:60`; [`super::time_stamp`]).
+//!
 //! Irregular sampling is accepted: the variational rows handle unequal steps. Consecutive quaternions of opposite
 //! sign (`q` and `−q` are the same attitude) are accepted and counted. Nothing is dropped:
-//! a row is either returned or reported as an error, and [`ReadStats`] counts what was
-//! read, renormalised and sign-flipped.
+//! a row is either returned or reported as an error (only blank lines, which hold
+//! nothing, are skipped), and [`ReadStats`] counts what was read, renormalised and
+//! sign-flipped.
 //!
 //! The reader is an iterator and holds one row at a time: memory does not grow with the
 //! file.
 
+use super::line_cap::{LineCap, LineTooLong};
+use super::time_stamp::{Clock, StampError};
 use crate::attitude::Quaternion;
 use crate::sample::Sample;
+use crate::text::{Clipped, Num, Quoted};
 use nalgebra::Vector3;
+use std::collections::HashMap;
 use std::fs::File;
 use std::io::Read;
 use std::path::Path;
+
+/// The longest line accepted, bytes (1 MiB).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
 
 /// Default tolerance on `| |q| − 1 |` below which quaternions are renormalised.
 pub const DEFAULT_UNIT_TOLERANCE: f64 = 1e-3;
@@ -169,8 +185,30 @@ pub enum TelemetryError {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// A line is longer than [`MAX_LINE_BYTES`] (found before it is read whole).
+    #[error("{file}:{line}: line longer than {limit} bytes (no line break?)")]
+    LineTooLong {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// The limit, bytes.
+        limit: usize,
+    },
+    /// Two header columns have the same name.
+    #[error("{file}:1: column `{}` appears twice (columns {first} and {second})", Clipped::new(.column))]
+    DuplicateColumn {
+        /// File name.
+        file: String,
+        /// The name.
+        column: String,
+        /// Its first position (1-based).
+        first: usize,
+        /// Its second position (1-based).
+        second: usize,
+    },
     /// The CSV structure is broken (e.g. a row with a different number of fields).
-    #[error("{file}:{line}: malformed CSV: {message}")]
+    #[error("{file}:{line}: malformed CSV: {}", Clipped::with_limit(.message, 300))]
     Malformed {
         /// File name.
         file: String,
@@ -180,7 +218,7 @@ pub enum TelemetryError {
         message: String,
     },
     /// A required column is absent from the header.
-    #[error("{file}:1: missing column `{column}` (columns present: {present})")]
+    #[error("{file}:1: missing column `{}` (columns present: {})", Clipped::new(.column), Clipped::new(.present))]
     MissingColumn {
         /// File name.
         file: String,
@@ -190,7 +228,7 @@ pub enum TelemetryError {
         present: String,
     },
     /// A field is not a number (or, in the time column, not a time stamp).
-    #[error("{file}:{line}: column `{column}`: cannot parse {value:?} as a number{hint}")]
+    #[error("{file}:{line}: column `{}`: cannot parse {} as a number{hint}", Clipped::new(.column), Quoted(.value))]
     Parse {
         /// File name.
         file: String,
@@ -204,7 +242,7 @@ pub enum TelemetryError {
         hint: &'static str,
     },
     /// A field is NaN or infinite.
-    #[error("{file}:{line}: column `{column}`: value {value} is not finite")]
+    #[error("{file}:{line}: column `{}`: value {value} is not finite", Clipped::new(.column))]
     NonFinite {
         /// File name.
         file: String,
@@ -216,7 +254,7 @@ pub enum TelemetryError {
         value: f64,
     },
     /// A quaternion's norm is too far from 1.
-    #[error("{file}:{line}: columns `{columns}`: quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}")]
+    #[error("{file}:{line}: columns `{}`: quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}", Clipped::new(.columns))]
     NonUnitQuaternion {
         /// File name.
         file: String,
@@ -230,7 +268,7 @@ pub enum TelemetryError {
         tolerance: f64,
     },
     /// Time does not increase.
-    #[error("{file}:{line}: column `{column}`: time {t} s does not increase (previous row: {previous} s)")]
+    #[error("{file}:{line}: column `{}`: time {} s does not increase (previous row: {} s)", Clipped::new(.column), Num(*.t), Num(*.previous))]
     NonIncreasingTime {
         /// File name.
         file: String,
@@ -244,7 +282,7 @@ pub enum TelemetryError {
         previous: f64,
     },
     /// The sample period changed.
-    #[error("{file}:{line}: column `{column}`: step {dt} s differs from the sample period {period} s by more than {tolerance:e} (relative); resample or split the file")]
+    #[error("{file}:{line}: column `{}`: step {} s differs from the sample period {} s by more than {tolerance:e} (relative); resample or split the file", Clipped::new(.column), Num(*.dt), Num(*.period))]
     NonUniformPeriod {
         /// File name.
         file: String,
@@ -267,8 +305,11 @@ impl TelemetryError {
     pub fn line(&self) -> Option<u64> {
         match self {
             TelemetryError::Io { .. } => None,
-            TelemetryError::MissingColumn { .. } => Some(1),
-            TelemetryError::Malformed { line, .. }
+            TelemetryError::MissingColumn { .. } | TelemetryError::DuplicateColumn { .. } => {
+                Some(1)
+            }
+            TelemetryError::LineTooLong { line, .. }
+            | TelemetryError::Malformed { line, .. }
             | TelemetryError::Parse { line, .. }
             | TelemetryError::NonFinite { line, .. }
             | TelemetryError::NonUnitQuaternion { line, .. }
@@ -289,7 +330,7 @@ struct Indices {
 
 /// A streaming, validating CSV telemetry reader.
 pub struct TelemetryReader<R: Read> {
-    reader: csv::Reader<R>,
+    reader: csv::Reader<LineCap<R>>,
     record: csv::StringRecord,
     file: String,
     options: CsvOptions,
@@ -299,8 +340,10 @@ pub struct TelemetryReader<R: Read> {
     prev: Option<Sample>,
     prev_step: Option<f64>,
     period: Option<f64>,
-    /// For ISO time stamps: the first row's (unix seconds, nanoseconds).
+    /// For ISO time stamps: the first row's (seconds, nanoseconds) on the clock's scale.
     time_origin: Option<(i64, i64)>,
+    /// Converts ISO time stamps, counting leap seconds.
+    clock: Clock,
     failed: bool,
 }
 
@@ -321,14 +364,24 @@ impl<R: Read> TelemetryReader<R> {
     pub fn new(input: R, file: &str, options: CsvOptions) -> Result<Self, TelemetryError> {
         let mut reader = csv::ReaderBuilder::new()
             .delimiter(options.delimiter)
-            .comment(Some(b'#'))
-            .from_reader(input);
+            .from_reader(LineCap::new(input, MAX_LINE_BYTES));
         let headers: Vec<String> = reader
             .headers()
-            .map_err(|e| csv_error(file, &e))?
+            .map_err(|e| csv_error(file, e))?
             .iter()
             .map(|h| h.trim().to_string())
             .collect();
+        let mut seen = HashMap::with_capacity(headers.len());
+        for (j, h) in headers.iter().enumerate() {
+            if let Some(i) = seen.insert(h.as_str(), j) {
+                return Err(TelemetryError::DuplicateColumn {
+                    file: file.to_string(),
+                    column: h.clone(),
+                    first: i + 1,
+                    second: j + 1,
+                });
+            }
+        }
         let find = |name: &str| headers.iter().position(|h| h == name);
         let need = |name: &str| {
             find(name).ok_or_else(|| TelemetryError::MissingColumn {
@@ -370,6 +423,7 @@ impl<R: Read> TelemetryReader<R> {
             prev_step: None,
             period: None,
             time_origin: None,
+            clock: Clock::default(),
             failed: false,
         })
     }
@@ -463,12 +517,19 @@ impl<R: Read> TelemetryReader<R> {
                 };
             }
         }
-        let stamp = parse_time_stamp(raw).ok_or_else(|| TelemetryError::Parse {
+        let stamp = self.clock.parse(raw).map_err(|e| TelemetryError::Parse {
             file: self.file.clone(),
             line,
             column: self.headers[i].clone(),
             value: raw.to_string(),
-            hint: " or an ISO-8601 time stamp (e.g. 2026-11-21T09:06:00.1Z)",
+            hint: match e {
+                StampError::Unparsable => {
+                    " or an ISO-8601 time stamp (e.g. 2026-11-21T09:06:00.1Z)"
+                }
+                StampError::NotALeapSecond => {
+                    " or a time stamp: second 60 exists only at 23:59:60 UTC (a leap second)"
+                }
+            },
         })?;
         if self.prev.is_some() && self.time_origin.is_none() {
             // Seconds so far, a time stamp now: not the same clock.
@@ -485,6 +546,19 @@ impl<R: Read> TelemetryReader<R> {
     }
 
     fn parse_row(&mut self, line: u64) -> Result<Sample, TelemetryError> {
+        if self
+            .record
+            .get(0)
+            .is_some_and(|f| f.trim_start().starts_with('#'))
+        {
+            return Err(TelemetryError::Malformed {
+                file: self.file.clone(),
+                line,
+                message: "the line starts with `#`: comment lines are not supported (every \
+                          non-blank line after the header is data)"
+                    .into(),
+            });
+        }
         let t = self.time(line)?;
         let c = [
             self.field(line, self.idx.q[0])?,
@@ -574,23 +648,30 @@ impl<R: Read> TelemetryReader<R> {
     }
 }
 
-/// An ISO-8601 / RFC 3339 time stamp as (unix seconds, nanoseconds); without an offset it
-/// is taken as UTC.
-fn parse_time_stamp(raw: &str) -> Option<(i64, i64)> {
-    use time::format_description::well_known::{Iso8601, Rfc3339};
-    let dt = time::OffsetDateTime::parse(raw, &Rfc3339)
-        .or_else(|_| time::OffsetDateTime::parse(raw, &Iso8601::DEFAULT))
-        .or_else(|_| time::PrimitiveDateTime::parse(raw, &Iso8601::DEFAULT).map(|p| p.assume_utc()))
-        .ok()?;
-    Some((dt.unix_timestamp(), i64::from(dt.nanosecond())))
-}
-
-fn csv_error(file: &str, e: &csv::Error) -> TelemetryError {
+/// The reader's error for a CSV error: a line over the limit, an I/O failure, or a
+/// malformed file.
+fn csv_error(file: &str, e: csv::Error) -> TelemetryError {
     let line = e.position().map_or(0, csv::Position::line);
-    TelemetryError::Malformed {
-        file: file.to_string(),
-        line,
-        message: e.to_string(),
+    let message = e.to_string();
+    match e.into_kind() {
+        csv::ErrorKind::Io(io) => {
+            match io.get_ref().and_then(|x| x.downcast_ref::<LineTooLong>()) {
+                Some(l) => TelemetryError::LineTooLong {
+                    file: file.to_string(),
+                    line: l.line,
+                    limit: l.limit,
+                },
+                None => TelemetryError::Io {
+                    file: file.to_string(),
+                    source: io,
+                },
+            }
+        }
+        _ => TelemetryError::Malformed {
+            file: file.to_string(),
+            line,
+            message,
+        },
     }
 }
 
@@ -606,13 +687,7 @@ impl<R: Read> Iterator for TelemetryReader<R> {
         self.record = record;
         let item = match res {
             Ok(false) => return None,
-            Err(e) => Err(match e.kind() {
-                csv::ErrorKind::Io(_) => TelemetryError::Io {
-                    file: self.file.clone(),
-                    source: std::io::Error::other(e.to_string()),
-                },
-                _ => csv_error(&self.file, &e),
-            }),
+            Err(e) => Err(csv_error(&self.file, e)),
             Ok(true) => {
                 let line = self.record.position().map_or(0, csv::Position::line);
                 self.parse_row(line)
@@ -632,17 +707,32 @@ impl<R: Read> Iterator for TelemetryReader<R> {
     }
 }
 
+#[cfg(test)]
+mod tests;
+
 /// Write samples as CSV in the default format (scalar-last Hamilton quaternion; the gyro
 /// columns `w_*` only when every sample has a rate). Used by the simulator's command-line
 /// front end and by tests.
 pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::Result<()> {
+    write_samples_with(out, samples, [], |_| [])
+}
+
+/// [`write_samples`] with `N` extra columns named `names`, valued `extra(sample)`. Streams:
+/// one row at a time.
+pub fn write_samples_with<W: std::io::Write, const N: usize>(
+    out: W,
+    samples: &[Sample],
+    names: [&str; N],
+    extra: impl Fn(&Sample) -> [f64; N],
+) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
     let with_rates = samples.iter().all(|s| s.omega_rad_s.is_some());
     let header = [
         "t", "q_x", "q_y", "q_z", "q_w", "rho_x", "rho_y", "rho_z", "tau_x", "tau_y", "tau_z",
         "w_x", "w_y", "w_z",
     ];
-    w.write_record(&header[..if with_rates { 14 } else { 11 }])?;
+    let n = if with_rates { 14 } else { 11 };
+    w.write_record(header[..n].iter().chain(&names))?;
     for s in samples {
         let rate = s.omega_rad_s.unwrap_or_default();
         let v = [
@@ -661,8 +751,7 @@ pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::
             rate.y,
             rate.z,
         ];
-        let n = if with_rates { 14 } else { 11 };
-        w.write_record(v[..n].iter().map(|x| format!("{x:?}")))?;
+        w.write_record(v[..n].iter().chain(&extra(s)).map(|x| format!("{x:?}")))?;
     }
     w.flush()
 }

@@ -6,3 +6,7 @@
 pub mod convention;
 #[cfg(feature = "csv")]
 pub mod csv;
+#[cfg(feature = "csv")]
+mod line_cap;
+#[cfg(feature = "csv")]
+pub mod time_stamp;

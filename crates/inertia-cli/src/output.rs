@@ -1,0 +1,119 @@
+//! Output files and standard output.
+//!
+//! A file is written to a temporary file beside its destination (`.NAME.PID.tmp`) and
+//! renamed over the destination only when the run succeeds ([`Pending::commit`]): a
+//! failed run leaves no partial output, and an unwritable destination is found when the
+//! temporary file is created, before any work.
+
+use crate::error::{write_failed, CliError};
+use std::ffi::OsString;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// `-`, the name of a standard stream in place of a file.
+pub fn is_stdio(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// An output file not yet in place: removed on drop unless committed.
+pub struct Pending {
+    tmp: PathBuf,
+    dest: PathBuf,
+    committed: bool,
+}
+
+impl Pending {
+    /// Create the temporary file for `dest`.
+    pub fn create(dest: &Path) -> Result<(Self, BufWriter<File>), CliError> {
+        if dest.is_dir() {
+            return Err(write_failed(dest, "is a directory"));
+        }
+        let name = dest
+            .file_name()
+            .ok_or_else(|| write_failed(dest, "not a file name"))?;
+        let mut tmp_name = OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".{}.tmp", std::process::id()));
+        let tmp = dest.with_file_name(tmp_name);
+        let file = File::options()
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(|e| write_failed(dest, e))?;
+        let pending = Self {
+            tmp,
+            dest: dest.to_path_buf(),
+            committed: false,
+        };
+        Ok((pending, BufWriter::new(file)))
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.dest
+    }
+
+    /// Flush `w` and move the file into place.
+    pub fn commit(mut self, w: BufWriter<File>) -> Result<(), CliError> {
+        let file = w
+            .into_inner()
+            .map_err(|e| write_failed(&self.dest, e.error()))?;
+        file.sync_all().map_err(|e| write_failed(&self.dest, e))?;
+        drop(file);
+        std::fs::rename(&self.tmp, &self.dest).map_err(|e| write_failed(&self.dest, e))?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Pending {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Standard output, noting whether the reader went away (the error itself may reach
+/// the caller wrapped, e.g. by the `csv` writer).
+struct Stdout<W> {
+    inner: W,
+    closed: bool,
+}
+
+impl<W: Write> Stdout<W> {
+    fn note<T>(&mut self, r: io::Result<T>) -> io::Result<T> {
+        if let Err(e) = &r {
+            self.closed |= e.kind() == io::ErrorKind::BrokenPipe;
+        }
+        r
+    }
+}
+
+impl<W: Write> Write for Stdout<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let r = self.inner.write(buf);
+        self.note(r)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        let r = self.inner.flush();
+        self.note(r)
+    }
+}
+
+/// Write to standard output. A closed pipe (`inertia … | head`) ends the output quietly;
+/// other failures are I/O errors.
+pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), CliError> {
+    let mut out = Stdout {
+        inner: BufWriter::new(io::stdout().lock()),
+        closed: false,
+    };
+    match write(&mut out).and_then(|()| out.flush()) {
+        Err(e) if !out.closed => Err(CliError::Io(format!(
+            "cannot write to standard output: {e}"
+        ))),
+        _ => Ok(()),
+    }
+}
