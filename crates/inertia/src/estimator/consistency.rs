@@ -37,8 +37,9 @@
 //! with the last answer before the span (its σ), or, for a span at the start of the
 //! record, with the first one after it. A change of J moves the answer by many σ,
 //! a glitch that the rows feel does too; a noisier stretch of honest data does not.
-//! Without any stated σ (no uncertainty model) the ratio alone decides. Under exponential
-//! forgetting the increments are reweighted and the test is not made.
+//! Without a stated σ (an estimator with no uncertainty model, such as the
+//! finite-difference baseline) no span is inconsistent: the worst one is still reported.
+//! Under exponential forgetting the increments are reweighted and the test is not made.
 
 use super::compensation::NOISE_GRAM_DIAGONAL;
 use super::observability::{Observability, Unobservable};
@@ -261,17 +262,14 @@ impl ResidualSegments {
     }
 
     /// The most distinct span beyond [`INCONSISTENT_RATIO`] that moved the answer `j` by
-    /// more than [`SHIFT_Z`] of its reference's σ (by its ratio alone when no answer
-    /// was ever noted).
+    /// more than [`SHIFT_Z`] of its reference's σ. A span with no answer noted before or
+    /// after it is never inconsistent: the ratio alone does not tell a failed model from
+    /// honest residuals of unequal size (module docs).
     #[must_use]
     pub fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
-        let noted = self.latest.is_some();
         self.spans()
             .filter(|s| s.worst.ratio > INCONSISTENT_RATIO)
-            .filter(|s| match s.reference {
-                Some(r) => shift_z(j, &r) > SHIFT_Z,
-                None => !noted,
-            })
+            .filter(|s| s.reference.is_some_and(|r| shift_z(j, &r) > SHIFT_Z))
             .map(|s| s.worst)
             .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
     }
@@ -354,6 +352,8 @@ mod tests {
     /// sequence), recorded as cumulative sums.
     fn white(n: usize, s2: f64, spike: Option<(usize, f64)>) -> ResidualSegments {
         let mut r = ResidualSegments::new();
+        // The answer is zero ± 0.01 throughout.
+        r.note(&InertiaVector::zeros(), &[0.01; 6]);
         let (mut rss, mut x) = (0.0, 0x2545_f491_4f6c_dd1d_u64);
         for k in 0..n {
             // Box-Muller on an xorshift generator.
@@ -380,10 +380,11 @@ mod tests {
     fn white_residuals_are_consistent_at_any_scale() {
         for s2 in [1e-20, 1.0, 1e12] {
             let r = white(50_000, s2, None);
+            let far = InertiaVector::repeat(1e9);
             let w = r.worst().unwrap();
             assert!(r.segments() >= MAX_SEGMENTS / 2 && r.segments() <= MAX_SEGMENTS);
             assert!(w.ratio < 1.5, "ratio {}", w.ratio);
-            assert!(r.inconsistent(&InertiaVector::zeros()).is_none());
+            assert!(r.inconsistent(&far).is_none());
         }
     }
 
@@ -391,7 +392,11 @@ mod tests {
     fn one_wild_residual_names_its_segment() {
         // One residual of 1e7 s² at row 20,000 (t = 1999.9 s).
         let r = white(50_000, 1.0, Some((20_000, 1e7)));
-        let w = r.inconsistent(&InertiaVector::zeros()).expect("flagged");
+        // Flagged when the answer moved beyond SHIFT_Z of its σ, not when it did not.
+        assert!(r.inconsistent(&InertiaVector::zeros()).is_none());
+        let w = r
+            .inconsistent(&InertiaVector::repeat(1.0))
+            .expect("flagged");
         assert!(w.t_start_s <= 1999.9 && 1999.9 <= w.t_end_s, "{w:?}");
         assert!(w.ratio > 3.0 * INCONSISTENT_RATIO);
     }
@@ -399,13 +404,16 @@ mod tests {
     #[test]
     fn a_residual_in_exact_data_is_infinitely_distinct() {
         let mut r = ResidualSegments::new();
+        r.note(&InertiaVector::zeros(), &[0.01; 6]);
         for k in 0..2000 {
             let rss = if k >= 1000 { 1e-30 } else { 0.0 };
             r.record(rss, k as f64 + 1.0, k as f64);
         }
-        let w = r.inconsistent(&InertiaVector::zeros()).expect("flagged");
+        let w = r
+            .inconsistent(&InertiaVector::repeat(1.0))
+            .expect("flagged");
         assert!(
-            w.ratio.is_infinite() && w.t_start_s <= 999.0 && 999.0 <= w.t_end_s,
+            w.ratio.is_infinite() && w.t_start_s <= 1000.0 && 1000.0 <= w.t_end_s,
             "{w:?}"
         );
     }
