@@ -50,11 +50,25 @@ pub fn downdate_row<const N: usize>(
 pub fn fold_row<const N: usize>(
     r: &mut SMatrix<f64, N, N>,
     a: &SVector<f64, N>,
-    mut rhs: Option<(&mut SVector<f64, N>, f64)>,
+    rhs: Option<(&mut SVector<f64, N>, f64)>,
 ) -> f64 {
     let mut a = *a;
+    fold_pivots(r, &mut a, rhs, 0..N)
+}
+
+/// [`fold_row`] through the pivots `pivots` only: rotate the row `a` (and `β`) against the
+/// rows `pivots` of `[R | z]`, leaving `a` zero there and returning what is left of `β`
+/// (0 without a right-hand side). Folding through `0..m` and then `m..N` is exactly
+/// [`fold_row`]; the remainder after `0..m` may be folded into another factor that shares
+/// the rows `0..m` ([`crate::estimator::augmented_qr`]).
+pub fn fold_pivots<const N: usize>(
+    r: &mut SMatrix<f64, N, N>,
+    a: &mut SVector<f64, N>,
+    mut rhs: Option<(&mut SVector<f64, N>, f64)>,
+    pivots: core::ops::Range<usize>,
+) -> f64 {
     let mut beta = rhs.as_ref().map_or(0.0, |(_, b)| *b);
-    for i in 0..N {
+    for i in pivots {
         let ai = a[i];
         if ai == 0.0 {
             continue;

@@ -11,7 +11,7 @@
 
 use super::momentum_rows::{AugmentedRow, ANCHOR0, J, TORQUE, UNKNOWNS};
 use super::qr::RecursiveQr;
-use crate::givens::fold_row;
+use crate::givens::{fold_pivots, fold_row};
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
@@ -47,18 +47,51 @@ impl AugmentedQr {
         }
     }
 
-    /// Fold a 3-row block.
-    pub fn add(&mut self, row: &AugmentedRow) {
+    /// Fold a 3-row block into this state and, when given, into `chain`, the state of the
+    /// chain in progress alone (the jackknife's, [`super::jackknife::ChainGroups`]).
+    ///
+    /// The chain's initial momenta are the leading unknowns and no other chain's rows
+    /// involve them (its predecessor's were eliminated when it ended), so the leading rows
+    /// of `R` and `z` are the same in both states, number for number: each row is rotated
+    /// through them once, here, and only its remainder, in the shared unknowns, is folded
+    /// into each state's trailing rows. The result is exactly that of folding the row into
+    /// each state separately; `chain`'s own leading rows stay zero (they are this
+    /// state's), which is what eliminating them at the chain's end leaves.
+    pub fn add(&mut self, row: &AugmentedRow, mut chain: Option<&mut AugmentedQr>) {
         for i in 0..3 {
-            let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
+            let mut a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
             let y = row.b[i];
-            self.y_energy += y * y;
-            let left = fold_row(&mut self.r, &a, Some((&mut self.z, y)));
-            self.rss += left * left;
-            self.rows += 1;
-            self.weight += 1.0;
+            let beta = fold_pivots(&mut self.r, &mut a, Some((&mut self.z, y)), ANCHOR0..TORQUE);
+            if let Some(c) = chain.as_deref_mut() {
+                let mut rest = a;
+                let left = fold_pivots(
+                    &mut c.r,
+                    &mut rest,
+                    Some((&mut c.z, beta)),
+                    TORQUE..UNKNOWNS,
+                );
+                c.count_row(y, left);
+            }
+            let left = fold_pivots(
+                &mut self.r,
+                &mut a,
+                Some((&mut self.z, beta)),
+                TORQUE..UNKNOWNS,
+            );
+            self.count_row(y, left);
         }
         self.noise_s += row.noise_s;
+        if let Some(c) = chain {
+            c.noise_s += row.noise_s;
+        }
+    }
+
+    /// Count a folded scalar row with right-hand side `y` and leftover `left`.
+    fn count_row(&mut self, y: f64, left: f64) {
+        self.y_energy += y * y;
+        self.rss += left * left;
+        self.rows += 1;
+        self.weight += 1.0;
     }
 
     /// Fold another state's rows into this one: afterwards this is the state of both sets
@@ -174,5 +207,61 @@ impl AugmentedQr {
             x[i] = s / d;
         }
         x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    /// The old way: each state folds the whole row on its own.
+    fn dense_add(qr: &mut AugmentedQr, row: &AugmentedRow) {
+        for i in 0..3 {
+            let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
+            let left = fold_row(&mut qr.r, &a, Some((&mut qr.z, row.b[i])));
+            qr.count_row(row.b[i], left);
+        }
+        qr.noise_s += row.noise_s;
+    }
+
+    /// Folding once through the shared leading rows gives, bit for bit, both the
+    /// estimator's state and the chain's (its initial momenta eliminated) of folding the
+    /// rows into each separately, over several chains of random rows.
+    #[test]
+    fn folding_once_equals_folding_into_each_state() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut once, mut dense) = (AugmentedQr::new(4), AugmentedQr::new(4));
+        for chain in 0..5 {
+            let (mut mine, mut reference) = (AugmentedQr::new(0), AugmentedQr::new(0));
+            for k in 0..20 + 7 * chain {
+                let mut row = AugmentedRow {
+                    a: SMatrix::from_fn(|_, _| rnd()),
+                    b: Vector3::from_fn(|_, _| rnd()),
+                    noise_s: rnd().abs(),
+                };
+                // Rows of a Richardson chain use one of the two initial momenta.
+                let unused = if k % 2 == 0 { ANCHOR0 + 3 } else { ANCHOR0 };
+                for i in 0..3 {
+                    for c in unused..unused + 3 {
+                        row.a[(i, c)] = 0.0;
+                    }
+                }
+                once.add(&row, Some(&mut mine));
+                dense_add(&mut dense, &row);
+                dense_add(&mut reference, &row);
+            }
+            assert_eq!(once, dense);
+            reference.eliminate_anchors();
+            assert_eq!(mine, reference);
+            once.eliminate_anchors();
+            dense.eliminate_anchors();
+        }
     }
 }
