@@ -53,15 +53,29 @@ pub fn fold_row<const N: usize>(
     rhs: Option<(&mut SVector<f64, N>, f64)>,
 ) -> f64 {
     let mut a = *a;
-    fold_pivots(r, &mut a, rhs, 0..N)
+    fold::<N, false>(r, &mut a, rhs, 0..N)
 }
 
-/// [`fold_row`] through the pivots `pivots` only: rotate the row `a` (and `β`) against the
-/// rows `pivots` of `[R | z]`, leaving `a` zero there and returning what is left of `β`
-/// (0 without a right-hand side). Folding through `0..m` and then `m..N` is exactly
-/// [`fold_row`]; the remainder after `0..m` may be folded into another factor that shares
-/// the rows `0..m` ([`crate::estimator::augmented_qr`]).
-pub fn fold_pivots<const N: usize>(
+/// [`fold_row`] through the pivots `pivots` only, with `Rᵀ` stored in `rt`: rotate the row
+/// `a` (and `β`) against the rows `pivots` of `[R | z]`, leaving `a` zero there and
+/// returning what is left of `β` (0 without a right-hand side). Folding through `0..m`
+/// and then `m..N` is exactly folding through `0..N`; the remainder after `0..m` may be
+/// folded into another factor that shares the rows `0..m`
+/// ([`crate::estimator::augmented_qr`]). With `Rᵀ` stored, the rows of `R` are
+/// contiguous in memory and each rotation runs over two contiguous slices, which the
+/// compiler vectorises: the same operations in the same order as [`fold_row`], so the
+/// same results bit for bit.
+pub fn fold_pivots_transposed<const N: usize>(
+    rt: &mut SMatrix<f64, N, N>,
+    a: &mut SVector<f64, N>,
+    rhs: Option<(&mut SVector<f64, N>, f64)>,
+    pivots: core::ops::Range<usize>,
+) -> f64 {
+    fold::<N, true>(rt, a, rhs, pivots)
+}
+
+/// Fold `a` through `pivots` into `R` (`TRANSPOSED == false`) or into `Rᵀ`.
+fn fold<const N: usize, const TRANSPOSED: bool>(
     r: &mut SMatrix<f64, N, N>,
     a: &mut SVector<f64, N>,
     mut rhs: Option<(&mut SVector<f64, N>, f64)>,
@@ -69,27 +83,83 @@ pub fn fold_pivots<const N: usize>(
 ) -> f64 {
     let mut beta = rhs.as_ref().map_or(0.0, |(_, b)| *b);
     for i in pivots {
-        let ai = a[i];
-        if ai == 0.0 {
-            continue;
+        rotate::<N, TRANSPOSED>(r, a, rhs.as_mut().map(|(z, _)| (&mut **z, &mut beta)), i);
+    }
+    beta
+}
+
+/// One rotation of [`fold_pivots_transposed`]: zero `a[i]` against row `i` of `[R | z]`
+/// (`Rᵀ` stored in `rt`), updating `β` with `z`. Independent rotations (other rows of `R`,
+/// or another factor) may be interleaved with it ([`wavefront`]).
+#[inline]
+pub fn rotate_transposed<const N: usize>(
+    rt: &mut SMatrix<f64, N, N>,
+    a: &mut SVector<f64, N>,
+    z: &mut SVector<f64, N>,
+    beta: &mut f64,
+    i: usize,
+) {
+    rotate::<N, true>(rt, a, Some((z, beta)), i);
+}
+
+/// The rotation at pivot `i` on `R` (`TRANSPOSED == false`) or on `Rᵀ`.
+#[inline(always)]
+fn rotate<const N: usize, const TRANSPOSED: bool>(
+    r: &mut SMatrix<f64, N, N>,
+    a: &mut SVector<f64, N>,
+    rhs: Option<(&mut SVector<f64, N>, &mut f64)>,
+    i: usize,
+) {
+    let ai = a[i];
+    if ai == 0.0 {
+        return;
+    }
+    let rii = r[(i, i)];
+    let rho = sqrt(rii * rii + ai * ai);
+    let (c, s) = (rii / rho, ai / rho);
+    r[(i, i)] = rho;
+    a[i] = 0.0;
+    if TRANSPOSED {
+        // Column i of Rᵀ, below the diagonal: row i of R right of it.
+        let row = &mut r.as_mut_slice()[i * N + i + 1..(i + 1) * N];
+        for (rk, ak) in row.iter_mut().zip(&mut a.as_mut_slice()[i + 1..]) {
+            let (x, y) = (*rk, *ak);
+            *rk = c * x + s * y;
+            *ak = -s * x + c * y;
         }
-        let rii = r[(i, i)];
-        let rho = sqrt(rii * rii + ai * ai);
-        let (c, s) = (rii / rho, ai / rho);
-        r[(i, i)] = rho;
-        a[i] = 0.0;
+    } else {
         for k in i + 1..N {
             let (rk, ak) = (r[(i, k)], a[k]);
             r[(i, k)] = c * rk + s * ak;
             a[k] = -s * rk + c * ak;
         }
-        if let Some((z, _)) = rhs.as_mut() {
-            let zi = z[i];
-            z[i] = c * zi + s * beta;
-            beta = -s * zi + c * beta;
+    }
+    if let Some((z, beta)) = rhs {
+        let zi = z[i];
+        z[i] = c * zi + s * *beta;
+        *beta = -s * zi + c * *beta;
+    }
+}
+
+/// Call `rotate(m, i)` for rows `m < rows` and pivots `i` in `pivots`, in the order of a
+/// wavefront: row `m` at pivot `i` comes after row `m − 1` at pivot `i` (as when the rows
+/// are folded one after the other, so the results are the same bit for bit) but beside
+/// row `m − 1` at pivot `i + 1`, which touches another row of `R`. The rotations of one
+/// row depend on each other through `√` and a division per pivot; interleaving rows that
+/// do not lets the processor overlap them.
+#[inline(always)]
+pub fn wavefront(
+    pivots: core::ops::Range<usize>,
+    rows: usize,
+    mut rotate: impl FnMut(usize, usize),
+) {
+    for t in pivots.start..pivots.end + rows.saturating_sub(1) {
+        for m in 0..rows {
+            if let Some(i) = t.checked_sub(m).filter(|i| pivots.contains(i)) {
+                rotate(m, i);
+            }
         }
     }
-    beta
 }
 
 /// Solve `RᵀR d = g` for upper-triangular `R` by two triangular solves. `None` when a

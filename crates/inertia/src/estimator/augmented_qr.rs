@@ -11,14 +11,16 @@
 
 use super::momentum_rows::{AugmentedRow, ANCHOR0, J, TORQUE, UNKNOWNS};
 use super::qr::RecursiveQr;
-use crate::givens::{fold_pivots, fold_row};
+use crate::givens::{fold_pivots_transposed as fold, rotate_transposed as rotate, wavefront};
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
 /// `(R, z, ρ²)` over the 16 unknowns, and counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AugmentedQr {
-    r: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
+    /// `Rᵀ`: the rows of `R` contiguous, for the rotations
+    /// ([`crate::givens::fold_pivots_transposed`]).
+    rt: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
     z: SVector<f64, UNKNOWNS>,
     rss: f64,
     y_energy: f64,
@@ -36,7 +38,7 @@ impl AugmentedQr {
     #[must_use]
     pub fn new(shared_nuisance: usize) -> Self {
         Self {
-            r: SMatrix::zeros(),
+            rt: SMatrix::zeros(),
             z: SVector::zeros(),
             rss: 0.0,
             y_energy: 0.0,
@@ -56,34 +58,36 @@ impl AugmentedQr {
     /// through them once, here, and only its remainder, in the shared unknowns, is folded
     /// into each state's trailing rows. The result is exactly that of folding the row into
     /// each state separately; `chain`'s own leading rows stay zero (they are this
-    /// state's), which is what eliminating them at the chain's end leaves.
+    /// state's), which is what eliminating them at the chain's end leaves. `R` is stored
+    /// transposed so that the rotations vectorise, and independent rotations are
+    /// interleaved ([`wavefront`]); neither changes a bit of the result.
     pub fn add(&mut self, row: &AugmentedRow, mut chain: Option<&mut AugmentedQr>) {
-        for i in 0..3 {
-            let mut a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
-            let y = row.b[i];
-            let beta = fold_pivots(&mut self.r, &mut a, Some((&mut self.z, y)), ANCHOR0..TORQUE);
-            if let Some(c) = chain.as_deref_mut() {
-                let mut rest = a;
-                let left = fold_pivots(
-                    &mut c.r,
-                    &mut rest,
-                    Some((&mut c.z, beta)),
-                    TORQUE..UNKNOWNS,
-                );
-                c.count_row(y, left);
+        let mut a: [SVector<f64, UNKNOWNS>; 3] = core::array::from_fn(|i| row.a.row(i).transpose());
+        let mut beta: [f64; 3] = core::array::from_fn(|i| row.b[i]);
+        // The three rows in a wavefront ([`wavefront`]), and the chain's rotations beside
+        // this state's: the same operations, in an order that overlaps them.
+        wavefront(ANCHOR0..TORQUE, 3, |m, i| {
+            rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+        });
+        if let Some(c) = chain.as_deref_mut() {
+            let (mut rest, mut left) = (a, beta);
+            wavefront(TORQUE..UNKNOWNS, 3, |m, i| {
+                rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+                rotate(&mut c.rt, &mut rest[m], &mut c.z, &mut left[m], i);
+            });
+            for (y, left) in row.b.iter().zip(left) {
+                c.count_row(*y, left);
             }
-            let left = fold_pivots(
-                &mut self.r,
-                &mut a,
-                Some((&mut self.z, beta)),
-                TORQUE..UNKNOWNS,
-            );
-            self.count_row(y, left);
+            c.noise_s += row.noise_s;
+        } else {
+            wavefront(TORQUE..UNKNOWNS, 3, |m, i| {
+                rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+            });
+        }
+        for (y, left) in row.b.iter().zip(beta) {
+            self.count_row(*y, left);
         }
         self.noise_s += row.noise_s;
-        if let Some(c) = chain {
-            c.noise_s += row.noise_s;
-        }
     }
 
     /// Count a folded scalar row with right-hand side `y` and leftover `left`.
@@ -98,11 +102,16 @@ impl AugmentedQr {
     /// of rows (their unknowns identified column by column).
     pub fn merge(&mut self, other: &AugmentedQr) {
         for i in 0..UNKNOWNS {
-            let a: SVector<f64, UNKNOWNS> = other.r.row(i).transpose();
+            let mut a: SVector<f64, UNKNOWNS> = other.rt.column(i).into_owned();
             if a.iter().all(|v| *v == 0.0) {
                 continue;
             }
-            let left = fold_row(&mut self.r, &a, Some((&mut self.z, other.z[i])));
+            let left = fold(
+                &mut self.rt,
+                &mut a,
+                Some((&mut self.z, other.z[i])),
+                0..UNKNOWNS,
+            );
             self.rss += left * left;
         }
         self.rss += other.rss;
@@ -123,7 +132,7 @@ impl AugmentedQr {
     pub fn eliminate_anchors(&mut self) {
         for i in ANCHOR0..TORQUE {
             for k in 0..UNKNOWNS {
-                self.r[(i, k)] = 0.0;
+                self.rt[(k, i)] = 0.0;
             }
             self.z[i] = 0.0;
         }
@@ -132,7 +141,7 @@ impl AugmentedQr {
     /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`).
     pub fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);
-        self.r *= s;
+        self.rt *= s;
         self.z *= s;
         self.rss *= lambda;
         self.y_energy *= lambda;
@@ -175,7 +184,7 @@ impl AugmentedQr {
     #[must_use]
     pub fn reduced(&self) -> RecursiveQr {
         RecursiveQr {
-            r: Matrix6::from_fn(|i, k| self.r[(J + i, J + k)]),
+            r: Matrix6::from_fn(|i, k| self.rt[(J + k, J + i)]),
             z: Vector6::from_fn(|i, _| self.z[J + i]),
             rss: self.rss,
             y_energy: self.y_energy,
@@ -193,16 +202,16 @@ impl AugmentedQr {
     pub fn nuisance_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J> {
         let mut x = SVector::<f64, J>::zeros();
         for i in (0..J).rev() {
-            let d = self.r[(i, i)];
+            let d = self.rt[(i, i)];
             if d == 0.0 {
                 continue;
             }
             let mut s = self.z[i];
             for k in i + 1..J {
-                s -= self.r[(i, k)] * x[k];
+                s -= self.rt[(k, i)] * x[k];
             }
             for k in 0..6 {
-                s -= self.r[(i, J + k)] * j[k];
+                s -= self.rt[(J + k, i)] * j[k];
             }
             x[i] = s / d;
         }
@@ -215,13 +224,15 @@ mod tests {
     use super::*;
     use nalgebra::Vector3;
 
-    /// The old way: each state folds the whole row on its own.
+    /// The old way: each state folds the whole row on its own, by [`fold_row`] on `R`.
     fn dense_add(qr: &mut AugmentedQr, row: &AugmentedRow) {
+        let mut r = qr.rt.transpose();
         for i in 0..3 {
             let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
-            let left = fold_row(&mut qr.r, &a, Some((&mut qr.z, row.b[i])));
+            let left = crate::givens::fold_row(&mut r, &a, Some((&mut qr.z, row.b[i])));
             qr.count_row(row.b[i], left);
         }
+        qr.rt = r.transpose();
         qr.noise_s += row.noise_s;
     }
 
