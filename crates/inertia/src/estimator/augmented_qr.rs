@@ -61,7 +61,7 @@ impl AugmentedQr {
     /// state's), which is what eliminating them at the chain's end leaves. `R` is stored
     /// transposed so that the rotations vectorise, and independent rotations are
     /// interleaved ([`wavefront`]); neither changes a bit of the result.
-    pub fn add(&mut self, row: &AugmentedRow, mut chain: Option<&mut AugmentedQr>) {
+    pub fn add(&mut self, row: &AugmentedRow, chain: Option<&mut AugmentedQr>) {
         let mut a: [SVector<f64, UNKNOWNS>; 3] = core::array::from_fn(|i| row.a.row(i).transpose());
         let mut beta: [f64; 3] = core::array::from_fn(|i| row.b[i]);
         // The three rows in a wavefront ([`wavefront`]), and the chain's rotations beside
@@ -69,7 +69,7 @@ impl AugmentedQr {
         wavefront(ANCHOR0..TORQUE, 3, |m, i| {
             rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
         });
-        if let Some(c) = chain.as_deref_mut() {
+        if let Some(c) = chain {
             let (mut rest, mut left) = (a, beta);
             wavefront(TORQUE..UNKNOWNS, 3, |m, i| {
                 rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
