@@ -50,47 +50,28 @@ pub fn downdate_row<const N: usize>(
 pub fn fold_row<const N: usize>(
     r: &mut SMatrix<f64, N, N>,
     a: &SVector<f64, N>,
-    rhs: Option<(&mut SVector<f64, N>, f64)>,
+    mut rhs: Option<(&mut SVector<f64, N>, f64)>,
 ) -> f64 {
     let mut a = *a;
-    fold::<N, false>(r, &mut a, rhs, 0..N)
-}
-
-/// [`fold_row`] through the pivots `pivots` only, with `Rᵀ` stored in `rt`: rotate the row
-/// `a` (and `β`) against the rows `pivots` of `[R | z]`, leaving `a` zero there and
-/// returning what is left of `β` (0 without a right-hand side). Folding through `0..m`
-/// and then `m..N` is exactly folding through `0..N`; the remainder after `0..m` may be
-/// folded into another factor that shares the rows `0..m`
-/// ([`crate::estimator::augmented_qr`]). With `Rᵀ` stored, the rows of `R` are
-/// contiguous in memory and each rotation runs over two contiguous slices, which the
-/// compiler vectorises: the same operations in the same order as [`fold_row`], so the
-/// same results bit for bit.
-pub fn fold_pivots_transposed<const N: usize>(
-    rt: &mut SMatrix<f64, N, N>,
-    a: &mut SVector<f64, N>,
-    rhs: Option<(&mut SVector<f64, N>, f64)>,
-    pivots: core::ops::Range<usize>,
-) -> f64 {
-    fold::<N, true>(rt, a, rhs, pivots)
-}
-
-/// Fold `a` through `pivots` into `R` (`TRANSPOSED == false`) or into `Rᵀ`.
-fn fold<const N: usize, const TRANSPOSED: bool>(
-    r: &mut SMatrix<f64, N, N>,
-    a: &mut SVector<f64, N>,
-    mut rhs: Option<(&mut SVector<f64, N>, f64)>,
-    pivots: core::ops::Range<usize>,
-) -> f64 {
     let mut beta = rhs.as_ref().map_or(0.0, |(_, b)| *b);
-    for i in pivots {
-        rotate::<N, TRANSPOSED>(r, a, rhs.as_mut().map(|(z, _)| (&mut **z, &mut beta)), i);
+    for i in 0..N {
+        rotate::<N, false>(
+            r,
+            &mut a,
+            rhs.as_mut().map(|(z, _)| (&mut **z, &mut beta)),
+            i,
+        );
     }
     beta
 }
 
-/// One rotation of [`fold_pivots_transposed`]: zero `a[i]` against row `i` of `[R | z]`
-/// (`Rᵀ` stored in `rt`), updating `β` with `z`. Independent rotations (other rows of `R`,
-/// or another factor) may be interleaved with it ([`wavefront`]).
+/// One rotation of [`fold_row`] with `Rᵀ` stored in `rt`: zero `a[i]` against row `i` of
+/// `[R | z]`, updating `β` with `z`. With `Rᵀ` stored, the rows of `R` are contiguous in
+/// memory and the rotation runs over two contiguous slices, which the compiler
+/// vectorises: the same operations in the same order as [`fold_row`], so the same
+/// results bit for bit. Folding a row is rotating it at every pivot in turn; rotations
+/// of other rows at other pivots, or of another factor, may be interleaved
+/// ([`wavefront`], [`crate::estimator::augmented_qr`]).
 #[inline]
 pub fn rotate_transposed<const N: usize>(
     rt: &mut SMatrix<f64, N, N>,

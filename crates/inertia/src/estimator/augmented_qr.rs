@@ -11,7 +11,7 @@
 
 use super::momentum_rows::{AugmentedRow, ANCHOR0, J, TORQUE, UNKNOWNS};
 use super::qr::RecursiveQr;
-use crate::givens::{fold_pivots_transposed as fold, rotate_transposed as rotate, wavefront};
+use crate::givens::{rotate_transposed as rotate, wavefront};
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
@@ -19,7 +19,7 @@ use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AugmentedQr {
     /// `Rᵀ`: the rows of `R` contiguous, for the rotations
-    /// ([`crate::givens::fold_pivots_transposed`]).
+    /// ([`crate::givens::rotate_transposed`]).
     rt: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
     z: SVector<f64, UNKNOWNS>,
     rss: f64,
@@ -101,17 +101,23 @@ impl AugmentedQr {
     /// Fold another state's rows into this one: afterwards this is the state of both sets
     /// of rows (their unknowns identified column by column).
     pub fn merge(&mut self, other: &AugmentedQr) {
+        // Its non-zero rows, folded in a wavefront ([`wavefront`]).
+        let mut a = [SVector::<f64, UNKNOWNS>::zeros(); UNKNOWNS];
+        let mut beta = [0.0; UNKNOWNS];
+        let mut n = 0;
         for i in 0..UNKNOWNS {
-            let mut a: SVector<f64, UNKNOWNS> = other.rt.column(i).into_owned();
-            if a.iter().all(|v| *v == 0.0) {
+            let row = other.rt.column(i);
+            if row.iter().all(|v| *v == 0.0) {
                 continue;
             }
-            let left = fold(
-                &mut self.rt,
-                &mut a,
-                Some((&mut self.z, other.z[i])),
-                0..UNKNOWNS,
-            );
+            a[n] = row.into_owned();
+            beta[n] = other.z[i];
+            n += 1;
+        }
+        wavefront(0..UNKNOWNS, n, |m, i| {
+            rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+        });
+        for left in &beta[..n] {
             self.rss += left * left;
         }
         self.rss += other.rss;
@@ -238,9 +244,10 @@ mod tests {
 
     /// Folding once through the shared leading rows gives, bit for bit, both the
     /// estimator's state and the chain's (its initial momenta eliminated) of folding the
-    /// rows into each separately, over several chains of random rows.
+    /// rows into each separately, over several chains of random rows; merging a chain's
+    /// state is folding its rows one by one.
     #[test]
-    fn folding_once_equals_folding_into_each_state() {
+    fn folding_once_and_merging_equal_folding_row_by_row() {
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         let mut rnd = move || {
             seed ^= seed << 13;
@@ -271,6 +278,22 @@ mod tests {
             assert_eq!(once, dense);
             reference.eliminate_anchors();
             assert_eq!(mine, reference);
+            // Merging (its rows in a wavefront) is folding them one by one.
+            let mut merged = dense;
+            merged.merge(&mine);
+            let mut r = dense.rt.transpose();
+            let mut one_by_one = dense;
+            for i in 0..UNKNOWNS {
+                let a: SVector<f64, UNKNOWNS> = mine.rt.column(i).into_owned();
+                if a.iter().any(|v| *v != 0.0) {
+                    let left =
+                        crate::givens::fold_row(&mut r, &a, Some((&mut one_by_one.z, mine.z[i])));
+                    one_by_one.rss += left * left;
+                }
+            }
+            one_by_one.rt = r.transpose();
+            assert_eq!((merged.rt, merged.z), (one_by_one.rt, one_by_one.z));
+            assert_eq!(merged.rss, one_by_one.rss + mine.rss);
             once.eliminate_anchors();
             dense.eliminate_anchors();
         }
