@@ -109,9 +109,9 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
 
 /// The model-uncertainty part of σ: per element, the largest difference between the
 /// chosen candidate's (`best`) unconstrained `ĵ` and that of any other candidate the data
-/// cannot tell apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen one's, with `ν`
-/// the chosen one's residual degrees of freedom (three standard deviations of the ratio
-/// of two variance estimates with ν degrees of freedom each). When two models of the
+/// cannot tell apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen
+/// one's, with `ν` the chosen one's residual degrees of freedom (three standard deviations
+/// of the ratio of two variance estimates with ν degrees of freedom each). When two models of the
 /// wheels, or two rotation sources, fit the data equally well, neither is known to be
 /// right, and the answer is uncertain by at least their difference. Zero when the chosen
 /// model fits significantly best.
