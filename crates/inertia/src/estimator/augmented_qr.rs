@@ -11,14 +11,16 @@
 
 use super::momentum_rows::{AugmentedRow, ANCHOR0, J, TORQUE, UNKNOWNS};
 use super::qr::RecursiveQr;
-use crate::givens::fold_row;
+use crate::givens::{rotate_transposed as rotate, wavefront};
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
 /// `(R, z, ρ²)` over the 16 unknowns, and counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AugmentedQr {
-    r: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
+    /// `Rᵀ`: the rows of `R` contiguous, for the rotations
+    /// ([`crate::givens::rotate_transposed`]).
+    rt: SMatrix<f64, UNKNOWNS, UNKNOWNS>,
     z: SVector<f64, UNKNOWNS>,
     rss: f64,
     y_energy: f64,
@@ -36,7 +38,7 @@ impl AugmentedQr {
     #[must_use]
     pub fn new(shared_nuisance: usize) -> Self {
         Self {
-            r: SMatrix::zeros(),
+            rt: SMatrix::zeros(),
             z: SVector::zeros(),
             rss: 0.0,
             y_energy: 0.0,
@@ -47,29 +49,75 @@ impl AugmentedQr {
         }
     }
 
-    /// Fold a 3-row block.
-    pub fn add(&mut self, row: &AugmentedRow) {
-        for i in 0..3 {
-            let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
-            let y = row.b[i];
-            self.y_energy += y * y;
-            let left = fold_row(&mut self.r, &a, Some((&mut self.z, y)));
-            self.rss += left * left;
-            self.rows += 1;
-            self.weight += 1.0;
+    /// Fold a 3-row block into this state and, when given, into `chain`, the state of the
+    /// chain in progress alone (the jackknife's, [`super::jackknife::ChainGroups`]).
+    ///
+    /// The chain's initial momenta are the leading unknowns and no other chain's rows
+    /// involve them (its predecessor's were eliminated when it ended), so the leading rows
+    /// of `R` and `z` are the same in both states, number for number: each row is rotated
+    /// through them once, here, and only its remainder, in the shared unknowns, is folded
+    /// into each state's trailing rows. The result is exactly that of folding the row into
+    /// each state separately; `chain`'s own leading rows stay zero (they are this
+    /// state's), which is what eliminating them at the chain's end leaves. `R` is stored
+    /// transposed so that the rotations vectorise, and independent rotations are
+    /// interleaved ([`wavefront`]); neither changes a bit of the result.
+    pub fn add(&mut self, row: &AugmentedRow, chain: Option<&mut AugmentedQr>) {
+        let mut a: [SVector<f64, UNKNOWNS>; 3] = core::array::from_fn(|i| row.a.row(i).transpose());
+        let mut beta: [f64; 3] = core::array::from_fn(|i| row.b[i]);
+        // The three rows in a wavefront ([`wavefront`]), and the chain's rotations beside
+        // this state's: the same operations, in an order that overlaps them.
+        wavefront(ANCHOR0..TORQUE, 3, |m, i| {
+            rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+        });
+        if let Some(c) = chain {
+            let (mut rest, mut left) = (a, beta);
+            wavefront(TORQUE..UNKNOWNS, 3, |m, i| {
+                rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+                rotate(&mut c.rt, &mut rest[m], &mut c.z, &mut left[m], i);
+            });
+            for (y, left) in row.b.iter().zip(left) {
+                c.count_row(*y, left);
+            }
+            c.noise_s += row.noise_s;
+        } else {
+            wavefront(TORQUE..UNKNOWNS, 3, |m, i| {
+                rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+            });
+        }
+        for (y, left) in row.b.iter().zip(beta) {
+            self.count_row(*y, left);
         }
         self.noise_s += row.noise_s;
+    }
+
+    /// Count a folded scalar row with right-hand side `y` and leftover `left`.
+    fn count_row(&mut self, y: f64, left: f64) {
+        self.y_energy += y * y;
+        self.rss += left * left;
+        self.rows += 1;
+        self.weight += 1.0;
     }
 
     /// Fold another state's rows into this one: afterwards this is the state of both sets
     /// of rows (their unknowns identified column by column).
     pub fn merge(&mut self, other: &AugmentedQr) {
+        // Its non-zero rows, folded in a wavefront ([`wavefront`]).
+        let mut a = [SVector::<f64, UNKNOWNS>::zeros(); UNKNOWNS];
+        let mut beta = [0.0; UNKNOWNS];
+        let mut n = 0;
         for i in 0..UNKNOWNS {
-            let a: SVector<f64, UNKNOWNS> = other.r.row(i).transpose();
-            if a.iter().all(|v| *v == 0.0) {
+            let row = other.rt.column(i);
+            if row.iter().all(|v| *v == 0.0) {
                 continue;
             }
-            let left = fold_row(&mut self.r, &a, Some((&mut self.z, other.z[i])));
+            a[n] = row.into_owned();
+            beta[n] = other.z[i];
+            n += 1;
+        }
+        wavefront(0..UNKNOWNS, n, |m, i| {
+            rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+        });
+        for left in &beta[..n] {
             self.rss += left * left;
         }
         self.rss += other.rss;
@@ -90,7 +138,7 @@ impl AugmentedQr {
     pub fn eliminate_anchors(&mut self) {
         for i in ANCHOR0..TORQUE {
             for k in 0..UNKNOWNS {
-                self.r[(i, k)] = 0.0;
+                self.rt[(k, i)] = 0.0;
             }
             self.z[i] = 0.0;
         }
@@ -99,7 +147,7 @@ impl AugmentedQr {
     /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`).
     pub fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);
-        self.r *= s;
+        self.rt *= s;
         self.z *= s;
         self.rss *= lambda;
         self.y_energy *= lambda;
@@ -148,7 +196,7 @@ impl AugmentedQr {
     #[must_use]
     pub fn reduced(&self) -> RecursiveQr {
         RecursiveQr {
-            r: Matrix6::from_fn(|i, k| self.r[(J + i, J + k)]),
+            r: Matrix6::from_fn(|i, k| self.rt[(J + k, J + i)]),
             z: Vector6::from_fn(|i, _| self.z[J + i]),
             rss: self.rss,
             y_energy: self.y_energy,
@@ -166,19 +214,94 @@ impl AugmentedQr {
     pub fn nuisance_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J> {
         let mut x = SVector::<f64, J>::zeros();
         for i in (0..J).rev() {
-            let d = self.r[(i, i)];
+            let d = self.rt[(i, i)];
             if d == 0.0 {
                 continue;
             }
             let mut s = self.z[i];
             for k in i + 1..J {
-                s -= self.r[(i, k)] * x[k];
+                s -= self.rt[(k, i)] * x[k];
             }
             for k in 0..6 {
-                s -= self.r[(i, J + k)] * j[k];
+                s -= self.rt[(J + k, i)] * j[k];
             }
             x[i] = s / d;
         }
         x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    /// The old way: each state folds the whole row on its own, by [`fold_row`] on `R`.
+    fn dense_add(qr: &mut AugmentedQr, row: &AugmentedRow) {
+        let mut r = qr.rt.transpose();
+        for i in 0..3 {
+            let a: SVector<f64, UNKNOWNS> = row.a.row(i).transpose();
+            let left = crate::givens::fold_row(&mut r, &a, Some((&mut qr.z, row.b[i])));
+            qr.count_row(row.b[i], left);
+        }
+        qr.rt = r.transpose();
+        qr.noise_s += row.noise_s;
+    }
+
+    /// Folding once through the shared leading rows gives, bit for bit, both the
+    /// estimator's state and the chain's (its initial momenta eliminated) of folding the
+    /// rows into each separately, over several chains of random rows; merging a chain's
+    /// state is folding its rows one by one.
+    #[test]
+    fn folding_once_and_merging_equal_folding_row_by_row() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut once, mut dense) = (AugmentedQr::new(4), AugmentedQr::new(4));
+        for chain in 0..5 {
+            let (mut mine, mut reference) = (AugmentedQr::new(0), AugmentedQr::new(0));
+            for k in 0..20 + 7 * chain {
+                let mut row = AugmentedRow {
+                    a: SMatrix::from_fn(|_, _| rnd()),
+                    b: Vector3::from_fn(|_, _| rnd()),
+                    noise_s: rnd().abs(),
+                };
+                // Rows of a Richardson chain use one of the two initial momenta.
+                let unused = if k % 2 == 0 { ANCHOR0 + 3 } else { ANCHOR0 };
+                for i in 0..3 {
+                    for c in unused..unused + 3 {
+                        row.a[(i, c)] = 0.0;
+                    }
+                }
+                once.add(&row, Some(&mut mine));
+                dense_add(&mut dense, &row);
+                dense_add(&mut reference, &row);
+            }
+            assert_eq!(once, dense);
+            reference.eliminate_anchors();
+            assert_eq!(mine, reference);
+            // Merging (its rows in a wavefront) is folding them one by one.
+            let mut merged = dense;
+            merged.merge(&mine);
+            let mut r = dense.rt.transpose();
+            let mut one_by_one = dense;
+            for i in 0..UNKNOWNS {
+                let a: SVector<f64, UNKNOWNS> = mine.rt.column(i).into_owned();
+                if a.iter().any(|v| *v != 0.0) {
+                    let left =
+                        crate::givens::fold_row(&mut r, &a, Some((&mut one_by_one.z, mine.z[i])));
+                    one_by_one.rss += left * left;
+                }
+            }
+            one_by_one.rt = r.transpose();
+            assert_eq!((merged.rt, merged.z), (one_by_one.rt, one_by_one.z));
+            assert_eq!(merged.rss, one_by_one.rss + mine.rss);
+            once.eliminate_anchors();
+            dense.eliminate_anchors();
+        }
     }
 }

@@ -43,7 +43,9 @@ impl MomentumEstimatorSettings {
 pub struct DiscreteMomentumEstimator<B: Backend> {
     source: MomentumRows,
     qr: AugmentedQr,
-    groups: ChainGroups,
+    /// The jackknife's chain groups; `None` with forgetting or after
+    /// [`DiscreteMomentumEstimator::stop_jackknife`].
+    groups: Option<ChainGroups>,
     svd: SvdTracker,
     sv: Vector6<f64>,
     reduced: RecursiveQr,
@@ -71,7 +73,13 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         Ok(Self {
             source: MomentumRows::new(*r),
             qr: AugmentedQr::new(r.shared_nuisance()),
-            groups: ChainGroups::default(),
+            // The delete-a-group jackknife weighs its groups equally: with forgetting they
+            // are not, and it is not kept ([`super::jackknife`]).
+            groups: settings
+                .recursive
+                .memory_s
+                .is_none()
+                .then(ChainGroups::default),
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
             reduced: RecursiveQr::new(),
@@ -104,12 +112,11 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     fn fold_row(&mut self, row: &AugmentedRow, t_s: f64) {
-        let forgetting = self.settings.recursive.memory_s.is_some();
         if self.source.epoch() != self.epoch {
             self.epoch = self.source.epoch();
             self.qr.eliminate_anchors();
-            if !forgetting {
-                self.groups.end_chain();
+            if let Some(g) = self.groups.as_mut() {
+                g.end_chain();
             }
             self.chain_counted = false;
         }
@@ -124,13 +131,17 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             self.qr.scale(libm::exp(-(t_s - t0) / m));
         }
         self.last_block_t_s = Some(t_s);
-        self.qr.add(row);
-        // The delete-a-group jackknife weighs its groups equally: with forgetting they
-        // are not, and it is not kept ([`super::jackknife`]).
-        if !forgetting {
-            self.groups.add(row);
-        }
+        self.qr
+            .add(row, self.groups.as_mut().map(ChainGroups::chain_mut));
         self.since_solve += 1;
+    }
+
+    /// Stop keeping the jackknife's chain groups (their folding is a third of the cost
+    /// per row): for a state whose noise σ is not wanted, such as the pipeline's half-rate
+    /// shadow or a candidate the data have ruled out. The noise σ is the least-squares
+    /// one from then on.
+    pub fn stop_jackknife(&mut self) {
+        self.groups = None;
     }
 
     /// Feed one sample. Returns an estimate when this sample completed a block and a solve
@@ -170,9 +181,10 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The delete-a-group jackknife σ per element over the completed chains
-    /// ([`super::jackknife`]), kg m²; `None` with too few chains or with forgetting.
+    /// ([`super::jackknife`]), kg m²; `None` with too few chains, with forgetting or
+    /// after [`Self::stop_jackknife`].
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
-        self.groups.sigma()
+        self.groups.as_mut()?.sigma()
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
@@ -181,7 +193,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let ls = self.noise_sigma()?;
         Some(super::jackknife::robust_sigma(
             &ls,
-            self.groups.sigma().as_ref(),
+            self.jackknife_sigma().as_ref(),
         ))
     }
 

@@ -31,7 +31,6 @@
 //! one.
 
 use super::augmented_qr::AugmentedQr;
-use super::momentum_rows::AugmentedRow;
 use crate::solver::unconstrained_minimiser;
 use crate::tensor::InertiaVector;
 
@@ -92,18 +91,19 @@ impl Default for ChainGroups {
 }
 
 impl ChainGroups {
-    /// Fold a row block of the chain in progress.
-    pub fn add(&mut self, row: &AugmentedRow) {
-        self.chain.add(row);
+    /// The state of the chain in progress, to fold its row blocks into along with the
+    /// estimator's ([`AugmentedQr::add`]): it holds the rows of the shared unknowns only,
+    /// the initial momenta being minimised out already.
+    pub fn chain_mut(&mut self) -> &mut AugmentedQr {
+        &mut self.chain
     }
 
-    /// The chain in progress ended: minimise its initial momenta out and file its rows in
-    /// its group. Nothing happens for a chain without rows.
+    /// The chain in progress ended: file its rows in its group. Nothing happens for a
+    /// chain without rows.
     pub fn end_chain(&mut self) {
         if self.chain.rows() == 0 {
             return;
         }
-        self.chain.eliminate_anchors();
         if let Some(g) = self.groups.get_mut(self.chains % GROUPS) {
             g.merge(&self.chain);
         }

@@ -11,10 +11,13 @@
 //! The σ of the answer is assembled here from the chosen candidate's noise σ
 //! ([`crate::estimator::jackknife`]) and three bias terms: the discretisation bias from a
 //! half-rate shadow of the first candidate, the spread of indistinguishable candidates,
-//! and the cross-check of the rotation sources ([`reconcile`]).
+//! and the cross-check of the rotation sources ([`reconcile`]). A candidate that has fitted
+//! markedly worse than the best for long is ruled out and no longer folded
+//! ([`super::standing`]).
 
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
+use super::standing::{Standing, RULE_OUT_AFTER};
 use super::PipelineError;
 use crate::estimator::audit::audit;
 use crate::estimator::compensation::compensate;
@@ -106,18 +109,19 @@ fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorS
 }
 
 /// The model-uncertainty part of σ: per element, the largest difference between the
-/// chosen candidate's unconstrained `ĵ` and that of any candidate the data cannot tell
-/// apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen one's, with `ν`
-/// the chosen one's residual degrees of freedom (three standard deviations of the ratio
-/// of two variance estimates with ν degrees of freedom each). When two models of the
+/// chosen candidate's (`best`) unconstrained `ĵ` and that of any other candidate the data
+/// cannot tell apart from it: a residual variance within `1 + 3√(2/ν)` of the chosen
+/// one's, with `ν` the chosen one's residual degrees of freedom (three standard deviations
+/// of the ratio of two variance estimates with ν degrees of freedom each). When two models of the
 /// wheels, or two rotation sources, fit the data equally well, neither is known to be
 /// right, and the answer is uncertain by at least their difference. Zero when the chosen
 /// model fits significantly best.
-fn model_spread(states: &[RecursiveQr], chosen: usize, gyro: Option<f64>) -> [f64; 6] {
+fn model_spread(
+    best: &RecursiveQr,
+    others: impl Iterator<Item = RecursiveQr>,
+    gyro: Option<f64>,
+) -> [f64; 6] {
     let mut out = [0.0; 6];
-    let Some(best) = states.get(chosen) else {
-        return out;
-    };
     let v_best = best.residual_variance();
     let dof = best.residual_dof();
     if !(dof > 0.0) {
@@ -127,11 +131,11 @@ fn model_spread(states: &[RecursiveQr], chosen: usize, gyro: Option<f64>) -> [f6
     let Some(j_best) = own_solution(best, gyro) else {
         return out;
     };
-    for (i, qr) in states.iter().enumerate() {
-        if i == chosen || !(qr.residual_variance() <= ratio * v_best) {
+    for qr in others {
+        if !(qr.residual_variance() <= ratio * v_best) {
             continue;
         }
-        if let Some(j) = own_solution(qr, gyro) {
+        if let Some(j) = own_solution(&qr, gyro) {
             for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
                 *o = o.max((a - b).abs());
             }
@@ -219,6 +223,10 @@ fn choose(candidates: impl Iterator<Item = (f64, f64, Option<f64>)> + Clone) -> 
 struct DiscreteMomentum {
     config: PipelineConfig,
     candidates: Vec<Candidate>,
+    /// Which candidates the data have not ruled out.
+    standing: Standing,
+    /// Row blocks beyond the limit that rule a candidate out ([`super::standing`]).
+    rule_out_after: usize,
     chosen: usize,
     since_solve: usize,
     /// Per candidate: its last own estimate and noise σ, and the row blocks since.
@@ -298,28 +306,34 @@ fn disagreement(a: &InertiaVector, sa: &[f64; 6], b: &InertiaVector, sb: &[f64; 
 }
 
 fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
-    // Validate the estimator settings now; candidates are built at the first sample.
-    MomentumEstimatorSettings::validate(&settings(c, MomentumRowSettings::default())).map_err(
-        |source| PipelineError::Estimator {
-            sample: None,
-            source,
-        },
-    )?;
-    Ok(Box::new(DiscreteMomentum {
-        config: *c,
-        candidates: Vec::new(),
-        chosen: 0,
-        since_solve: 0,
-        checks: Vec::new(),
-        shadow: None,
-        residuals: Vec::new(),
-        density_ratio: None,
-        samples: 0,
-        held: None,
-    }))
+    Ok(Box::new(DiscreteMomentum::new(c)?))
 }
 
 impl DiscreteMomentum {
+    fn new(c: &PipelineConfig) -> Result<Self, PipelineError> {
+        // Validate the estimator settings now; candidates are built at the first sample.
+        MomentumEstimatorSettings::validate(&settings(c, MomentumRowSettings::default())).map_err(
+            |source| PipelineError::Estimator {
+                sample: None,
+                source,
+            },
+        )?;
+        Ok(DiscreteMomentum {
+            config: *c,
+            candidates: Vec::new(),
+            standing: Standing::default(),
+            rule_out_after: RULE_OUT_AFTER,
+            chosen: 0,
+            since_solve: 0,
+            checks: Vec::new(),
+            shadow: None,
+            residuals: Vec::new(),
+            density_ratio: None,
+            samples: 0,
+            held: None,
+        })
+    }
+
     fn start(&mut self, first: &Sample) -> Result<(), EstimatorError> {
         for rows in candidates(&self.config, first.omega_rad_s.is_some()) {
             let backend = registry::build_backend(self.config.backend);
@@ -331,14 +345,45 @@ impl DiscreteMomentum {
         }
         if self.config.uncertainty {
             if let Some(first) = self.candidates.first() {
-                self.shadow = Some(Box::new(DiscreteMomentumEstimator::new(
+                let mut shadow = DiscreteMomentumEstimator::new(
                     settings(&self.config, *first.row_settings()),
                     self.config.constraints,
                     registry::build_backend(self.config.backend),
-                )?));
+                )?;
+                // Only its least-squares state is used ([`discretisation_bias`]).
+                shadow.stop_jackknife();
+                self.shadow = Some(Box::new(shadow));
             }
         }
+        self.standing = Standing::new(self.candidates.len(), self.rule_out_after);
         Ok(())
+    }
+
+    /// Rule out the candidates the data have ruled out ([`super::standing`]). The first
+    /// keeps folding without its jackknife: the discretisation bias compares it with the
+    /// shadow whichever candidate is chosen.
+    fn rule_out(&mut self) {
+        self.standing.update(
+            self.candidates
+                .iter()
+                .map(|c| (c.qr().residual_variance(), c.qr().residual_dof())),
+        );
+        for (i, c) in self.candidates.iter_mut().enumerate() {
+            if !self.standing.live(i) {
+                c.stop_jackknife();
+            }
+        }
+    }
+
+    /// Per candidate `(residual variance, residual degrees of freedom, chain length)` for
+    /// [`choose`], a ruled-out one's variance infinite.
+    fn fit(&self, i: usize, c: &Candidate) -> (f64, f64, Option<f64>) {
+        let v = if self.standing.live(i) {
+            c.qr().residual_variance()
+        } else {
+            f64::INFINITY
+        };
+        (v, c.qr().residual_dof(), c.row_settings().max_chain_s)
     }
 }
 
@@ -362,6 +407,7 @@ impl DiscreteMomentum {
         let mut others: Vec<(InertiaVector, [f64; 6])> = Vec::new();
         for (i, (c, check)) in self.candidates.iter_mut().zip(&mut self.checks).enumerate() {
             if i == self.chosen
+                || !self.standing.live(i)
                 || c.qr().rows() < 6
                 || !(c.qr().residual_variance() <= COMPARABLE_FIT * best_variance)
             {
@@ -395,8 +441,13 @@ impl Estimator for DiscreteMomentum {
         let record = self.config.memory_s.is_none();
         self.residuals
             .resize(self.candidates.len(), ResidualSegments::new());
-        for (c, r) in self.candidates.iter_mut().zip(&mut self.residuals) {
-            if c.fold(s)? {
+        for (i, (c, r)) in self
+            .candidates
+            .iter_mut()
+            .zip(&mut self.residuals)
+            .enumerate()
+        {
+            if (i == 0 || self.standing.live(i)) && c.fold(s)? {
                 folded = true;
                 if record {
                     r.record(c.qr().rss(), c.qr().residual_dof(), s.t_s);
@@ -421,6 +472,7 @@ impl Estimator for DiscreteMomentum {
         if !folded {
             return Ok(None);
         }
+        self.rule_out();
         for k in self.checks.iter_mut().flatten() {
             k.age += 1;
         }
@@ -428,13 +480,12 @@ impl Estimator for DiscreteMomentum {
         if self.since_solve < self.config.solve_every {
             return Ok(None);
         }
-        self.chosen = choose(self.candidates.iter().map(|c| {
-            (
-                c.qr().residual_variance(),
-                c.qr().residual_dof(),
-                c.row_settings().max_chain_s,
-            )
-        }));
+        self.chosen = choose(
+            self.candidates
+                .iter()
+                .enumerate()
+                .map(|(i, c)| self.fit(i, c)),
+        );
         let Some(c) = self.candidates.get_mut(self.chosen) else {
             return Ok(None);
         };
@@ -444,11 +495,16 @@ impl Estimator for DiscreteMomentum {
         self.since_solve = 0;
         let mut e = c.solve_now(s.t_s)?;
         let noise = c.robust_noise_sigma();
+        let best = *c.reduced();
         if self.config.uncertainty {
             if let (Some(j), Some(noise)) = (e.j(), noise) {
-                let states: Vec<RecursiveQr> =
-                    self.candidates.iter().map(|c| c.qr().reduced()).collect();
-                let spread = model_spread(&states, self.chosen, self.config.gyro_noise_rad_s_rthz);
+                let others = self
+                    .candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, _)| i != self.chosen && self.standing.live(i))
+                    .map(|(_, c)| c.qr().reduced());
+                let spread = model_spread(&best, others, self.config.gyro_noise_rad_s_rthz);
                 let discretisation = match (self.candidates.first(), self.shadow.as_deref()) {
                     (Some(first), Some(shadow)) => discretisation_bias(
                         &first.qr().reduced(),
@@ -477,7 +533,12 @@ impl Estimator for DiscreteMomentum {
         let described = self
             .candidates
             .iter()
-            .find(|c| c.row_settings().rotation == RotationSource::Gyro);
+            .enumerate()
+            .find(|&(i, c)| {
+                (i == 0 || self.standing.live(i))
+                    && c.row_settings().rotation == RotationSource::Gyro
+            })
+            .map(|(_, c)| c);
         self.density_ratio = match (self.config.gyro_noise_rad_s_rthz, e.j(), described) {
             (Some(g), Some(j), Some(d)) if record => {
                 consistency::gyro_density_ratio(&d.qr().reduced(), &j, g)
@@ -574,8 +635,12 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     let (mut estimate, noise) = own(batch)?;
     if c.uncertainty {
         if let (Some(j), Some(noise)) = (estimate.j(), noise) {
-            let states: Vec<RecursiveQr> = reduced.iter().map(|(_, b)| b.qr).collect();
-            let spread = model_spread(&states, chosen, c.gyro_noise_rad_s_rthz);
+            let others = reduced
+                .iter()
+                .enumerate()
+                .filter(|&(i, _)| i != chosen)
+                .map(|(_, (_, b))| b.qr);
+            let spread = model_spread(qr, others, c.gyro_noise_rad_s_rthz);
             // As in the recursive path: the first candidate on every other sample.
             let half: Vec<Sample> = samples
                 .chunks_exact(2)
@@ -620,4 +685,48 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         gaps: batch.gaps,
         row_model: Some(*rows),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::PipelineSettings;
+    use crate::sim::realism::{AttitudeSource, Realism};
+    use crate::sim::scenario::{Common, Scenario};
+
+    /// With star-tracker attitudes the attitude candidates fit far worse than the gyro
+    /// ones and are ruled out; every answer (ĵ, status, σ) is still exactly that of the
+    /// run that folds them to the end.
+    #[test]
+    fn ruling_out_candidates_changes_no_answer() {
+        let common = Common {
+            duration_s: Some(900.0),
+            realism: Realism {
+                attitude: AttitudeSource::StarTracker,
+                ..Realism::default()
+            },
+            ..Common::paper()
+        };
+        let config = PipelineSettings::default().validate().unwrap();
+        for scenario in [Scenario::slew(), Scenario::spin()] {
+            let run = scenario.simulate(&common).unwrap();
+            let mut pruned = DiscreteMomentum::new(&config).unwrap();
+            let mut full = DiscreteMomentum {
+                rule_out_after: usize::MAX,
+                ..DiscreteMomentum::new(&config).unwrap()
+            };
+            let mut answers = 0;
+            for s in &run.samples {
+                let (a, b) = (pruned.push(s).unwrap(), full.push(s).unwrap());
+                assert_eq!(a, b, "t = {}", s.t_s);
+                answers += usize::from(a.and_then(|e| e.j()).is_some());
+            }
+            assert!(answers > 1000);
+            assert_eq!(pruned.candidates.len(), 4);
+            assert!(
+                pruned.standing.live(0) && !pruned.standing.live(1) && !pruned.standing.live(3)
+            );
+            assert!((0..4).all(|i| full.standing.live(i)));
+        }
+    }
 }

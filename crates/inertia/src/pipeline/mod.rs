@@ -49,6 +49,7 @@ mod momentum;
 pub mod registry;
 mod sdp;
 mod settings;
+mod standing;
 
 #[cfg(feature = "csv")]
 pub mod history;
