@@ -1129,3 +1129,36 @@ fn messages_are_compact_and_true() {
         stderr(&o)
     );
 }
+
+/// A bound that holds the answer is reported as active, in the text and the JSON; a bound
+/// the answer does not touch is not.
+#[test]
+fn active_bounds_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "slew", "slew", "300");
+    let run = |bound: &str| {
+        let o = inertia(&[
+            "estimate",
+            csv.to_str().unwrap(),
+            "--bound",
+            bound,
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        json(&o)["active_bounds"].clone()
+    };
+    let active = run("J33=10:11");
+    assert_eq!(active.as_array().map(Vec::len), Some(1), "{active}");
+    assert_eq!(active[0]["component"], "J33");
+    assert_eq!(active[0]["side"], "lower");
+    assert_eq!(active[0]["value_kg_m2"], 10.0);
+    assert_eq!(run("J33=2.7:3.3").as_array().map(Vec::len), Some(0));
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--bound", "J33=10:11"]);
+    assert!(
+        stdout(&o).contains(
+            "active bounds (they, not the data, hold the answer there): J33 at its lower bound 10"
+        ),
+        "{}",
+        stdout(&o)
+    );
+}

@@ -43,6 +43,44 @@ pub enum Consistency {
     PositiveDefiniteOnly,
 }
 
+/// Which side of an element's interval.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum BoundSide {
+    /// `j[k] ≥ lower`.
+    Lower,
+    /// `j[k] ≤ upper`.
+    Upper,
+}
+
+/// An element bound the answer sits on ([`ConstraintSet::active_bounds`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct ActiveBound {
+    /// The element.
+    pub component: Component,
+    /// Which bound.
+    pub side: BoundSide,
+    /// The bound, kg m² (products are tensor entries, `J12 = −Σ m x y`).
+    pub value_kg_m2: f64,
+}
+
+impl core::fmt::Display for ActiveBound {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let side = match self.side {
+            BoundSide::Lower => "lower",
+            BoundSide::Upper => "upper",
+        };
+        write!(
+            f,
+            "{} at its {side} bound {}",
+            self.component,
+            crate::text::Num(self.value_kg_m2)
+        )
+    }
+}
+
 /// A user's constraint set. Build, then [`validate`](ConstraintSet::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConstraintSet {
@@ -182,6 +220,29 @@ impl ConstraintSet {
             self = self.with_bounds(k, Some(j[k.index()] - w), Some(j[k.index()] + w));
         }
         self
+    }
+
+    /// The element bounds that `j` sits on (within `1e-9` of the bound's size, at least
+    /// 1e-12 kg m²): the bounds that hold the answer, which the data alone would have
+    /// put elsewhere.
+    pub fn active_bounds(&self, j: &InertiaVector) -> impl Iterator<Item = ActiveBound> + '_ {
+        let j = *j;
+        Component::ALL.into_iter().flat_map(move |c| {
+            let k = c.index();
+            let on =
+                move |b: f64| crate::math::abs(j[k] - b) <= 1e-9 * crate::math::abs(b).max(1e-3);
+            let lower = self.lower_kg_m2[k].filter(|b| on(*b)).map(|b| ActiveBound {
+                component: c,
+                side: BoundSide::Lower,
+                value_kg_m2: b,
+            });
+            let upper = self.upper_kg_m2[k].filter(|b| on(*b)).map(|b| ActiveBound {
+                component: c,
+                side: BoundSide::Upper,
+                value_kg_m2: b,
+            });
+            lower.into_iter().chain(upper)
+        })
     }
 
     /// `true` when any element bound is set (a prior that can fix the scale of J).

@@ -8,7 +8,8 @@
 //! `samples`, `gaps`, `t`, `status` ([`Observability::code`]), `reason`, `condition`,
 //! `inertia` (3×3, kg m²), `j`, `sigma`, `principal_moments`, `principal_moments_sigma`,
 //! `principal_axes` (columns), `solver_status`, `iterations`, `relative_error` (against a
-//! given truth), `excitation`, `residual_consistency` (the span whose residuals stand out
+//! given truth), `excitation`, `active_bounds` (`component`, `side`, `value_kg_m2` of each
+//! element bound the answer sits on), `residual_consistency` (the span whose residuals stand out
 //! most: `ratio`, `t_start_s`, `t_end_s`; [`crate::estimator::consistency`]),
 //! `gyro_density_ratio` (the residual variance over the part the stated gyro density
 //! implies). Absent values are `null`.
@@ -16,6 +17,7 @@
 //! [`Observability::code`]: crate::estimator::observability::Observability::code
 
 use super::settings::PipelineConfig;
+use crate::constraints::ActiveBound;
 use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO};
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
@@ -101,6 +103,8 @@ pub struct Report {
     pub row_model: Option<MomentumRowSettings>,
     /// The estimated constant body-frame disturbance torque, N m.
     pub torque_bias_nm: Option<[f64; 3]>,
+    /// The element bounds the answer sits on: they, not the data, hold it there.
+    pub active_bounds: std::vec::Vec<ActiveBound>,
     /// The span whose residuals stand out most from the rest.
     pub residual_consistency: Option<Worst>,
     /// The residual variance over the part the stated gyro density alone implies.
@@ -156,6 +160,10 @@ impl Report {
             excitation: None,
             row_model: None,
             torque_bias_nm: None,
+            active_bounds: estimate
+                .j()
+                .map(|j| config.constraints().set().active_bounds(&j).collect())
+                .unwrap_or_default(),
             residual_consistency: None,
             gyro_density_ratio: None,
             observability: estimate.observability,
@@ -278,6 +286,15 @@ impl fmt::Display for Report {
             for r in ax {
                 writeln!(s, "  [ {:>9.5} {:>9.5} {:>9.5} ]", r[0], r[1], r[2])?;
             }
+        }
+        if !self.active_bounds.is_empty() {
+            let list: std::vec::Vec<String> =
+                self.active_bounds.iter().map(ToString::to_string).collect();
+            writeln!(
+                s,
+                "active bounds (they, not the data, hold the answer there): {}",
+                list.join(", ")
+            )?;
         }
         if let Some(t) = self.torque_bias_nm {
             writeln!(
