@@ -242,6 +242,16 @@ pub enum RotationArg {
     Gyro,
 }
 
+/// What to do with an attitude glitch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum GlitchArg {
+    /// Stop with an error naming the line.
+    #[default]
+    Stop,
+    /// Estimate anyway; the report counts and lists the steps.
+    Keep,
+}
+
 /// Models of the wheel momentum between samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
 pub enum RhoModelArg {
@@ -332,6 +342,12 @@ pub struct EstimateArgs {
     /// telemetry step, changing at the samples), or `plain` (O(h²) one-step rows).
     #[arg(long, value_enum, default_value = "auto")]
     pub rho_model: RhoModelArg,
+    /// A step where the attitude jumps against the gyro (a glitch in the quaternions or
+    /// the rates; telemetry with `w_*` columns): `stop` with an error naming the line
+    /// (default), or `keep` it and estimate anyway, the steps counted and listed in the
+    /// report.
+    #[arg(long, value_enum, default_value = "stop")]
+    pub glitches: GlitchArg,
     /// Do not estimate an unknown constant disturbance torque (discrete-momentum
     /// estimator; by default it is estimated, at no cost when it is absent).
     #[arg(long)]

@@ -1,11 +1,12 @@
 //! Arguments validated into configurations.
 
-use crate::args::{ConstraintArg, EstimateArgs, InputArgs, RhoModelArg, RotationArg};
+use crate::args::{ConstraintArg, EstimateArgs, GlitchArg, InputArgs, RhoModelArg, RotationArg};
 use crate::error::{input, read_failed, CliError};
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{PipelineError, PipelineSettings};
 use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
+use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::{j_from_matrix, Component};
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
@@ -166,6 +167,10 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         },
         torque_bias: !a.no_torque_bias,
         max_chain_s: (a.chain != 0.0).then_some(a.chain),
+        glitches: match a.glitches {
+            GlitchArg::Stop => GlitchPolicy::Stop,
+            GlitchArg::Keep => GlitchPolicy::Keep,
+        },
         ..PipelineSettings::default()
     })
 }

@@ -1162,3 +1162,58 @@ fn active_bounds_are_reported() {
         stdout(&o)
     );
 }
+
+/// One quaternion turned by 90°: the run stops (exit 2) naming its line; with
+/// `--glitches keep` it estimates, and the report lists the two steps around it.
+#[test]
+fn an_attitude_glitch_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(dir.path(), "slew", "slew", "300");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (ix, iw) = (col("q_x"), col("q_w"));
+    // Line 1502 (sample 1500): q ← (sin 45°, 0, 0, cos 45°) ⊗ q, a 90° turn about x.
+    let mut f: Vec<String> = lines[1501].split(',').map(str::to_string).collect();
+    let q: Vec<f64> = (ix..=iw).map(|k| f[k].parse().unwrap()).collect();
+    let (s, c) = (
+        std::f64::consts::FRAC_1_SQRT_2,
+        std::f64::consts::FRAC_1_SQRT_2,
+    );
+    let turned = [
+        c * q[0] + s * q[3],
+        c * q[1] - s * q[2],
+        c * q[2] + s * q[1],
+        c * q[3] - s * q[0],
+    ];
+    for (k, v) in turned.iter().enumerate() {
+        f[ix + k] = v.to_string();
+    }
+    lines[1501] = f.join(",");
+    let bad = dir.path().join("glitch.csv");
+    std::fs::write(&bad, lines.join("\n")).unwrap();
+    for extra in [&[][..], &["--batch"][..]] {
+        let mut args = vec!["estimate", bad.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = inertia(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            e.contains("glitch.csv:1502:") && e.contains("90.000°"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 1, "{e}");
+    }
+    let o = inertia(&[
+        "estimate",
+        bad.to_str().unwrap(),
+        "--glitches",
+        "keep",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j = json(&o);
+    assert_eq!(j["glitches"]["count"], 2, "{j}");
+    assert!(j["inertia"].is_array());
+}

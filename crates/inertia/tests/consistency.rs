@@ -13,6 +13,7 @@ use inertia::sample::Sample;
 use inertia::sim::control::Slew;
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::sim::InertiaChange;
+use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::{paper_j_true, relative_frobenius_error};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
@@ -141,7 +142,8 @@ fn forgetting_makes_no_residual_test() {
     }
 }
 
-/// One sample's attitude off by 90°: with its rotation from the attitude the discrete
+/// One sample's attitude off by 90°, kept (`GlitchPolicy::Keep`; by default the pipeline
+/// stops at it, `telemetry::glitch`): with its rotation from the attitude the discrete
 /// momentum estimator withdraws the answer and names the glitch's span; with the rotation
 /// from the gyro (the default when rates are present) the glitch does not reach the rows,
 /// and the answer stays determined and right.
@@ -151,9 +153,13 @@ fn an_attitude_glitch_is_caught_or_ignored() {
     let at = 3000;
     let t_glitch = s[at].t_s;
     s[at].q = Quaternion::exp(&Vector3::new(PI / 2.0, 0.0, 0.0)) * s[at].q;
+    let keep = |name| PipelineSettings {
+        glitches: GlitchPolicy::Keep,
+        ..estimator(name)
+    };
     let attitude = PipelineSettings {
         rotation_source: Some(RotationSource::Attitude),
-        ..estimator("discrete-momentum")
+        ..keep("discrete-momentum")
     };
     let (e, ratio) = run(attitude, &s);
     eprintln!(
@@ -161,7 +167,7 @@ fn an_attitude_glitch_is_caught_or_ignored() {
         e.observability
     );
     assert!(inconsistent_at(&e, t_glitch), "{:?}", e.observability);
-    let (e, ratio) = run(estimator("discrete-momentum"), &s);
+    let (e, ratio) = run(keep("discrete-momentum"), &s);
     eprintln!("glitch, rotation chosen from the data: ratio {ratio:.3?}");
     assert!(matches!(e.observability, Observability::Determined { .. }));
     let err = relative_frobenius_error(&e.inertia().unwrap(), &paper_j_true());
@@ -275,4 +281,36 @@ fn honest_heteroscedastic_residuals_are_not_inconsistent() {
             assert!(!inconsistent(&e), "{label}, {name}");
         }
     }
+}
+
+/// By default a glitch stops the run, naming the sample that ends the jumping step, in
+/// the streaming and the batch paths; the same data unbroken run through.
+#[test]
+fn an_attitude_glitch_stops_the_run_by_default() {
+    use inertia::pipeline::PipelineError;
+    let clean = samples(None, 1e-5, 1);
+    let mut s = clean.clone();
+    s[3000].q = Quaternion::exp(&Vector3::new(PI / 180.0, 0.0, 0.0)) * s[3000].q;
+    let config = estimator("discrete-momentum").validate().unwrap();
+    let mut p = Pipeline::from_config(config).unwrap();
+    let err = s.iter().find_map(|x| p.push(x).err()).expect("stopped");
+    match err {
+        PipelineError::AttitudeGlitch { sample, glitch } => {
+            assert_eq!(sample, 3000, "{glitch}");
+            assert!(
+                (glitch.attitude_turn_rad.to_degrees() - 1.0).abs() < 0.05,
+                "{glitch}"
+            );
+        }
+        other => panic!("{other}"),
+    }
+    assert!(matches!(
+        inertia::pipeline::batch(&s, &config),
+        Err(PipelineError::AttitudeGlitch { sample: 3000, .. })
+    ));
+    let mut p = Pipeline::from_config(config).unwrap();
+    for x in &clean {
+        p.push(x).unwrap();
+    }
+    assert_eq!(p.glitches().count(), 0);
 }

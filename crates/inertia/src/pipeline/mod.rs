@@ -65,6 +65,7 @@ use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
 use crate::sample::Sample;
 use crate::telemetry::convention::{ConventionCheck, Verdict};
+use crate::telemetry::glitch::{Glitch, GlitchCheck, GlitchPolicy};
 use std::boxed::Box;
 use std::string::String;
 
@@ -129,6 +130,15 @@ pub enum PipelineError {
         /// Steps compared.
         steps: usize,
     },
+    /// One step of the attitude jumps against the gyro ([`crate::telemetry::glitch`]),
+    /// and the policy is [`GlitchPolicy::Stop`].
+    #[error("{glitch} (the step ends at this line; --glitches keep estimates anyway)")]
+    AttitudeGlitch {
+        /// 0-based index of the input sample that ends the step.
+        sample: usize,
+        /// The step.
+        glitch: Glitch,
+    },
     /// The constraint set is unusable.
     #[error("constraints: {0}")]
     Constraints(#[from] ConstraintError),
@@ -161,6 +171,7 @@ pub struct Pipeline {
     estimator_samples: usize,
     last: Option<Estimate>,
     convention: ConventionCheck,
+    glitch: GlitchCheck,
 }
 
 impl core::fmt::Debug for Pipeline {
@@ -194,6 +205,7 @@ impl Pipeline {
             estimator_samples: 0,
             last: None,
             convention: ConventionCheck::default(),
+            glitch: GlitchCheck::default(),
         })
     }
 
@@ -213,6 +225,14 @@ impl Pipeline {
         mut on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), PipelineError> {
         let index = self.input_samples;
+        if let Some(glitch) = self.glitch.push(s) {
+            if self.config.glitches == GlitchPolicy::Stop {
+                return Err(PipelineError::AttitudeGlitch {
+                    sample: index,
+                    glitch,
+                });
+            }
+        }
         self.input_samples += 1;
         if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
             self.convention.push(s);
@@ -263,6 +283,13 @@ impl Pipeline {
                 result
             }
         }
+    }
+
+    /// The steps where the attitude jumped against the gyro, kept under
+    /// [`GlitchPolicy::Keep`] ([`crate::telemetry::glitch`]).
+    #[must_use]
+    pub fn glitches(&self) -> &GlitchCheck {
+        &self.glitch
     }
 
     /// How the attitude compares with the gyro rates so far
@@ -357,8 +384,14 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         estimator: entry.name,
     })?;
     let mut check = ConventionCheck::default();
-    for s in samples {
+    let mut glitches = GlitchCheck::default();
+    for (sample, s) in samples.iter().enumerate() {
         check.push(s);
+        if let Some(glitch) = glitches.push(s) {
+            if config.glitches == GlitchPolicy::Stop {
+                return Err(PipelineError::AttitudeGlitch { sample, glitch });
+            }
+        }
     }
     if let Verdict::Wrong {
         reading,

@@ -24,11 +24,21 @@ use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
 use crate::estimator::Estimate;
 use crate::solver::SolveStatus;
+use crate::telemetry::glitch::{Glitch, GlitchCheck};
 use crate::tensor::{principal, relative_frobenius_error, COMPONENT_NAMES};
 use crate::text::{Counted, Num};
 use core::fmt::{self, Write};
 use nalgebra::Matrix3;
 use std::string::{String, ToString};
+
+/// Steps where the attitude jumped against the gyro, kept.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Glitches {
+    /// How many steps.
+    pub count: usize,
+    /// The first ones.
+    pub listed: std::vec::Vec<Glitch>,
+}
 
 /// Version of the JSON report; it changes whenever a key is removed or changes meaning.
 pub const SCHEMA_VERSION: u32 = 1;
@@ -105,6 +115,9 @@ pub struct Report {
     pub torque_bias_nm: Option<[f64; 3]>,
     /// The element bounds the answer sits on: they, not the data, hold it there.
     pub active_bounds: std::vec::Vec<ActiveBound>,
+    /// Steps where the attitude jumped against the gyro, kept (`--glitches keep`): how
+    /// many, and the first [`crate::telemetry::glitch::LISTED`].
+    pub glitches: Option<Glitches>,
     /// The span whose residuals stand out most from the rest.
     pub residual_consistency: Option<Worst>,
     /// The residual variance over the part the stated gyro density alone implies.
@@ -164,6 +177,7 @@ impl Report {
                 .j()
                 .map(|j| config.constraints().set().active_bounds(&j).collect())
                 .unwrap_or_default(),
+            glitches: None,
             residual_consistency: None,
             gyro_density_ratio: None,
             observability: estimate.observability,
@@ -203,6 +217,16 @@ impl Report {
     pub fn with_residual_tests(mut self, worst: Option<Worst>, density_ratio: Option<f64>) -> Self {
         self.residual_consistency = worst;
         self.gyro_density_ratio = density_ratio;
+        self
+    }
+
+    /// With the glitches kept, if any.
+    #[must_use]
+    pub fn with_glitches(mut self, check: Option<&GlitchCheck>) -> Self {
+        self.glitches = check.filter(|c| c.count() > 0).map(|c| Glitches {
+            count: c.count(),
+            listed: c.listed().copied().collect(),
+        });
         self
     }
 
@@ -285,6 +309,17 @@ impl fmt::Display for Report {
             writeln!(s, "principal axes (columns, body axes):")?;
             for r in ax {
                 writeln!(s, "  [ {:>9.5} {:>9.5} {:>9.5} ]", r[0], r[1], r[2])?;
+            }
+        }
+        if let Some(g) = &self.glitches {
+            writeln!(
+                s,
+                "attitude glitches kept: {} step{} where the attitude jumped against the gyro",
+                g.count,
+                if g.count == 1 { "" } else { "s" }
+            )?;
+            for x in &g.listed {
+                writeln!(s, "  {x}")?;
             }
         }
         if !self.active_bounds.is_empty() {

@@ -6,6 +6,7 @@ use super::PipelineError;
 use crate::constraints::{ConstraintSet, Constraints};
 use crate::estimator::momentum_rows::{RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
+use crate::telemetry::glitch::GlitchPolicy;
 
 /// Settings of an estimation run. Every field has a documented default
 /// ([`Default`]); [`PipelineSettings::validate`] checks them all before any data is read.
@@ -53,6 +54,10 @@ pub struct PipelineSettings {
     /// (`pipeline::discrete_momentum`). Default [`DEFAULT_MAX_CHAIN_S`]; `None`: chains
     /// end only at gaps.
     pub max_chain_s: Option<f64>,
+    /// What to do with a step where the attitude jumps against the gyro
+    /// ([`crate::telemetry::glitch`]; telemetry with gyro rates). Default
+    /// [`GlitchPolicy::Stop`].
+    pub glitches: GlitchPolicy,
 }
 
 /// Default longest momentum chain, s.
@@ -74,6 +79,7 @@ impl Default for PipelineSettings {
             rho_model: RhoModel::Auto,
             torque_bias: true,
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
+            glitches: GlitchPolicy::Stop,
         }
     }
 }
@@ -94,6 +100,7 @@ pub struct PipelineConfig {
     pub(crate) rho_model: RhoModel,
     pub(crate) torque_bias: bool,
     pub(crate) max_chain_s: Option<f64>,
+    pub(crate) glitches: GlitchPolicy,
 }
 
 fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
@@ -194,6 +201,7 @@ impl PipelineSettings {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             max_chain_s: self.max_chain_s,
+            glitches: self.glitches,
         })
     }
 }
