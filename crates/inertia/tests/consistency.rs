@@ -314,3 +314,31 @@ fn an_attitude_glitch_stops_the_run_by_default() {
     }
     assert_eq!(p.glitches().count(), 0);
 }
+
+/// Issue 11's reproduction: a 30 s memory on a slew followed by 300 s at rest once said
+/// "determined" with an error of 0.40 (the slew forgotten, the rest unexciting). Now every
+/// estimator that says "determined" there is right within its 3σ, or says it cannot tell.
+#[test]
+fn a_short_memory_over_a_long_rest_is_not_determined_wrongly() {
+    let out = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(600.0),
+            ..Common::paper()
+        })
+        .unwrap();
+    for name in ["discrete-momentum", "variational"] {
+        let mut p = Pipeline::new(&PipelineSettings {
+            memory_s: Some(30.0),
+            ..estimator(name)
+        })
+        .unwrap();
+        for s in &out.samples {
+            p.push(s).unwrap();
+        }
+        let e = p.last().unwrap();
+        eprintln!("{name}: {:?}", e.observability);
+        if matches!(e.observability, Observability::Determined { .. }) {
+            assert_eq!(e.within_3sigma(&out.inertia_kg_m2), Some(true), "{name}");
+        }
+    }
+}
