@@ -4,7 +4,6 @@
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use inertia::estimator::rows::VariationalRows;
-use inertia::sim::control::Slew;
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::sim::{InertiaChange, SimOutput};
 use inertia::solver::native::NativeSolver;
@@ -12,17 +11,7 @@ use inertia::tensor::relative_frobenius_error;
 
 /// The paper's six slews, repeated every 300 s, for 600 s.
 fn long_slew() -> Scenario {
-    let base = SlewPlan::default();
-    let mut slews: Vec<Slew> = base.slews.clone();
-    slews.extend(base.slews.iter().map(|s| Slew {
-        start_s: s.start_s + 300.0,
-        ..*s
-    }));
-    Scenario::Slew(SlewPlan {
-        duration_s: 600.0,
-        slews,
-        ..base
-    })
+    Scenario::Slew(SlewPlan::default().repeated(2))
 }
 
 fn simulate(change: Option<InertiaChange>) -> SimOutput {

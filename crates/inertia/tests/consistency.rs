@@ -10,7 +10,6 @@ use inertia::estimator::observability::{Observability, Unobservable};
 use inertia::estimator::Estimate;
 use inertia::pipeline::{Pipeline, PipelineSettings};
 use inertia::sample::Sample;
-use inertia::sim::control::Slew;
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::sim::InertiaChange;
 use inertia::telemetry::glitch::GlitchPolicy;
@@ -20,17 +19,7 @@ use std::f64::consts::PI;
 
 /// The paper's six slews, repeated every 300 s, for 600 s.
 fn long_slew() -> Scenario {
-    let base = SlewPlan::default();
-    let mut slews: Vec<Slew> = base.slews.clone();
-    slews.extend(base.slews.iter().map(|s| Slew {
-        start_s: s.start_s + 300.0,
-        ..*s
-    }));
-    Scenario::Slew(SlewPlan {
-        duration_s: 600.0,
-        slews,
-        ..base
-    })
+    Scenario::Slew(SlewPlan::default().repeated(2))
 }
 
 fn samples(change: Option<InertiaChange>, gyro_deg_s_rthz: f64, seed: u64) -> Vec<Sample> {

@@ -126,6 +126,28 @@ impl Default for SlewPlan {
     }
 }
 
+impl SlewPlan {
+    /// The plan's slews `times` times over, one plan's duration apart, for `times` plans'
+    /// duration (a long run of the same manoeuvres).
+    #[must_use]
+    pub fn repeated(&self, times: usize) -> SlewPlan {
+        let slews = (0..times)
+            .flat_map(|k| {
+                let shift = k as f64 * self.duration_s;
+                self.slews.iter().map(move |s| Slew {
+                    start_s: s.start_s + shift,
+                    ..*s
+                })
+            })
+            .collect();
+        SlewPlan {
+            duration_s: times as f64 * self.duration_s,
+            slews,
+            ..self.clone()
+        }
+    }
+}
+
 /// The spin case.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpinPlan {
