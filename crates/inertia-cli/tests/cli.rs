@@ -1153,6 +1153,22 @@ fn active_bounds_are_reported() {
     assert_eq!(active[0]["side"], "lower");
     assert_eq!(active[0]["value_kg_m2"], 10.0);
     assert_eq!(run("J33=2.7:3.3").as_array().map(Vec::len), Some(0));
+    // An equality is accepted, holds the element, and is reported as fixed; one that
+    // contradicts J ⪰ εI is still an error.
+    let fixed = inertia(&[
+        "estimate",
+        csv.to_str().unwrap(),
+        "--bound",
+        "J33=3:3",
+        "--json",
+    ]);
+    assert!(fixed.status.success(), "{}", stderr(&fixed));
+    let j = json(&fixed);
+    assert!((j["j"][2].as_f64().unwrap() - 3.0).abs() <= 1e-8, "{j}");
+    assert_eq!(j["active_bounds"][0]["side"], "fixed");
+    let o = inertia(&["estimate", csv.to_str().unwrap(), "--bound", "J11=-1:-1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("contradict"), "{}", stderr(&o));
     let o = inertia(&["estimate", csv.to_str().unwrap(), "--bound", "J33=10:11"]);
     assert!(
         stdout(&o).contains(

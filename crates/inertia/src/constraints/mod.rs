@@ -43,6 +43,15 @@ pub enum Consistency {
     PositiveDefiniteOnly,
 }
 
+/// Relative half-width of the interval that stands for an equality bound (`--bound
+/// J12=0:0`): `1e-9 · max(|v|, 1e-3 kg m²)`. The answer then sits within it, and
+/// [`ConstraintSet::active_bounds`] reports the element as fixed.
+pub const EQUALITY_HALF_WIDTH: f64 = 1e-9;
+
+fn equality_half_width(v: f64) -> f64 {
+    EQUALITY_HALF_WIDTH * crate::math::abs(v).max(1e-3)
+}
+
 /// Which side of an element's interval.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -52,6 +61,8 @@ pub enum BoundSide {
     Lower,
     /// `j[k] ≤ upper`.
     Upper,
+    /// `j[k] = value` (lower and upper bounds equal).
+    Fixed,
 }
 
 /// An element bound the answer sits on ([`ConstraintSet::active_bounds`]).
@@ -68,16 +79,12 @@ pub struct ActiveBound {
 
 impl core::fmt::Display for ActiveBound {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let side = match self.side {
-            BoundSide::Lower => "lower",
-            BoundSide::Upper => "upper",
-        };
-        write!(
-            f,
-            "{} at its {side} bound {}",
-            self.component,
-            crate::text::Num(self.value_kg_m2)
-        )
+        let (c, v) = (self.component, crate::text::Num(self.value_kg_m2));
+        match self.side {
+            BoundSide::Lower => write!(f, "{c} at its lower bound {v}"),
+            BoundSide::Upper => write!(f, "{c} at its upper bound {v}"),
+            BoundSide::Fixed => write!(f, "{c} fixed at {v}"),
+        }
     }
 }
 
@@ -224,13 +231,22 @@ impl ConstraintSet {
 
     /// The element bounds that `j` sits on (within `1e-9` of the bound's size, at least
     /// 1e-12 kg m²): the bounds that hold the answer, which the data alone would have
-    /// put elsewhere.
+    /// put elsewhere. An equality is always active ([`BoundSide::Fixed`]).
     pub fn active_bounds(&self, j: &InertiaVector) -> impl Iterator<Item = ActiveBound> + '_ {
         let j = *j;
         Component::ALL.into_iter().flat_map(move |c| {
             let k = c.index();
-            let on =
-                move |b: f64| crate::math::abs(j[k] - b) <= 1e-9 * crate::math::abs(b).max(1e-3);
+            if let (Some(l), Some(u)) = (self.lower_kg_m2[k], self.upper_kg_m2[k]) {
+                if l == u {
+                    let fixed = ActiveBound {
+                        component: c,
+                        side: BoundSide::Fixed,
+                        value_kg_m2: l,
+                    };
+                    return Some(fixed).into_iter().chain(None);
+                }
+            }
+            let on = move |b: f64| crate::math::abs(j[k] - b) <= equality_half_width(b);
             let lower = self.lower_kg_m2[k].filter(|b| on(*b)).map(|b| ActiveBound {
                 component: c,
                 side: BoundSide::Lower,
@@ -324,16 +340,22 @@ impl ConstraintSet {
             Consistency::PositiveDefiniteOnly => {}
         }
         for i in 0..6 {
+            // An equality (`lower = upper`) is the interval of half-width
+            // [`EQUALITY_HALF_WIDTH`] about it, so that the set keeps an interior.
+            let half = match (self.lower_kg_m2[i], self.upper_kg_m2[i]) {
+                (Some(l), Some(u)) if l == u => equality_half_width(l),
+                _ => 0.0,
+            };
             if let Some(l) = self.lower_kg_m2[i] {
                 c.push_lin(Lin {
                     a: InertiaVector::ith(i, 1.0),
-                    b: l,
+                    b: l - half,
                 });
             }
             if let Some(u) = self.upper_kg_m2[i] {
                 c.push_lin(Lin {
                     a: InertiaVector::ith(i, -1.0),
-                    b: -u,
+                    b: -(u + half),
                 });
             }
         }
