@@ -126,7 +126,7 @@ impl GlitchCheck {
                 t_s: a.t_s,
                 attitude_turn_rad: 2.0 * libm::asin(turn.norm().min(1.0)),
                 gyro_turn_rad: w.norm() * h,
-                ratio: m / self.mean_square.sqrt(),
+                ratio: m / crate::math::sqrt(self.mean_square),
             };
             if let Some(slot) = self.listed.get_mut(self.count) {
                 *slot = Some(g);
