@@ -63,7 +63,7 @@ use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
-use crate::sample::Sample;
+use crate::sample::{check_range, OutOfRange, Sample};
 use crate::telemetry::convention::{ConventionCheck, Verdict};
 use std::boxed::Box;
 use std::string::String;
@@ -128,6 +128,14 @@ pub enum PipelineError {
         fixed: f64,
         /// Steps compared.
         steps: usize,
+    },
+    /// A sample holds a value outside the supported range ([`crate::sample::range`]).
+    #[error("input sample {sample}: {source}")]
+    OutOfRange {
+        /// 0-based index of the input sample.
+        sample: usize,
+        /// Which value, and how far out.
+        source: OutOfRange,
     },
     /// The constraint set is unusable.
     #[error("constraints: {0}")]
@@ -213,6 +221,10 @@ impl Pipeline {
         mut on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), PipelineError> {
         let index = self.input_samples;
+        check_range(s).map_err(|source| PipelineError::OutOfRange {
+            sample: index,
+            source,
+        })?;
         self.input_samples += 1;
         if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
             self.convention.push(s);
@@ -357,7 +369,8 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         estimator: entry.name,
     })?;
     let mut check = ConventionCheck::default();
-    for s in samples {
+    for (sample, s) in samples.iter().enumerate() {
+        check_range(s).map_err(|source| PipelineError::OutOfRange { sample, source })?;
         check.push(s);
     }
     if let Verdict::Wrong {

@@ -272,6 +272,13 @@ impl fmt::Display for Report {
                     pm[0], pm[1], pm[2]
                 )?,
             }
+            // Ascending: the triangle inequality J1 + J2 >= J3 and positivity.
+            if pm[0] <= 0.0 || pm[0] + pm[1] < pm[2] * (1.0 - 1e-6) {
+                writeln!(
+                    s,
+                    "warning: not a physical inertia (a principal moment is not positive, or J1 + J2 < J3): the data do not support this answer"
+                )?;
+            }
         }
         if let Some(ax) = self.principal_axes {
             writeln!(s, "principal axes (columns, body axes):")?;
