@@ -137,6 +137,16 @@ pub enum PipelineError {
         /// Which value, and how far out.
         source: OutOfRange,
     },
+    /// Resampling would put more than [`MAX_RESAMPLE_FACTOR`] samples in one input step.
+    #[error("input sample {sample}: resampling to {} s would make {} samples of the step of {} s (at most {})", crate::text::Num(*.period_s), crate::text::Num((*.step_s / *.period_s).round()), crate::text::Num(*.step_s), crate::text::Num(MAX_RESAMPLE_FACTOR))]
+    ResampleTooFine {
+        /// 0-based index of the input sample that ends the step.
+        sample: usize,
+        /// The step, s.
+        step_s: f64,
+        /// The resampling period, s.
+        period_s: f64,
+    },
     /// The constraint set is unusable.
     #[error("constraints: {0}")]
     Constraints(#[from] ConstraintError),
@@ -169,7 +179,13 @@ pub struct Pipeline {
     estimator_samples: usize,
     last: Option<Estimate>,
     convention: ConventionCheck,
+    /// The previous input sample's time and the step that ended at it.
+    previous: Option<(f64, Option<f64>)>,
 }
+
+/// Most resampled samples per input step (`resample_s`): a finer grid is refused
+/// ([`PipelineError::ResampleTooFine`]) rather than left to produce billions of samples.
+pub const MAX_RESAMPLE_FACTOR: f64 = 100.0;
 
 impl core::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -202,6 +218,7 @@ impl Pipeline {
             estimator_samples: 0,
             last: None,
             convention: ConventionCheck::default(),
+            previous: None,
         })
     }
 
@@ -225,6 +242,19 @@ impl Pipeline {
             sample: index,
             source,
         })?;
+        if let (Some(h), Some((t0, before))) = (self.config.resample_s, self.previous) {
+            let step = s.t_s - t0;
+            // A gap restarts the grid: nothing is interpolated across it.
+            let gap = before.is_some_and(|b| crate::sample::is_gap(b, step));
+            if !gap && step / h > MAX_RESAMPLE_FACTOR {
+                return Err(PipelineError::ResampleTooFine {
+                    sample: index,
+                    step_s: step,
+                    period_s: h,
+                });
+            }
+        }
+        self.previous = Some((s.t_s, self.previous.map(|(t0, _)| s.t_s - t0)));
         self.input_samples += 1;
         if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
             self.convention.push(s);
