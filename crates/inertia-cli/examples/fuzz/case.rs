@@ -10,7 +10,12 @@ use inertia::pipeline::{self, Pipeline, PipelineError, PipelineSettings};
 use inertia::telemetry::csv::{CsvOptions, TelemetryError, TelemetryReader};
 use inertia::tensor::Component;
 
-const ESTIMATORS: &[&str] = &["discrete-momentum", "variational", "finite-difference", "momentum"];
+const ESTIMATORS: &[&str] = &[
+    "discrete-momentum",
+    "variational",
+    "finite-difference",
+    "momentum",
+];
 
 /// What a case ran with, for the findings log.
 #[derive(Debug, Clone)]
@@ -56,7 +61,12 @@ pub fn plan(rng: &mut Rng) -> Plan {
             s.rotation_source = Some(*rng.pick(&[RotationSource::Attitude, RotationSource::Gyro]));
         }
         if rng.chance(0.3) {
-            s.rho_model = *rng.pick(&[RhoModel::Auto, RhoModel::Smooth, RhoModel::Held, RhoModel::Plain]);
+            s.rho_model = *rng.pick(&[
+                RhoModel::Auto,
+                RhoModel::Smooth,
+                RhoModel::Held,
+                RhoModel::Plain,
+            ]);
         }
     }
     if rng.chance(0.1) {
@@ -203,7 +213,12 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
                 return Ok(Outcome::Refused);
             }
         }
-        (p.last().copied(), p.excitation(), p.estimator_samples(), p.gaps())
+        (
+            p.last().copied(),
+            p.excitation(),
+            p.estimator_samples(),
+            p.gaps(),
+        )
     };
     let Some(last) = last else {
         return Ok(Outcome::Refused);

@@ -45,7 +45,10 @@ fn args() -> Args {
     let v: Vec<String> = std::env::args().skip(1).collect();
     for pair in v.chunks(2) {
         let val = pair.get(1).map_or("", String::as_str);
-        let num = || val.parse::<f64>().unwrap_or_else(|_| panic!("{}: not a number", pair[0]));
+        let num = || {
+            val.parse::<f64>()
+                .unwrap_or_else(|_| panic!("{}: not a number", pair[0]))
+        };
         match pair[0].as_str() {
             "--cases" => a.cases = num() as u64,
             "--seconds" => a.seconds = num(),
@@ -97,7 +100,15 @@ fn make(corpus: &[String], seed: u64, i: u64) -> (String, case::Plan) {
     (t.to_csv(), case::plan(&mut rng))
 }
 
-fn save(out: &std::path::Path, kind: &str, seed: u64, i: u64, csv: &str, plan: &case::Plan, what: &str) {
+fn save(
+    out: &std::path::Path,
+    kind: &str,
+    seed: u64,
+    i: u64,
+    csv: &str,
+    plan: &case::Plan,
+    what: &str,
+) {
     let _ = std::fs::create_dir_all(out);
     let stem = out.join(format!("{kind}-s{seed}-c{i}"));
     let _ = std::fs::write(stem.with_extension("csv"), csv);
@@ -160,7 +171,11 @@ fn main() {
                     };
                     if let Some((kind, what)) = finding {
                         counts.findings.fetch_add(1, Ordering::Relaxed);
-                        eprintln!("{kind} at case {i} ({}{}): {what}", plan.settings.estimator, if plan.batch { ", batch" } else { "" });
+                        eprintln!(
+                            "{kind} at case {i} ({}{}): {what}",
+                            plan.settings.estimator,
+                            if plan.batch { ", batch" } else { "" }
+                        );
                         save(&a.out, kind, a.seed, i, &csv, &plan, &what);
                     }
                     i += a.jobs;
@@ -175,8 +190,21 @@ fn main() {
             if let Some((i, since)) = *slot.lock().unwrap() {
                 if since.elapsed().as_secs_f64() > a.limit_s {
                     let (csv, plan) = make(&corpus, a.seed, i);
-                    save(&a.out, "hang", a.seed, i, &csv, &plan, "over the time limit");
-                    eprintln!("hang at case {i} ({}): over {} s; saved under {}", plan.settings.estimator, a.limit_s, a.out.display());
+                    save(
+                        &a.out,
+                        "hang",
+                        a.seed,
+                        i,
+                        &csv,
+                        &plan,
+                        "over the time limit",
+                    );
+                    eprintln!(
+                        "hang at case {i} ({}): over {} s; saved under {}",
+                        plan.settings.estimator,
+                        a.limit_s,
+                        a.out.display()
+                    );
                     stop.store(true, Ordering::Relaxed);
                     summary(&counts, start);
                     std::process::exit(2);

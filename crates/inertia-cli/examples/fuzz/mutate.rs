@@ -46,7 +46,9 @@ pub struct Table {
 
 impl Table {
     pub fn parse(text: &str) -> Self {
-        let mut lines = text.lines().map(|l| l.split(',').map(String::from).collect());
+        let mut lines = text
+            .lines()
+            .map(|l| l.split(',').map(String::from).collect());
         let header = lines.next().unwrap_or_default();
         Self {
             header,
@@ -85,9 +87,37 @@ impl Table {
 /// Special field texts: zeros, tiny and huge numbers on both sides of the supported
 /// range, non-numbers.
 const SPECIAL: &[&str] = &[
-    "0", "-0", "1e-300", "-1e-300", "5e-324", "1e-12", "1e308", "-1e308", "1.7976931348623157e308",
-    "1e154", "1e20", "1e15", "1e6", "-1e6", "999999.9", "1e4", "-1e4", "100", "-100", "1e10",
-    "-1e10", "NaN", "nan", "inf", "-inf", "", " ", "abc", "1e", "0x10", "1,5",
+    "0",
+    "-0",
+    "1e-300",
+    "-1e-300",
+    "5e-324",
+    "1e-12",
+    "1e308",
+    "-1e308",
+    "1.7976931348623157e308",
+    "1e154",
+    "1e20",
+    "1e15",
+    "1e6",
+    "-1e6",
+    "999999.9",
+    "1e4",
+    "-1e4",
+    "100",
+    "-100",
+    "1e10",
+    "-1e10",
+    "NaN",
+    "nan",
+    "inf",
+    "-inf",
+    "",
+    " ",
+    "abc",
+    "1e",
+    "0x10",
+    "1,5",
 ];
 
 const COLUMNS: &[&str] = &[
@@ -121,7 +151,9 @@ pub fn mutate(t: &mut Table, rng: &mut Rng) {
                         "t" => 1e4,
                         _ => 100.0,
                     };
-                    let v = limit * if rng.chance(0.5) { 1.0 } else { -1.0 } * (1.0 - rng.unit() * 1e-3);
+                    let v = limit
+                        * if rng.chance(0.5) { 1.0 } else { -1.0 }
+                        * (1.0 - rng.unit() * 1e-3);
                     let len = 1 + rng.below(20);
                     for r in row..(row + len).min(t.rows.len()) {
                         t.set(r, c, v);
@@ -177,7 +209,8 @@ pub fn mutate(t: &mut Table, rng: &mut Rng) {
             }
             10 => {
                 // Time reversal or a repeated time stamp.
-                if row + 1 < t.rows.len() && !t.rows[row].is_empty() && !t.rows[row + 1].is_empty() {
+                if row + 1 < t.rows.len() && !t.rows[row].is_empty() && !t.rows[row + 1].is_empty()
+                {
                     if rng.chance(0.5) {
                         let (a, b) = (t.rows[row][0].clone(), t.rows[row + 1][0].clone());
                         t.rows[row][0] = b;
