@@ -139,14 +139,15 @@ fn check_telemetry_error(e: &TelemetryError) -> Result<(), Finding> {
 
 /// The report text, as the command prints it, must hold no NaN or infinity.
 fn check_report(text: &str) -> Result<(), Finding> {
-    let bad = text
-        .split(|c: char| c.is_whitespace() || c == ',' || c == '[' || c == ']')
-        .find(|w| {
-            let w = w.trim_start_matches(['-', '+']).to_ascii_lowercase();
-            w == "nan" || w == "inf" || w.starts_with("nan") || w == "infinity"
-        });
-    match bad {
-        Some(w) => Err(Finding::NonFinite(format!("report holds `{w}`"))),
+    let bad = |w: &str| {
+        let w = w.trim_start_matches(['-', '+']).to_ascii_lowercase();
+        w == "inf" || w == "infinity" || w.starts_with("nan")
+    };
+    match text.lines().find(|l| {
+        l.split(|c: char| c.is_whitespace() || c == ',' || c == '[' || c == ']')
+            .any(bad)
+    }) {
+        Some(line) => Err(Finding::NonFinite(format!("report line: {line}"))),
         None => Ok(()),
     }
 }

@@ -26,6 +26,8 @@ use std::time::{Duration, Instant};
 
 struct Args {
     cases: u64,
+    /// First case index (replay one finding: `--from I --cases I+1`).
+    from: u64,
     seconds: f64,
     seed: u64,
     jobs: u64,
@@ -36,6 +38,7 @@ struct Args {
 fn args() -> Args {
     let mut a = Args {
         cases: u64::MAX,
+        from: 0,
         seconds: f64::INFINITY,
         seed: 1,
         jobs: 1,
@@ -52,6 +55,7 @@ fn args() -> Args {
         match pair[0].as_str() {
             "--cases" => a.cases = num() as u64,
             "--seconds" => a.seconds = num(),
+            "--from" => a.from = num() as u64,
             "--seed" => a.seed = num() as u64,
             "--jobs" => a.jobs = (num() as u64).max(1),
             "--limit-s" => a.limit_s = num(),
@@ -142,7 +146,7 @@ fn main() {
                 Arc::clone(&running[w as usize]),
             );
             std::thread::spawn(move || {
-                let mut i = w;
+                let mut i = a.from + w;
                 while i < a.cases && !stop.load(Ordering::Relaxed) {
                     if start.elapsed().as_secs_f64() > a.seconds {
                         break;

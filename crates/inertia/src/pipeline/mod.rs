@@ -254,7 +254,15 @@ impl Pipeline {
                 });
             }
         }
-        self.previous = Some((s.t_s, self.previous.map(|(t0, _)| s.t_s - t0)));
+        // As the resampler sees it: the step after a gap (or the first) has no previous
+        // step to be a gap against.
+        self.previous = Some((
+            s.t_s,
+            self.previous.and_then(|(t0, before)| {
+                let step = s.t_s - t0;
+                (!before.is_some_and(|b| crate::sample::is_gap(b, step))).then_some(step)
+            }),
+        ));
         self.input_samples += 1;
         if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
             self.convention.push(s);

@@ -299,8 +299,8 @@ impl fmt::Display for Report {
         if let Some(w) = self.residual_consistency {
             writeln!(
                 s,
-                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {:.1e} times the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
-                w.t_start_s, w.t_end_s, w.ratio
+                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
+                w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
             )?;
         }
         if let Some(r) = self.gyro_density_ratio {
