@@ -11,6 +11,9 @@ use inertia::sample::{check_range, range, Quantity, Sample};
 use inertia::sim::scenario::{Common, Scenario};
 use nalgebra::{Vector3, Vector6};
 
+/// Sets one value of a sample.
+type Edit = fn(&mut Sample, f64);
+
 fn slew(duration_s: f64) -> Vec<Sample> {
     Scenario::slew()
         .simulate(&Common {
@@ -34,7 +37,7 @@ fn settings(estimator: &str) -> PipelineSettings {
 fn range_check_names_the_quantity() {
     let s = slew(1.0)[3];
     assert!(check_range(&s).is_ok());
-    let cases: [(Quantity, fn(&mut Sample, f64)); 4] = [
+    let cases: [(Quantity, Edit); 4] = [
         (Quantity::Time, |s, v| s.t_s = v),
         (Quantity::Rho(2), |s, v| s.rho_nms.z = v),
         (Quantity::Tau(0), |s, v| s.tau_nm.x = v),
@@ -176,6 +179,30 @@ fn resampling_a_huge_step_is_refused() {
     for s in &samples {
         pipe.push(s).unwrap();
     }
+    // Fuzz finding (hang): a gap, then a huge step. The resampler restarted at the gap
+    // has no previous step to call the next one a gap against: refused.
+    let mut after_gap = slew(2.0);
+    for s in &mut after_gap[5..] {
+        s.t_s += 3.0;
+    }
+    for s in &mut after_gap[6..] {
+        s.t_s += 1e9;
+    }
+    let mut pipe = Pipeline::new(&p).unwrap();
+    let err = after_gap.iter().find_map(|s| pipe.push(s).err()).unwrap();
+    assert!(
+        matches!(err, PipelineError::ResampleTooFine { sample: 6, .. }),
+        "{err}"
+    );
+}
+
+/// Fuzz finding: a residual span against a rest that fits exactly has an infinite
+/// variance ratio, which the status printed as `inf`.
+#[test]
+fn infinite_ratio_is_worded() {
+    let t = inertia::text::Times(f64::INFINITY).to_string();
+    assert!(!t.contains("inf") && t.contains("fits exactly"), "{t}");
+    assert_eq!(inertia::text::Times(12.0).to_string(), "1.2e1 times");
 }
 
 /// The excitation diagnosis decomposes R with a bounded SVD: non-finite or wildly scaled

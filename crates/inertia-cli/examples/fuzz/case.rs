@@ -42,7 +42,7 @@ pub fn plan(rng: &mut Rng) -> Plan {
         if rng.chance(0.3) {
             let c = *rng.pick(&Component::ALL);
             let nominal = *rng.pick(&[1.0, 2.0, 3.0, 0.5, 100.0]);
-            s.constraints = s.constraints.clone().with_nominal(c, nominal, 0.1);
+            s.constraints = s.constraints.with_nominal(c, nominal, 0.1);
         }
         if estimator != "finite-difference" && rng.chance(0.25) {
             s.gyro_noise_deg_s_rthz = Some(*rng.pick(&[0.0, 1e-5, 1e-3, 0.1]));

@@ -119,6 +119,9 @@ fn save(
     let _ = std::fs::write(stem.with_extension("txt"), format!("{what}\n{plan:#?}\n"));
 }
 
+/// A worker's running case and since when.
+type Slot = Arc<Mutex<Option<(u64, Instant)>>>;
+
 #[derive(Default)]
 struct Counts {
     cases: AtomicU64,
@@ -134,8 +137,7 @@ fn main() {
     let stop = Arc::new(AtomicBool::new(false));
     let start = Instant::now();
     // Per worker: the case running and since when.
-    let running: Vec<Arc<Mutex<Option<(u64, Instant)>>>> =
-        (0..a.jobs).map(|_| Arc::new(Mutex::new(None))).collect();
+    let running: Vec<Slot> = (0..a.jobs).map(|_| Arc::new(Mutex::new(None))).collect();
     let workers: Vec<_> = (0..a.jobs)
         .map(|w| {
             let (a, corpus, counts, stop, slot) = (
