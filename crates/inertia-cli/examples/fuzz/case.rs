@@ -168,7 +168,7 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
     if config.estimator().capabilities.needs_gyro && !reader.has_gyro() {
         return Ok(Outcome::Refused);
     }
-    let (last, excitation, samples, gaps) = if plan.batch {
+    let (last, excitation, samples, gaps, extra) = if plan.batch {
         let mut all = Vec::new();
         for item in reader.by_ref() {
             match item {
@@ -182,7 +182,14 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
         match pipeline::batch(&all, &config) {
             Ok(out) => {
                 check_estimate(&out.estimate)?;
-                (Some(out.estimate), out.excitation, all.len(), out.gaps)
+                let extra = (out.row_model, None, None, None);
+                (
+                    Some(out.estimate),
+                    out.excitation,
+                    all.len(),
+                    out.gaps,
+                    extra,
+                )
             }
             Err(e) => {
                 check_pipeline_error(&e)?;
@@ -219,6 +226,12 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
             p.excitation(),
             p.estimator_samples(),
             p.gaps(),
+            (
+                p.row_model(),
+                p.torque_bias_nm(),
+                p.residual_consistency(),
+                p.gyro_density_ratio(),
+            ),
         )
     };
     let Some(last) = last else {
@@ -232,7 +245,12 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
             )));
         }
     }
-    let report = Report::new(&last, &config, plan.batch, samples, gaps).with_excitation(excitation);
+    // The report as `inertia estimate` builds it (less the file summary).
+    let (row_model, torque, residuals, density) = extra;
+    let report = Report::new(&last, &config, plan.batch, samples, gaps)
+        .with_excitation(excitation)
+        .with_row_model(row_model, torque)
+        .with_residual_tests(residuals, density);
     check_report(&report.to_string())?;
     Ok(Outcome::Estimate)
 }
