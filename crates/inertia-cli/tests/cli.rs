@@ -1084,12 +1084,18 @@ fn failed_runs_leave_no_output() {
 fn messages_are_compact_and_true() {
     let d = tempfile::tempdir().unwrap();
     // Times print in at most 12 significant digits.
-    let p = bad_file(d.path(), "big", 5, &|l| field(l, 0, "1e308"));
+    let p = bad_file(d.path(), "big", 5, &|l| field(l, 0, "9876543210.123456789"));
     assert_bad(
         &p,
         &[],
-        &["big.csv:6", "s does not increase (previous row: 1e308 s)"],
+        &[
+            "big.csv:6",
+            "s does not increase (previous row: 9876543210.12 s)",
+        ],
     );
+    // Beyond the supported range, the value itself is the error, in the same form.
+    let p = bad_file(d.path(), "huge", 5, &|l| field(l, 0, "1e308"));
+    assert_bad(&p, &[], &["huge.csv:5", "value 1e308 is outside"]);
     // One gap (lines 6-10 removed), in the singular.
     let src = simulate(d.path(), "gap_src", "slew", "2");
     let text: Vec<String> = std::fs::read_to_string(&src)
