@@ -18,8 +18,7 @@ use std::io::{IsTerminal, Read};
 /// How many recent samples' lines are kept to name the line of an error.
 const RECENT: usize = 8;
 
-/// Most resampled samples per input step (`--resample`).
-pub const MAX_RESAMPLE_FACTOR: f64 = 100.0;
+use inertia::pipeline::MAX_RESAMPLE_FACTOR;
 
 /// The telemetry: a file, or standard input for `-`.
 fn open(path: &std::path::Path) -> Result<(Box<dyn Read>, String), CliError> {

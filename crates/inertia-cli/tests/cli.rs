@@ -1084,12 +1084,18 @@ fn failed_runs_leave_no_output() {
 fn messages_are_compact_and_true() {
     let d = tempfile::tempdir().unwrap();
     // Times print in at most 12 significant digits.
-    let p = bad_file(d.path(), "big", 5, &|l| field(l, 0, "1e308"));
+    let p = bad_file(d.path(), "big", 5, &|l| field(l, 0, "9876543210.123456789"));
     assert_bad(
         &p,
         &[],
-        &["big.csv:6", "s does not increase (previous row: 1e308 s)"],
+        &[
+            "big.csv:6",
+            "s does not increase (previous row: 9876543210.12 s)",
+        ],
     );
+    // Beyond the supported range, the value itself is the error, in the same form.
+    let p = bad_file(d.path(), "huge", 5, &|l| field(l, 0, "1e308"));
+    assert_bad(&p, &[], &["huge.csv:5", "value 1e308 is outside"]);
     // One gap (lines 6-10 removed), in the singular.
     let src = simulate(d.path(), "gap_src", "slew", "2");
     let text: Vec<String> = std::fs::read_to_string(&src)
@@ -1232,4 +1238,104 @@ fn an_attitude_glitch_names_its_line() {
     let j = json(&o);
     assert_eq!(j["glitches"]["count"], 2, "{j}");
     assert!(j["inertia"].is_array());
+}
+
+/// Issue 11's reproductions: one value far outside the supported range (gyro, rotor
+/// momentum, torque), with the estimator and mode that hung, failed or printed NaN on
+/// it. Each is now an error naming the file, the line and the column, with the range.
+#[test]
+fn values_outside_the_supported_range_name_line_and_column() {
+    let d = tempfile::tempdir().unwrap();
+    let cases: [(usize, &str, &str, &[&str]); 8] = [
+        (11, "w_x", "1e308", &["--estimator", "finite-difference"]),
+        (
+            11,
+            "w_x",
+            "1e308",
+            &["--estimator", "finite-difference", "--batch"],
+        ),
+        (7, "rho_z", "1e15", &[]),
+        (8, "tau_x", "1e308", &["--batch"]),
+        (5, "rho_x", "1e308", &["--estimator", "momentum"]),
+        (5, "rho_x", "1e20", &["--estimator", "momentum"]),
+        (6, "rho_y", "1e160", &[]),
+        (0, "t", "2e10", &[]),
+    ];
+    for (i, (col, name, value, extra)) in cases.into_iter().enumerate() {
+        let file = format!("range{i}");
+        let p = bad_file(d.path(), &file, 9, &|l| field(l, col, value));
+        assert_bad(
+            &p,
+            extra,
+            &[
+                &format!("{file}.csv:9:"),
+                &format!("`{name}`"),
+                "outside the supported range",
+            ],
+        );
+    }
+}
+
+/// Inside the range, at its limits: every estimator, recursive and batch, exits 0 with
+/// finite numbers (no NaN or inf in the report, no null in J or σ), and the
+/// unconstrained baseline warns when its answer is not a physical inertia.
+#[test]
+fn values_at_the_limits_give_finite_reports() {
+    let d = tempfile::tempdir().unwrap();
+    let src = simulate(d.path(), "edge_src", "slew", "20");
+    let text = std::fs::read_to_string(&src).unwrap();
+    for (col, value) in [(5, "1e6"), (7, "-1e6"), (8, "1e4"), (11, "100")] {
+        let edited: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if (50..53).contains(&i) {
+                    field(l, col, value)
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect();
+        let p = d.path().join(format!("edge{col}.csv"));
+        std::fs::write(&p, edited.join("\n") + "\n").unwrap();
+        let path = p.to_str().unwrap();
+        for est in [
+            "discrete-momentum",
+            "variational",
+            "finite-difference",
+            "momentum",
+        ] {
+            for batch in [false, true] {
+                if batch && est == "momentum" {
+                    continue;
+                }
+                // A gyro rate of 100 rad/s on three rows is also an attitude glitch (the
+                // attitude does not turn with it): kept, to reach the estimators.
+                let mut args = vec!["estimate", path, "--estimator", est, "--glitches", "keep"];
+                if batch {
+                    args.push("--batch");
+                }
+                let o = inertia(&args);
+                assert_eq!(o.status.code(), Some(0), "{est} {col}: {}", stderr(&o));
+                let out = stdout(&o);
+                assert!(
+                    !out.contains("NaN") && !out.contains("inf "),
+                    "{est} {col}: {out}"
+                );
+                if est == "momentum" && col == 5 {
+                    assert!(out.contains("warning: not a physical inertia"), "{out}");
+                }
+                args.push("--json");
+                let v = json(&inertia(&args));
+                for key in ["inertia", "sigma"] {
+                    let nulls = v[key].to_string().matches("null").count();
+                    assert!(
+                        v[key].is_null() || nulls == 0,
+                        "{est} {col} {key}: {}",
+                        v[key]
+                    );
+                }
+            }
+        }
+    }
 }

@@ -306,6 +306,9 @@ fn center<const N: usize>(
     Centering::Stalled
 }
 
+/// Most rounds of the outer (path-following) loop.
+const MAX_OUTER_ROUNDS: u32 = 2_000;
+
 /// Run the barrier method from a strictly feasible `x0`.
 ///
 /// A centering that stalls (step cap, or round-off at a point within ~1e-12 of the
@@ -340,7 +343,16 @@ pub fn solve<const N: usize>(
     let mut steps = 0u32;
     let mut last: Option<(SVector<f64, N>, f64)> = None;
     let converged;
+    // t grows by μ > 1 per round, so m/t falls below any tolerance within a few hundred
+    // rounds; the bound makes that explicit (a round that does not get there is a
+    // numerical failure, reported as not converged).
+    let mut rounds = 0u32;
     loop {
+        rounds += 1;
+        if rounds > MAX_OUTER_ROUNDS {
+            converged = false;
+            break;
+        }
         let mut trial = x;
         match center(problem, &mut trial, t, settings, &mut steps) {
             Centering::Done => {

@@ -63,3 +63,9 @@ pub(crate) fn abs(x: f64) -> f64 {
         x
     }
 }
+
+/// Most iterations of nalgebra's iterative decompositions (SVD, symmetric eigen). Their
+/// plain constructors iterate without bound, which on matrices they cannot converge on
+/// (non-finite or wildly scaled entries) never returns; every call here goes through
+/// `try_new` with this bound and handles the failure.
+pub(crate) const MAX_DECOMPOSITION_ITERATIONS: usize = 10_000;

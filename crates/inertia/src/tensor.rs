@@ -131,7 +131,15 @@ pub fn second_moment(j: &Matrix3<f64>) -> Matrix3<f64> {
 /// from principal to body axes. Std only (uses an iterative eigen-solver).
 #[must_use]
 pub fn principal(j: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
-    let e = SymmetricEigen::new(*j);
+    // Bounded iterations; the closed form when they do not converge.
+    let e = SymmetricEigen::try_new(*j, f64::EPSILON, crate::math::MAX_DECOMPOSITION_ITERATIONS)
+        .unwrap_or_else(|| {
+            let (values, vectors) = crate::eigen3::symmetric_eigen3(j);
+            SymmetricEigen {
+                eigenvalues: values,
+                eigenvectors: Matrix3::from_columns(&vectors),
+            }
+        });
     let mut idx = [0usize, 1, 2];
     idx.sort_unstable_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
     let vals = Vector3::new(

@@ -186,3 +186,18 @@ mod tests {
         assert!(std::format!("{}", Clipped::new(&wide)).starts_with("éé"));
     }
 }
+
+/// A variance ratio as `"{r:.1e} times"`, and for an infinite one (the reference
+/// variance is zero: the rest fits exactly) words instead of `inf`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Times(pub f64);
+
+impl fmt::Display for Times {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.is_finite() {
+            write!(f, "{:.1e} times", self.0)
+        } else {
+            f.write_str("unboundedly many times (the rest fits exactly)")
+        }
+    }
+}

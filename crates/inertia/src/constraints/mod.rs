@@ -448,7 +448,7 @@ impl Constraints {
     pub fn margin(&self, j: &InertiaVector) -> f64 {
         let mut m = f64::INFINITY;
         for l in self.lmis() {
-            m = m.min(l.eval(j).symmetric_eigenvalues().min());
+            m = m.min(crate::eigen3::symmetric_eigen3(&l.eval(j)).0.min());
         }
         for l in self.lins() {
             m = m.min(l.eval(j));
@@ -527,7 +527,7 @@ impl Constraints {
         let mut s0 = 0.0f64;
         let mut m0 = f64::INFINITY;
         for l in self.lmis() {
-            m0 = m0.min(l.eval(&j0).symmetric_eigenvalues().min());
+            m0 = m0.min(crate::eigen3::symmetric_eigen3(&l.eval(&j0)).0.min());
         }
         for l in self.lins() {
             m0 = m0.min(l.eval(&j0));

@@ -42,8 +42,11 @@ pub fn reduce<S: RowSource>(
     let y_energy = yv.norm_squared();
     let qr = hm.qr();
     let (q, r) = (qr.q(), qr.r());
-    let mut rr = Matrix6::from_fn(|i, k| r[(i, k)]);
-    let mut z: Vector6<f64> = Vector6::from_iterator((q.transpose() * &yv).iter().copied());
+    // Fewer than six rows (a gap right after the first steps): R has fewer rows; the
+    // missing ones are zero (rank deficient, for the observability test to report).
+    let qty = q.transpose() * &yv;
+    let mut rr = Matrix6::from_fn(|i, k| if i < r.nrows() { r[(i, k)] } else { 0.0 });
+    let mut z = Vector6::from_fn(|i, _| qty.get(i).copied().unwrap_or(0.0));
     for i in 0..6 {
         if rr[(i, i)] < 0.0 {
             for k in 0..6 {

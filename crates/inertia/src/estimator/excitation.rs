@@ -46,15 +46,24 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 /// "determined" and "barely separate" at once.
 #[must_use]
 pub fn diagnose(qr: &RecursiveQr, settings: &ObservabilitySettings) -> Excitation {
-    let svd = SVD::new(qr.r, false, true);
+    // A decomposition that does not converge (bounded iterations) reports nothing
+    // excited: zero singular values, no σ.
+    let (singular_values, v_t) = SVD::try_new(
+        qr.r,
+        false,
+        true,
+        f64::EPSILON,
+        crate::math::MAX_DECOMPOSITION_ITERATIONS,
+    )
+    .and_then(|s| Some((s.singular_values, s.v_t?)))
+    .unwrap_or_else(|| (nalgebra::Vector6::zeros(), nalgebra::Matrix6::identity()));
     let mut order = [0usize, 1, 2, 3, 4, 5];
-    order.sort_unstable_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
-    let sv: [f64; 6] = order.map(|i| svd.singular_values[i]);
-    let v_t = svd.v_t.unwrap_or_else(nalgebra::Matrix6::identity);
+    order.sort_unstable_by(|&a, &b| singular_values[b].total_cmp(&singular_values[a]));
+    let sv: [f64; 6] = order.map(|i| singular_values[i]);
     let weakest = InertiaVector::from_fn(|k, _| v_t[(order[5], k)]);
     // With y ≡ 0 the residual is zero by construction: no variance to report.
     let v = v_t.transpose();
-    let element_sigma = super::uncertainty::noise_sigma(qr, &svd.singular_values, &v);
+    let element_sigma = super::uncertainty::noise_sigma(qr, &singular_values, &v);
     let mut weak_elements = Vec::new();
     let mut advice = Vec::new();
     if qr.y_energy == 0.0 {

@@ -189,11 +189,13 @@ impl core::fmt::Display for Unobservable {
                 t_end_s,
             } => write!(
                 f,
-                "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {ratio:.1e} times the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or use --memory for a J that changes"
+                "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {} the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or use --memory for a J that changes",
+                crate::text::Times(*ratio)
             ),
             Unobservable::DensityOverstated { ratio } => write!(
                 f,
-                "the residuals are {ratio:.1e} times the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (--gyro-noise is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)"
+                "the residuals are {} the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (--gyro-noise is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)",
+                crate::text::Times(*ratio)
             ),
             Unobservable::IllConditioned {
                 condition,

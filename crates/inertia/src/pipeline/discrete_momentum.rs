@@ -625,8 +625,15 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
             c.gyro_noise_rad_s_rthz,
         )
         .map_err(wrap)?;
-        let svd = b.qr.r.svd(false, true);
-        let noise = svd.v_t.and_then(|v_t| {
+        let svd = nalgebra::SVD::try_new(
+            b.qr.r,
+            false,
+            true,
+            f64::EPSILON,
+            crate::math::MAX_DECOMPOSITION_ITERATIONS,
+        );
+        let noise = svd.and_then(|svd| {
+            let v_t = svd.v_t?;
             noise_sigma(&b.qr, &svd.singular_values, &v_t.transpose())
                 .map(|ls| robust_sigma(&ls, b.jackknife_sigma_kg_m2.as_ref()))
         });

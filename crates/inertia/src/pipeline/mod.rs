@@ -63,7 +63,7 @@ use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
-use crate::sample::Sample;
+use crate::sample::{check_range, OutOfRange, Sample};
 use crate::telemetry::convention::{ConventionCheck, Verdict};
 use crate::telemetry::glitch::{Glitch, GlitchCheck, GlitchPolicy};
 use std::boxed::Box;
@@ -139,6 +139,24 @@ pub enum PipelineError {
         /// The step.
         glitch: Glitch,
     },
+    /// A sample holds a value outside the supported range ([`crate::sample::range`]).
+    #[error("input sample {sample}: {source}")]
+    OutOfRange {
+        /// 0-based index of the input sample.
+        sample: usize,
+        /// Which value, and how far out.
+        source: OutOfRange,
+    },
+    /// Resampling would put more than [`MAX_RESAMPLE_FACTOR`] samples in one input step.
+    #[error("input sample {sample}: resampling to {} s would make {} samples of the step of {} s (at most {})", crate::text::Num(*.period_s), crate::text::Num((*.step_s / *.period_s).round()), crate::text::Num(*.step_s), crate::text::Num(MAX_RESAMPLE_FACTOR))]
+    ResampleTooFine {
+        /// 0-based index of the input sample that ends the step.
+        sample: usize,
+        /// The step, s.
+        step_s: f64,
+        /// The resampling period, s.
+        period_s: f64,
+    },
     /// The constraint set is unusable.
     #[error("constraints: {0}")]
     Constraints(#[from] ConstraintError),
@@ -172,7 +190,13 @@ pub struct Pipeline {
     last: Option<Estimate>,
     convention: ConventionCheck,
     glitch: GlitchCheck,
+    /// The previous input sample's time and the step that ended at it.
+    previous: Option<(f64, Option<f64>)>,
 }
+
+/// Most resampled samples per input step (`resample_s`): a finer grid is refused
+/// ([`PipelineError::ResampleTooFine`]) rather than left to produce billions of samples.
+pub const MAX_RESAMPLE_FACTOR: f64 = 100.0;
 
 impl core::fmt::Debug for Pipeline {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -206,6 +230,7 @@ impl Pipeline {
             last: None,
             convention: ConventionCheck::default(),
             glitch: GlitchCheck::default(),
+            previous: None,
         })
     }
 
@@ -225,6 +250,31 @@ impl Pipeline {
         mut on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), PipelineError> {
         let index = self.input_samples;
+        check_range(s).map_err(|source| PipelineError::OutOfRange {
+            sample: index,
+            source,
+        })?;
+        if let (Some(h), Some((t0, before))) = (self.config.resample_s, self.previous) {
+            let step = s.t_s - t0;
+            // A gap restarts the grid: nothing is interpolated across it.
+            let gap = before.is_some_and(|b| crate::sample::is_gap(b, step));
+            if !gap && step / h > MAX_RESAMPLE_FACTOR {
+                return Err(PipelineError::ResampleTooFine {
+                    sample: index,
+                    step_s: step,
+                    period_s: h,
+                });
+            }
+        }
+        // As the resampler sees it: the step after a gap (or the first) has no previous
+        // step to be a gap against.
+        self.previous = Some((
+            s.t_s,
+            self.previous.and_then(|(t0, before)| {
+                let step = s.t_s - t0;
+                (!before.is_some_and(|b| crate::sample::is_gap(b, step))).then_some(step)
+            }),
+        ));
         if let Some(glitch) = self.glitch.push(s) {
             if self.config.glitches == GlitchPolicy::Stop {
                 return Err(PipelineError::AttitudeGlitch {
@@ -386,6 +436,7 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     let mut check = ConventionCheck::default();
     let mut glitches = GlitchCheck::default();
     for (sample, s) in samples.iter().enumerate() {
+        check_range(s).map_err(|source| PipelineError::OutOfRange { sample, source })?;
         check.push(s);
         if let Some(glitch) = glitches.push(s) {
             if config.glitches == GlitchPolicy::Stop {

@@ -304,6 +304,13 @@ impl fmt::Display for Report {
                     pm[0], pm[1], pm[2]
                 )?,
             }
+            // Ascending: the triangle inequality J1 + J2 >= J3 and positivity.
+            if pm[0] <= 0.0 || pm[0] + pm[1] < pm[2] * (1.0 - 1e-6) {
+                writeln!(
+                    s,
+                    "warning: not a physical inertia (a principal moment is not positive, or J1 + J2 < J3): the data do not support this answer"
+                )?;
+            }
         }
         if let Some(ax) = self.principal_axes {
             writeln!(s, "principal axes (columns, body axes):")?;
@@ -344,8 +351,8 @@ impl fmt::Display for Report {
         if let Some(w) = self.residual_consistency {
             writeln!(
                 s,
-                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {:.1e} times the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
-                w.t_start_s, w.t_end_s, w.ratio
+                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
+                w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
             )?;
         }
         if let Some(r) = self.gyro_density_ratio {

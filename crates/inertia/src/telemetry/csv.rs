@@ -16,7 +16,7 @@
 //! # Validation
 //!
 //! Every error names the file, the line and the column: unparsable numbers, NaN or
-//! infinite values, missing or duplicated columns, lines longer than [`MAX_LINE_BYTES`]
+//! infinite values, values outside the supported range ([`crate::sample::range`]), missing or duplicated columns, lines longer than [`MAX_LINE_BYTES`]
 //! (checked while reading, so a file without line breaks fails fast), lines starting with
 //! `#` (there are no comment lines: every non-blank line is data), quaternions whose norm differs from 1 by more than
 //! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
@@ -43,7 +43,7 @@
 use super::line_cap::{LineCap, LineTooLong};
 use super::time_stamp::{Clock, StampError};
 use crate::attitude::Quaternion;
-use crate::sample::Sample;
+use crate::sample::{check_value, Quantity, Sample};
 use crate::text::{Clipped, Num, Quoted};
 use nalgebra::Vector3;
 use std::collections::HashMap;
@@ -253,6 +253,22 @@ pub enum TelemetryError {
         /// The value.
         value: f64,
     },
+    /// A value outside the supported range ([`crate::sample::range`]).
+    #[error("{file}:{line}: column `{}`: value {} is outside the supported range (magnitude at most {} {unit})", Clipped::new(.column), Num(*.value), Num(*.limit))]
+    OutOfRange {
+        /// File name.
+        file: String,
+        /// Line.
+        line: u64,
+        /// Column.
+        column: String,
+        /// The value.
+        value: f64,
+        /// The largest magnitude supported.
+        limit: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
     /// A quaternion's norm is too far from 1.
     #[error("{file}:{line}: columns `{}`: quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}", Clipped::new(.columns))]
     NonUnitQuaternion {
@@ -312,6 +328,7 @@ impl TelemetryError {
             | TelemetryError::Malformed { line, .. }
             | TelemetryError::Parse { line, .. }
             | TelemetryError::NonFinite { line, .. }
+            | TelemetryError::OutOfRange { line, .. }
             | TelemetryError::NonUnitQuaternion { line, .. }
             | TelemetryError::NonIncreasingTime { line, .. }
             | TelemetryError::NonUniformPeriod { line, .. } => Some(*line),
@@ -484,12 +501,40 @@ impl<R: Read> TelemetryReader<R> {
         Ok(v)
     }
 
-    fn vec3(&self, line: u64, i: &[usize; 3]) -> Result<Vector3<f64>, TelemetryError> {
-        Ok(Vector3::new(
-            self.field(line, i[0])?,
-            self.field(line, i[1])?,
-            self.field(line, i[2])?,
-        ))
+    /// `v`, read from column `i`, when it lies in the supported range of `quantity`.
+    fn in_range(
+        &self,
+        line: u64,
+        i: usize,
+        quantity: Quantity,
+        v: f64,
+    ) -> Result<f64, TelemetryError> {
+        check_value(quantity, v).map_err(|_| {
+            let (limit, unit) = quantity.limit();
+            TelemetryError::OutOfRange {
+                file: self.file.clone(),
+                line,
+                column: self.headers[i].clone(),
+                value: v,
+                limit,
+                unit,
+            }
+        })?;
+        Ok(v)
+    }
+
+    /// Three columns of `kind` (`Quantity::Rho`, …), each within the supported range.
+    fn vec3(
+        &self,
+        line: u64,
+        i: &[usize; 3],
+        kind: fn(usize) -> Quantity,
+    ) -> Result<Vector3<f64>, TelemetryError> {
+        let mut v = Vector3::zeros();
+        for (axis, &col) in i.iter().enumerate() {
+            v[axis] = self.in_range(line, col, kind(axis), self.field(line, col)?)?;
+        }
+        Ok(v)
     }
 
     /// The names of the quaternion columns, comma-separated (for messages).
@@ -560,6 +605,7 @@ impl<R: Read> TelemetryReader<R> {
             });
         }
         let t = self.time(line)?;
+        let t = self.in_range(line, self.idx.t, Quantity::Time, t)?;
         let c = [
             self.field(line, self.idx.q[0])?,
             self.field(line, self.idx.q[1])?,
@@ -590,13 +636,13 @@ impl<R: Read> TelemetryReader<R> {
                 q = n;
             }
         }
-        let rho = self.vec3(line, &self.idx.rho)?;
+        let rho = self.vec3(line, &self.idx.rho, Quantity::Rho)?;
         let tau = match self.idx.tau {
-            Some(i) => self.vec3(line, &i)?,
+            Some(i) => self.vec3(line, &i, Quantity::Tau)?,
             None => Vector3::zeros(),
         };
         let w = match self.idx.w {
-            Some(i) => Some(self.vec3(line, &i)?),
+            Some(i) => Some(self.vec3(line, &i, Quantity::Rate)?),
             None => None,
         };
         if let Some(prev) = self.prev {

@@ -89,11 +89,15 @@ fn messages_quote_bounded_content() {
 
 #[test]
 fn times_in_messages_are_compact() {
-    let text = format!("{HEADER}\n{}\n{}\n", row("1e308"), row("299.8999999999997"));
+    let text = format!(
+        "{HEADER}\n{}\n{}\n",
+        row("9876543210.123456789"),
+        row("299.8999999999997")
+    );
     let m = read(&text).unwrap_err().to_string();
     assert_eq!(
         m,
-        "f.csv:3: column `t`: time 299.9 s does not increase (previous row: 1e308 s)"
+        "f.csv:3: column `t`: time 299.9 s does not increase (previous row: 9876543210.12 s)"
     );
 }
 
