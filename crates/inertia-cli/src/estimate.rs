@@ -139,90 +139,69 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         p
     });
     let mut first_times = [f64::NAN; 2];
-    let (last, excitation, samples, gaps, row_model, torque, residuals, density_ratio, glitches) =
-        if a.batch {
-            let mut all = Vec::new();
-            let mut lines = Vec::new();
-            while let Some(item) = reader.next() {
-                all.push(item.map_err(telemetry)?);
-                lines.push(reader.last_line());
+    let (report, samples) = if a.batch {
+        let mut all = Vec::new();
+        let mut lines = Vec::new();
+        while let Some(item) = reader.next() {
+            all.push(item.map_err(telemetry)?);
+            lines.push(reader.last_line());
+        }
+        for (t, s) in first_times.iter_mut().zip(&all) {
+            *t = s.t_s;
+        }
+        let out = pipeline::batch(&all, &config).map_err(|e| {
+            let line = match &e {
+                PipelineError::Estimator {
+                    source: EstimatorError::Row { sample, .. },
+                    ..
+                }
+                | PipelineError::AttitudeGlitch { sample, .. } => lines.get(*sample).copied(),
+                _ => None,
+            };
+            data_error(e, line)
+        })?;
+        if let Some(h) = history.as_mut() {
+            h.write(&out.estimate)?;
+        }
+        (Some(Report::of_batch(&out, &config, all.len())), all.len())
+    } else {
+        let mut p = Pipeline::from_config(config).map_err(settings_error)?;
+        let mut write_error = None;
+        let mut recent = VecDeque::with_capacity(RECENT);
+        while let Some(item) = reader.next() {
+            let s = item.map_err(telemetry)?;
+            if recent.len() == RECENT {
+                recent.pop_front();
             }
-            for (t, s) in first_times.iter_mut().zip(&all) {
-                *t = s.t_s;
+            recent.push_back((s.t_s, reader.last_line()));
+            let n = p.input_samples();
+            if n < 2 {
+                first_times[n] = s.t_s;
             }
-            let out = pipeline::batch(&all, &config).map_err(|e| {
-                let line = match &e {
-                    PipelineError::Estimator {
-                        source: EstimatorError::Row { sample, .. },
-                        ..
-                    }
-                    | PipelineError::AttitudeGlitch { sample, .. } => lines.get(*sample).copied(),
-                    _ => None,
-                };
-                data_error(e, line)
+            if n == 1 {
+                let at = format!("{file}:{}", reader.last_line());
+                check_against_step(&config, first_times[1] - first_times[0], &at)?;
+            }
+            p.push_each(&s, |e| {
+                if let (Some(h), None) = (history.as_mut(), &write_error) {
+                    write_error = h.write(e).err();
+                }
+            })
+            .map_err(|e| {
+                let line = step_end_line(&e, &recent).unwrap_or(reader.last_line());
+                data_error(e, Some(line))
             })?;
-            if let Some(h) = history.as_mut() {
-                h.write(&out.estimate)?;
+            if let Some(e) = write_error.take() {
+                return Err(e);
             }
-            (
-                Some(out.estimate),
-                out.excitation,
-                all.len(),
-                out.gaps,
-                out.row_model,
-                None,
-                None,
-                None,
-                None,
-            )
-        } else {
-            let mut p = Pipeline::from_config(config).map_err(settings_error)?;
-            let mut write_error = None;
-            let mut recent = VecDeque::with_capacity(RECENT);
-            while let Some(item) = reader.next() {
-                let s = item.map_err(telemetry)?;
-                if recent.len() == RECENT {
-                    recent.pop_front();
-                }
-                recent.push_back((s.t_s, reader.last_line()));
-                let n = p.input_samples();
-                if n < 2 {
-                    first_times[n] = s.t_s;
-                }
-                if n == 1 {
-                    let at = format!("{file}:{}", reader.last_line());
-                    check_against_step(&config, first_times[1] - first_times[0], &at)?;
-                }
-                p.push_each(&s, |e| {
-                    if let (Some(h), None) = (history.as_mut(), &write_error) {
-                        write_error = h.write(e).err();
-                    }
-                })
-                .map_err(|e| {
-                    let line = step_end_line(&e, &recent).unwrap_or(reader.last_line());
-                    data_error(e, Some(line))
-                })?;
-                if let Some(e) = write_error.take() {
-                    return Err(e);
-                }
-                if let Some(pb) = &progress {
-                    if n.is_multiple_of(4096) {
-                        pb.set_position(reader.byte_position());
-                    }
+            if let Some(pb) = &progress {
+                if n.is_multiple_of(4096) {
+                    pb.set_position(reader.byte_position());
                 }
             }
-            (
-                p.last().copied(),
-                p.excitation(),
-                p.estimator_samples(),
-                p.gaps(),
-                p.row_model(),
-                p.torque_bias_nm(),
-                p.residual_consistency(),
-                p.gyro_density_ratio(),
-                Some(*p.glitches()),
-            )
-        };
+        }
+        (Report::of_pipeline(&p), p.estimator_samples())
+    };
     if let Some(p) = progress {
         p.finish_and_clear();
     }
@@ -230,7 +209,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         h.finish()?;
     }
     let stats = reader.stats();
-    let Some(last) = last else {
+    let Some(report) = report else {
         let need = if entry.capabilities.needs_gyro && !entry.capabilities.constraints {
             2
         } else {
@@ -246,7 +225,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             entry.name,
         )));
     };
-    let report = Report::new(&last, &config, a.batch, samples, gaps)
+    let report = report
         .with_input(InputSummary {
             file: file.clone(),
             sample_period_s: config
@@ -257,10 +236,6 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             min_step_s: stats.min_step_s,
             max_step_s: stats.max_step_s,
         })
-        .with_excitation(excitation)
-        .with_row_model(row_model, torque)
-        .with_residual_tests(residuals, density_ratio)
-        .with_glitches(glitches.as_ref())
         .with_truth(truth.as_ref());
     if a.json {
         let json = serde_json::to_string(&report).map_err(|e| internal(format!("JSON: {e}")))?;

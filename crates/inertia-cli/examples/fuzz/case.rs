@@ -168,7 +168,7 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
     if config.estimator().capabilities.needs_gyro && !reader.has_gyro() {
         return Ok(Outcome::Refused);
     }
-    let (last, excitation, samples, gaps, extra) = if plan.batch {
+    let report = if plan.batch {
         let mut all = Vec::new();
         for item in reader.by_ref() {
             match item {
@@ -182,14 +182,7 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
         match pipeline::batch(&all, &config) {
             Ok(out) => {
                 check_estimate(&out.estimate)?;
-                let extra = (out.row_model, None, None, None);
-                (
-                    Some(out.estimate),
-                    out.excitation,
-                    all.len(),
-                    out.gaps,
-                    extra,
-                )
+                Some(Report::of_batch(&out, &config, all.len()))
             }
             Err(e) => {
                 check_pipeline_error(&e)?;
@@ -221,23 +214,13 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
                 return Ok(Outcome::Refused);
             }
         }
-        (
-            p.last().copied(),
-            p.excitation(),
-            p.estimator_samples(),
-            p.gaps(),
-            (
-                p.row_model(),
-                p.torque_bias_nm(),
-                p.residual_consistency(),
-                p.gyro_density_ratio(),
-            ),
-        )
+        Report::of_pipeline(&p)
     };
-    let Some(last) = last else {
+    // The report as `inertia estimate` builds it (less the file summary).
+    let Some(report) = report else {
         return Ok(Outcome::Refused);
     };
-    if let Some(x) = &excitation {
+    if let Some(x) = &report.excitation {
         if !finite(&x.singular_values) || x.element_sigma.is_some_and(|s| !finite(&s)) {
             return Err(Finding::NonFinite(format!(
                 "excitation: {:?} {:?}",
@@ -245,12 +228,6 @@ pub fn run(csv: &str, plan: &Plan) -> Result<Outcome, Finding> {
             )));
         }
     }
-    // The report as `inertia estimate` builds it (less the file summary).
-    let (row_model, torque, residuals, density) = extra;
-    let report = Report::new(&last, &config, plan.batch, samples, gaps)
-        .with_excitation(excitation)
-        .with_row_model(row_model, torque)
-        .with_residual_tests(residuals, density);
     check_report(&report.to_string())?;
     Ok(Outcome::Estimate)
 }

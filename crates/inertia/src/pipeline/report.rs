@@ -184,6 +184,29 @@ impl Report {
         }
     }
 
+    /// The report of a streaming pipeline's latest estimate (`None` before one): the
+    /// estimate, the excitation, the row model and torque, the residual tests and the
+    /// glitches kept.
+    #[must_use]
+    pub fn of_pipeline(p: &super::Pipeline) -> Option<Self> {
+        let last = p.last()?;
+        Some(
+            Self::new(last, p.config(), false, p.estimator_samples(), p.gaps())
+                .with_excitation(p.excitation())
+                .with_row_model(p.row_model(), p.torque_bias_nm())
+                .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
+                .with_glitches(Some(p.glitches())),
+        )
+    }
+
+    /// The report of a batch run over `samples` samples.
+    #[must_use]
+    pub fn of_batch(out: &super::BatchOutput, config: &PipelineConfig, samples: usize) -> Self {
+        Self::new(&out.estimate, config, true, samples, out.gaps)
+            .with_excitation(out.excitation.clone())
+            .with_row_model(out.row_model, None)
+    }
+
     /// With the input summary.
     #[must_use]
     pub fn with_input(mut self, input: InputSummary) -> Self {
