@@ -233,6 +233,15 @@ pub enum ConstraintArg {
     PositiveDefinite,
 }
 
+/// Conventions for products of inertia.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ProductsArg {
+    /// Tensor entries: J12 = −Σ m x y (this tool's convention).
+    Tensor,
+    /// CAD products of inertia: I_xy = +Σ m x y = −J12.
+    Cad,
+}
+
 /// Sources of the incremental rotations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum RotationArg {
@@ -315,6 +324,26 @@ pub struct EstimateArgs {
     /// Tolerance for `--nominal`, e.g. `10%` or `0.1`.
     #[arg(long, value_name = "P", requires = "nominal")]
     pub tolerance: Option<String>,
+    /// Fix every product of inertia at zero (J diagonal in the telemetry's body axes): an
+    /// equality the solver eliminates, as `--bound J12=0:0` etc.
+    #[arg(long)]
+    pub diagonal: bool,
+    /// Gaussian prior on J, e.g. from CAD (JSON as written by `simulate`, optionally with
+    /// `sigma_kg_m2` per element and `products_of_inertia`: "tensor" or "cad"). It is
+    /// weighed against the data; the report says how much of each element the data
+    /// determine.
+    #[arg(long, value_name = "J.json")]
+    pub prior: Option<PathBuf>,
+    /// Standard deviation of the prior: relative (`5%`: moments ±5 %·|J_ii|, products
+    /// ±5 %·√(J_ii J_jj)) or absolute in kg m² for every element (`0.02`). Overrides the
+    /// file's `sigma_kg_m2`.
+    #[arg(long, value_name = "P", requires = "prior")]
+    pub prior_sigma: Option<String>,
+    /// How products of inertia are written in `--prior`, `--nominal` and `--bound Jij`
+    /// (i ≠ j): `tensor` (J12 = −Σ m x y, this tool's convention) or `cad` (I_xy = +Σ m x y,
+    /// what CAD tools report). Default: the file's `products_of_inertia`, else tensor.
+    #[arg(long, value_enum, value_name = "CONVENTION")]
+    pub products: Option<ProductsArg>,
     /// Solve every N samples (recursive estimators).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub every: usize,

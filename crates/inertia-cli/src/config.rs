@@ -1,8 +1,10 @@
 //! Arguments validated into configurations.
 
-use crate::args::{ConstraintArg, EstimateArgs, GlitchArg, InputArgs, RhoModelArg, RotationArg};
+use crate::args::{
+    ConstraintArg, EstimateArgs, GlitchArg, InputArgs, ProductsArg, RhoModelArg, RotationArg,
+};
 use crate::error::{input, read_failed, CliError};
-use inertia::constraints::ConstraintSet;
+use inertia::constraints::{ConstraintSet, ProductConvention};
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{PipelineError, PipelineSettings};
 use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
@@ -12,7 +14,7 @@ use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// An inertia tensor file (`FILE.truth.json`, `--nominal`, `--truth`).
+/// An inertia tensor file (`FILE.truth.json`, `--nominal`, `--truth`, `--prior`).
 #[derive(Debug, Serialize, Deserialize)]
 pub struct InertiaFile {
     /// J, kg m², rows of the 3×3 matrix.
@@ -20,6 +22,23 @@ pub struct InertiaFile {
     /// `[J11, J22, J33, J12, J13, J23]`, kg m² (written for convenience; ignored on input).
     #[serde(default, skip_deserializing)]
     pub j: Option<[f64; 6]>,
+    /// Standard deviation of each element, kg m², as a symmetric 3×3 matrix (`--prior`
+    /// only; optional).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_kg_m2: Option<[[f64; 3]; 3]>,
+    /// How the off-diagonal entries are written: `"tensor"` (J12 = −Σ m x y, the
+    /// default) or `"cad"` (+Σ m x y).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub products_of_inertia: Option<String>,
+}
+
+/// A prior-knowledge file as read: J (and σ) in tensor entries.
+#[derive(Debug, Clone, Copy)]
+pub struct KnownInertia {
+    /// J, kg m², tensor entries.
+    pub inertia_kg_m2: Matrix3<f64>,
+    /// σ per element, kg m², when the file gives it.
+    pub sigma_kg_m2: Option<[f64; 6]>,
 }
 
 impl InertiaFile {
@@ -29,11 +48,82 @@ impl InertiaFile {
         Self {
             inertia_kg_m2: [0, 1, 2].map(|r| [0, 1, 2].map(|c| j[(r, c)])),
             j: Some([0, 1, 2, 3, 4, 5].map(|k| v[k])),
+            sigma_kg_m2: None,
+            products_of_inertia: None,
         }
     }
 
-    /// Read and check a file.
+    /// Read and check a file of J in tensor entries (a `products_of_inertia` other than
+    /// `"tensor"` is an error: simulation truth and `--truth` are always tensors).
     pub fn read(path: &Path) -> Result<Matrix3<f64>, CliError> {
+        Ok(Self::read_known(path, Some(ProductsArg::Tensor), "--truth")?.inertia_kg_m2)
+    }
+
+    /// Read and check a prior-knowledge file, converting its products to tensor entries:
+    /// `option` is the `--products` given on the command line (it must agree with the
+    /// file's `products_of_inertia` when both are given).
+    pub fn read_known(
+        path: &Path,
+        option: Option<ProductsArg>,
+        what: &str,
+    ) -> Result<KnownInertia, CliError> {
+        let f = Self::parse(path)?;
+        let from_file = match f.products_of_inertia.as_deref() {
+            None => None,
+            Some("tensor") => Some(ProductsArg::Tensor),
+            Some("cad") => Some(ProductsArg::Cad),
+            Some(other) => {
+                return Err(input(format!(
+                    "{}: products_of_inertia {other:?}: expected \"tensor\" (J12 = −Σ m x y) or \"cad\" (+Σ m x y)",
+                    path.display()
+                )))
+            }
+        };
+        let convention = match (from_file, option) {
+            (Some(a), Some(b)) if a != b => {
+                return Err(input(format!(
+                    "{}: products_of_inertia is {:?} but {what} asks for {}",
+                    path.display(),
+                    f.products_of_inertia.as_deref().unwrap_or_default(),
+                    match b {
+                        ProductsArg::Tensor => "tensor",
+                        ProductsArg::Cad => "cad",
+                    }
+                )))
+            }
+            (Some(a), _) => a,
+            (None, Some(b)) => b,
+            (None, None) => ProductsArg::Tensor,
+        };
+        let c = product_convention(Some(convention));
+        let to_tensor = |m: [[f64; 3]; 3]| {
+            Matrix3::from_fn(|r, k| {
+                if r == k {
+                    m[r][k]
+                } else {
+                    c.to_tensor(m[r][k])
+                }
+            })
+        };
+        let m = to_tensor(f.inertia_kg_m2);
+        check_matrix(path, "inertia_kg_m2", &m)?;
+        let sigma_kg_m2 = match f.sigma_kg_m2 {
+            Some(s) => {
+                // σ is a magnitude: its sign does not depend on the convention.
+                let s = Matrix3::from_fn(|r, k| s[r][k]);
+                check_matrix(path, "sigma_kg_m2", &s)?;
+                let v = j_from_matrix(&s);
+                Some([0, 1, 2, 3, 4, 5].map(|k| v[k]))
+            }
+            None => None,
+        };
+        Ok(KnownInertia {
+            inertia_kg_m2: m,
+            sigma_kg_m2,
+        })
+    }
+
+    fn parse(path: &Path) -> Result<Self, CliError> {
         use std::io::Read;
         // A small JSON file: read at most 1 MiB of it.
         const LIMIT: u64 = 1 << 20;
@@ -47,28 +137,38 @@ impl InertiaFile {
                 path.display()
             )));
         }
-        let f: InertiaFile = serde_json::from_str(&text).map_err(|e| {
+        serde_json::from_str(&text).map_err(|e| {
             input(format!(
                 "{}:{}:{}: {e} (expected {{\"inertia_kg_m2\": [[..],[..],[..]]}})",
                 path.display(),
                 e.line(),
                 e.column()
             ))
-        })?;
-        let m = Matrix3::from_fn(|r, c| f.inertia_kg_m2[r][c]);
-        if !m.iter().all(|v| v.is_finite()) {
-            return Err(input(format!(
-                "{}: inertia_kg_m2 has non-finite entries",
-                path.display()
-            )));
-        }
-        if (m - m.transpose()).norm() > 1e-9 * m.norm() {
-            return Err(input(format!(
-                "{}: inertia_kg_m2 is not symmetric",
-                path.display()
-            )));
-        }
-        Ok(m)
+        })
+    }
+}
+
+fn check_matrix(path: &Path, field: &str, m: &Matrix3<f64>) -> Result<(), CliError> {
+    if !m.iter().all(|v| v.is_finite()) {
+        return Err(input(format!(
+            "{}: {field} has non-finite entries",
+            path.display()
+        )));
+    }
+    if (m - m.transpose()).norm() > 1e-9 * m.norm() {
+        return Err(input(format!(
+            "{}: {field} is not symmetric",
+            path.display()
+        )));
+    }
+    Ok(())
+}
+
+/// The library's convention of a `--products` option (`None`: tensor entries).
+pub fn product_convention(a: Option<ProductsArg>) -> ProductConvention {
+    match a {
+        Some(ProductsArg::Cad) => ProductConvention::Cad,
+        Some(ProductsArg::Tensor) | None => ProductConvention::Tensor,
     }
 }
 
@@ -121,6 +221,7 @@ pub fn constraint_set(
     kind: ConstraintArg,
     bounds: &[String],
     nominal: Option<(&Matrix3<f64>, f64)>,
+    products: ProductConvention,
 ) -> Result<ConstraintSet, CliError> {
     let mut set = match kind {
         ConstraintArg::Physical => ConstraintSet::physical(),
@@ -132,25 +233,92 @@ pub fn constraint_set(
     }
     for b in bounds {
         let (k, l, h) = parse_bound(b)?;
+        // A CAD product bound `lo ≤ +Σ m x y ≤ hi` is `−hi ≤ J_ik ≤ −lo`.
+        let (l, h) = if k.is_product() {
+            match products {
+                ProductConvention::Cad => (h.map(|v| -v), l.map(|v| -v)),
+                _ => (l, h),
+            }
+        } else {
+            (l, h)
+        };
         set = set.with_bounds(k, l, h);
     }
     Ok(set)
 }
 
+/// Parse `--prior-sigma`: `5%` (relative) or `0.02` (kg m², every element).
+pub fn parse_prior_sigma(s: &str) -> Result<PriorSigma, CliError> {
+    let t = s.trim();
+    let bad = || {
+        input(format!(
+            "--prior-sigma {s:?}: expected a relative σ such as 5% or an absolute one in kg m² such as 0.02, finite and > 0"
+        ))
+    };
+    let out = match t.strip_suffix('%') {
+        Some(p) => PriorSigma::Relative(p.trim().parse::<f64>().map_err(|_| bad())? / 100.0),
+        None => PriorSigma::Absolute(t.parse::<f64>().map_err(|_| bad())?),
+    };
+    match out {
+        PriorSigma::Relative(v) | PriorSigma::Absolute(v) if v.is_finite() && v > 0.0 => Ok(out),
+        _ => Err(bad()),
+    }
+}
+
+/// A `--prior-sigma`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PriorSigma {
+    /// A fraction (moments of |J_ii|, products of √(J_ii J_jj)).
+    Relative(f64),
+    /// kg m², every element.
+    Absolute(f64),
+}
+
 /// The pipeline settings of `inertia estimate`.
 pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError> {
     let nominal = match (&a.nominal, &a.tolerance) {
-        (Some(p), Some(t)) => Some((InertiaFile::read(p)?, parse_fraction(t)?)),
+        (Some(p), Some(t)) => Some((
+            InertiaFile::read_known(p, a.products, "--products")?.inertia_kg_m2,
+            parse_fraction(t)?,
+        )),
         _ => None,
     };
+    let mut constraints = constraint_set(
+        a.constraints,
+        &a.bounds,
+        nominal.as_ref().map(|(m, p)| (m, *p)),
+        product_convention(a.products),
+    )?;
+    if a.diagonal {
+        constraints = constraints.diagonal();
+    }
+    if let Some(path) = &a.prior {
+        let known = InertiaFile::read_known(path, a.products, "--products")?;
+        let sigma = a
+            .prior_sigma
+            .as_deref()
+            .map(parse_prior_sigma)
+            .transpose()?;
+        constraints = match (sigma, known.sigma_kg_m2) {
+            (Some(PriorSigma::Relative(f)), _) => {
+                constraints.with_relative_prior(&known.inertia_kg_m2, f)
+            }
+            (Some(PriorSigma::Absolute(v)), _) => {
+                constraints.with_prior(&known.inertia_kg_m2, [v; 6])
+            }
+            (None, Some(s)) => constraints.with_prior(&known.inertia_kg_m2, s),
+            (None, None) => {
+                return Err(input(format!(
+                    "{}: the prior needs a standard deviation: --prior-sigma (e.g. 5%) or sigma_kg_m2 in the file",
+                    path.display()
+                )))
+            }
+        };
+    }
     Ok(PipelineSettings {
         estimator: a.estimator.clone(),
         solver: a.solver.clone(),
-        constraints: constraint_set(
-            a.constraints,
-            &a.bounds,
-            nominal.as_ref().map(|(m, p)| (m, *p)),
-        )?,
+        constraints,
         solve_every: a.every,
         memory_s: a.memory,
         resample_s: a.resample,
@@ -182,7 +350,7 @@ fn option_of(field: &str) -> &str {
         "memory_s" => "--memory",
         "resample_s" => "--resample",
         "gyro_noise_deg_s_rthz" => "--gyro-noise",
-        "constraints" => "--constraints/--bound/--nominal",
+        "constraints" => "--constraints/--bound/--nominal/--diagonal/--prior",
         "rotation_source" => "--rotation-source",
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",

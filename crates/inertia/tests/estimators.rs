@@ -57,10 +57,11 @@ fn momentum_history(samples: &[Sample]) -> Vec<(f64, Matrix3<f64>)> {
     samples
         .iter()
         .filter_map(|s| {
+            // The RLS state itself, physical or not (its estimates withhold an
+            // unphysical J).
             m.push(s)
                 .expect("valid samples")
-                .and_then(|e| e.j())
-                .map(|j| (s.t_s, matrix_from_j(&j)))
+                .map(|_| (s.t_s, m.inertia()))
         })
         .collect()
 }

@@ -43,13 +43,12 @@ pub enum Consistency {
     PositiveDefiniteOnly,
 }
 
-/// Relative half-width of the interval that stands for an equality bound (`--bound
-/// J12=0:0`): `1e-9 · max(|v|, 1e-3 kg m²)`. The answer then sits within it, and
-/// [`ConstraintSet::active_bounds`] reports the element as fixed.
-pub const EQUALITY_HALF_WIDTH: f64 = 1e-9;
+/// Relative tolerance within which an answer counts as sitting on a bound
+/// ([`ConstraintSet::active_bounds`]): `1e-9 · max(|b|, 1e-3 kg m²)`.
+pub const ACTIVE_TOLERANCE: f64 = 1e-9;
 
-fn equality_half_width(v: f64) -> f64 {
-    EQUALITY_HALF_WIDTH * crate::math::abs(v).max(1e-3)
+fn active_tolerance(v: f64) -> f64 {
+    ACTIVE_TOLERANCE * crate::math::abs(v).max(1e-3)
 }
 
 /// Which side of an element's interval.
@@ -99,6 +98,44 @@ pub struct ConstraintSet {
     pub lower_kg_m2: [Option<f64>; 6],
     /// Upper bounds per component of `j`, kg m².
     pub upper_kg_m2: [Option<f64>; 6],
+    /// A Gaussian prior on `j` (e.g. from CAD), weighed against the data
+    /// ([`crate::estimator::prior`]). Default `None`.
+    pub prior: Option<GaussianPrior>,
+}
+
+/// A Gaussian prior on `j`: `j_k ~ N(mean_k, sigma_k²)`, independent elements. Products
+/// are tensor entries (`J12 = −Σ m x y`): a CAD tool's products of inertia (`+Σ m x y`)
+/// are negated on input ([`ProductConvention`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct GaussianPrior {
+    /// Prior mean of `j` (order of eq. 48), kg m².
+    pub mean_kg_m2: [f64; 6],
+    /// Prior standard deviation of each element, kg m² (> 0; an element known exactly
+    /// is an equality bound instead).
+    pub sigma_kg_m2: [f64; 6],
+}
+
+/// How products of inertia are written in a file or by a tool.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum ProductConvention {
+    /// Tensor entries, `J12 = −Σ m x y` (this crate's convention, and the default).
+    #[default]
+    Tensor,
+    /// Products of inertia as CAD tools report them, `I_xy = +Σ m x y = −J12`.
+    Cad,
+}
+
+impl ProductConvention {
+    /// The tensor entry (`J_ik`) of a product written in this convention.
+    #[must_use]
+    pub fn to_tensor(self, product: f64) -> f64 {
+        match self {
+            ProductConvention::Tensor => product,
+            ProductConvention::Cad => -product,
+        }
+    }
 }
 
 impl Consistency {
@@ -143,6 +180,18 @@ pub enum ConstraintError {
         /// Upper bound.
         upper: f64,
     },
+    /// A prior mean that is not finite, or a prior σ that is not finite and > 0.
+    #[error("prior on {component}: {what} must be {expected}, got {}", crate::text::Num(*.value))]
+    InvalidPrior {
+        /// Component name (J11 … J23).
+        component: &'static str,
+        /// `mean` or `sigma`.
+        what: &'static str,
+        /// The value.
+        value: f64,
+        /// What it must be.
+        expected: &'static str,
+    },
     /// No J satisfies every constraint strictly.
     #[error("the bounds contradict J ⪰ εI and the {consistency} condition: no inertia satisfies all of them (best achievable margin {margin:.3e} kg m²)")]
     Infeasible {
@@ -162,6 +211,7 @@ impl ConstraintSet {
             consistency: Consistency::Physical,
             lower_kg_m2: [None; 6],
             upper_kg_m2: [None; 6],
+            prior: None,
         }
     }
 
@@ -229,6 +279,59 @@ impl ConstraintSet {
         self
     }
 
+    /// Fix `j[component] = value` (an equality: the solver eliminates it, and the
+    /// observability test runs on the remaining elements).
+    #[must_use]
+    pub fn with_equality(self, component: Component, value: f64) -> Self {
+        self.with_bounds(component, Some(value), Some(value))
+    }
+
+    /// Fix every product of inertia at zero: J diagonal in the body axes of the
+    /// telemetry (a symmetric design whose axes are the principal axes).
+    #[must_use]
+    pub fn diagonal(self) -> Self {
+        self.with_equality(Component::J12, 0.0)
+            .with_equality(Component::J13, 0.0)
+            .with_equality(Component::J23, 0.0)
+    }
+
+    /// A Gaussian prior: `nominal` (tensor entries) with a standard deviation per element
+    /// (order of eq. 48), kg m².
+    #[must_use]
+    pub fn with_prior(mut self, nominal: &Matrix3<f64>, sigma_kg_m2: [f64; 6]) -> Self {
+        let j: InertiaVector = crate::tensor::j_from_matrix(nominal);
+        self.prior = Some(GaussianPrior {
+            mean_kg_m2: core::array::from_fn(|k| j[k]),
+            sigma_kg_m2,
+        });
+        self
+    }
+
+    /// A Gaussian prior with a relative standard deviation, as
+    /// [`Self::with_nominal_inertia`] scales its bounds: a moment `J_ii` with
+    /// `fraction · |J_ii|`, a product `J_ik` with `fraction · √(J_ii J_kk)`.
+    #[must_use]
+    pub fn with_relative_prior(self, nominal: &Matrix3<f64>, fraction: f64) -> Self {
+        let sigma = Component::ALL.map(|k| {
+            let (r, c) = k.position();
+            if k.is_product() {
+                fraction * crate::math::sqrt(crate::math::abs(nominal[(r, r)] * nominal[(c, c)]))
+            } else {
+                fraction * crate::math::abs(nominal[(r, r)])
+            }
+        });
+        self.with_prior(nominal, sigma)
+    }
+
+    /// The elements fixed by an equality (`lower == upper`), with their values.
+    #[must_use]
+    pub fn fixed(&self) -> [Option<f64>; 6] {
+        core::array::from_fn(|k| match (self.lower_kg_m2[k], self.upper_kg_m2[k]) {
+            (Some(l), Some(u)) if l == u => Some(l),
+            _ => None,
+        })
+    }
+
     /// The element bounds that `j` sits on (within `1e-9` of the bound's size, at least
     /// 1e-12 kg m²): the bounds that hold the answer, which the data alone would have
     /// put elsewhere. An equality is always active ([`BoundSide::Fixed`]).
@@ -246,7 +349,7 @@ impl ConstraintSet {
                     return Some(fixed).into_iter().chain(None);
                 }
             }
-            let on = move |b: f64| crate::math::abs(j[k] - b) <= equality_half_width(b);
+            let on = move |b: f64| crate::math::abs(j[k] - b) <= active_tolerance(b);
             let lower = self.lower_kg_m2[k].filter(|b| on(*b)).map(|b| ActiveBound {
                 component: c,
                 side: BoundSide::Lower,
@@ -261,7 +364,8 @@ impl ConstraintSet {
         })
     }
 
-    /// `true` when any element bound is set (a prior that can fix the scale of J).
+    /// `true` when any element bound is set (a-priori knowledge that can pin one open
+    /// direction of J).
     #[must_use]
     pub fn has_bounds(&self) -> bool {
         self.lower_kg_m2
@@ -310,6 +414,7 @@ impl ConstraintSet {
             lins: [Lin::zero(); MAX_LIN],
             n_lin: 0,
             interior: InertiaVector::zeros(),
+            fixed: [None; 6],
         };
         // J − εI ⪰ 0.
         c.push_lmi(Lmi {
@@ -339,24 +444,60 @@ impl ConstraintSet {
             }
             Consistency::PositiveDefiniteOnly => {}
         }
-        for i in 0..6 {
-            // An equality (`lower = upper`) is the interval of half-width
-            // [`EQUALITY_HALF_WIDTH`] about it, so that the set keeps an interior.
-            let half = match (self.lower_kg_m2[i], self.upper_kg_m2[i]) {
-                (Some(l), Some(u)) if l == u => equality_half_width(l),
-                _ => 0.0,
-            };
+        if let Some(p) = &self.prior {
+            for (k, name) in COMPONENT_NAMES.iter().enumerate() {
+                let (m, sd) = (p.mean_kg_m2[k], p.sigma_kg_m2[k]);
+                if !m.is_finite() {
+                    return Err(ConstraintError::InvalidPrior {
+                        component: name,
+                        what: "mean",
+                        value: m,
+                        expected: "finite",
+                    });
+                }
+                if !(sd.is_finite() && sd > 0.0) {
+                    return Err(ConstraintError::InvalidPrior {
+                        component: name,
+                        what: "sigma",
+                        value: sd,
+                        expected:
+                            "finite and > 0 kg m² (an exactly known element is an equality bound)",
+                    });
+                }
+            }
+        }
+        let fixed = self.fixed();
+        for i in (0..6).filter(|&i| fixed[i].is_none()) {
             if let Some(l) = self.lower_kg_m2[i] {
                 c.push_lin(Lin {
                     a: InertiaVector::ith(i, 1.0),
-                    b: l - half,
+                    b: l,
                 });
             }
             if let Some(u) = self.upper_kg_m2[i] {
                 c.push_lin(Lin {
                     a: InertiaVector::ith(i, -1.0),
-                    b: -(u + half),
+                    b: -u,
                 });
+            }
+        }
+        // Equalities are eliminated: their values move into the constant terms, and the
+        // constraints no longer depend on those elements.
+        c.fixed = fixed;
+        for l in &mut c.lmis[..c.n_lmi] {
+            for (k, v) in fixed.iter().enumerate() {
+                if let Some(v) = v {
+                    l.f0 += l.fk[k] * *v;
+                    l.fk[k] = Matrix3::zeros();
+                }
+            }
+        }
+        for l in &mut c.lins[..c.n_lin] {
+            for (k, v) in fixed.iter().enumerate() {
+                if let Some(v) = v {
+                    l.b -= l.a[k] * *v;
+                    l.a[k] = 0.0;
+                }
             }
         }
         let (interior, margin) = c.phase_one();
@@ -366,7 +507,7 @@ impl ConstraintSet {
                 margin,
             });
         }
-        c.interior = interior;
+        c.interior = c.with_fixed(&interior);
         Ok(c)
     }
 
@@ -399,6 +540,7 @@ pub struct Constraints {
     lins: [Lin<6>; MAX_LIN],
     n_lin: usize,
     interior: InertiaVector,
+    fixed: [Option<f64>; 6],
 }
 
 impl Constraints {
@@ -410,6 +552,26 @@ impl Constraints {
     fn push_lin(&mut self, l: Lin<6>) {
         self.lins[self.n_lin] = l;
         self.n_lin += 1;
+    }
+
+    /// The elements fixed by equalities, with their values. The LMIs and linear
+    /// inequalities do not depend on them (their values are in the constant terms), and
+    /// [`crate::solver::solve`] eliminates them from the objective.
+    #[must_use]
+    pub fn fixed(&self) -> &[Option<f64>; 6] {
+        &self.fixed
+    }
+
+    /// `j` with its fixed elements set to their values.
+    #[must_use]
+    pub fn with_fixed(&self, j: &InertiaVector) -> InertiaVector {
+        let mut out = *j;
+        for (o, v) in out.iter_mut().zip(&self.fixed) {
+            if let Some(v) = v {
+                *o = *v;
+            }
+        }
+        out
     }
 
     /// The set this was validated from.

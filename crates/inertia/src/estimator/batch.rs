@@ -96,10 +96,17 @@ pub fn solve_reduced(
     observability: &ObservabilitySettings,
     gyro_noise_rad_s_rthz: Option<f64>,
 ) -> Result<Estimate, EstimatorError> {
-    let observability = assess(qr, constraints.set().has_bounds(), observability);
+    let (solved, fit) = super::prior::augment(qr, constraints);
+    let observability = super::recursive::with_prior(
+        assess(&solved, constraints.set().has_bounds(), observability),
+        qr,
+        fit.as_ref(),
+        constraints,
+        observability,
+    );
     let (solution, observability) = super::recursive::solve_with(
         backend,
-        qr,
+        &solved,
         constraints,
         observability,
         gyro_noise_rad_s_rthz,
@@ -111,5 +118,6 @@ pub fn solve_reduced(
         observability,
         solution,
         uncertainty: None,
+        prior: fit,
     })
 }

@@ -49,6 +49,8 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     svd: SvdTracker,
     sv: Vector6<f64>,
     reduced: RecursiveQr,
+    /// `reduced` with the prior knowledge stacked on ([`super::prior::augment`]).
+    solved: RecursiveQr,
     constraints: Constraints,
     backend: B,
     settings: MomentumEstimatorSettings,
@@ -83,6 +85,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
             reduced: RecursiveQr::new(),
+            solved: RecursiveQr::new(),
             constraints,
             backend,
             settings,
@@ -160,10 +163,14 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         self.reduced = self.qr.reduced();
-        self.sv = self.svd.singular_values(&self.reduced.r);
+        let (solved, fit) = super::prior::augment(&self.reduced, &self.constraints);
+        self.solved = solved;
+        self.sv = self.svd.singular_values(&self.solved.r);
         let e = estimate_from(
             &mut self.backend,
             &self.reduced,
+            &self.solved,
+            fit,
             &self.sv,
             &self.constraints,
             &self.settings.recursive,
@@ -177,14 +184,15 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// Least-squares standard deviation per element at the last solve.
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {
-        super::uncertainty::noise_sigma(&self.reduced, &self.sv, self.svd.v())
+        super::uncertainty::noise_sigma(&self.solved, &self.sv, self.svd.v())
     }
 
     /// The delete-a-group jackknife σ per element over the completed chains
     /// ([`super::jackknife`]), kg m²; `None` with too few chains, with forgetting or
     /// after [`Self::stop_jackknife`].
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
-        self.groups.as_mut()?.sigma()
+        let constraints = self.constraints;
+        self.groups.as_mut()?.sigma(&constraints)
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
@@ -201,6 +209,13 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     #[must_use]
     pub fn reduced(&self) -> &RecursiveQr {
         &self.reduced
+    }
+
+    /// [`Self::reduced`] with the prior knowledge stacked on: the state the last solve
+    /// used.
+    #[must_use]
+    pub fn solved(&self) -> &RecursiveQr {
+        &self.solved
     }
 
     /// The full least-squares state.

@@ -31,6 +31,7 @@
 //! one.
 
 use super::augmented_qr::AugmentedQr;
+use crate::constraints::Constraints;
 use crate::solver::unconstrained_minimiser;
 use crate::tensor::InertiaVector;
 
@@ -114,13 +115,15 @@ impl ChainGroups {
     /// The jackknife σ per element, kg m², scaled to include the chain in progress
     /// (module docs); `None` with fewer than [`MIN_GROUPS`] groups or a delete-one-group
     /// problem without a unique solution.
-    pub fn sigma(&mut self) -> Option<[f64; 6]> {
+    /// Each delete-one-group problem carries the prior knowledge of `constraints`
+    /// ([`super::prior::augment`]), as the estimate does.
+    pub fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
         if let Some((chains, sigma)) = self.cached {
             if chains == self.chains {
                 return sigma.map(|s| self.scaled(s));
             }
         }
-        let sigma = self.compute();
+        let sigma = self.compute(constraints);
         self.cached = Some((self.chains, sigma));
         sigma.map(|s| self.scaled(s))
     }
@@ -136,7 +139,7 @@ impl ChainGroups {
         s.map(|v| v * f)
     }
 
-    fn compute(&self) -> Option<[f64; 6]> {
+    fn compute(&self, constraints: &Constraints) -> Option<[f64; 6]> {
         let used = self.chains.min(GROUPS);
         let mut estimates = [InertiaVector::zeros(); GROUPS];
         for (g, out) in estimates.iter_mut().enumerate().take(used) {
@@ -146,7 +149,7 @@ impl ChainGroups {
                     rest.merge(group);
                 }
             }
-            let reduced = rest.reduced();
+            let reduced = super::prior::augment(&rest.reduced(), constraints).0;
             *out = unconstrained_minimiser(&reduced.r, &reduced.z)?;
         }
         estimates.get(..used).and_then(jackknife_sigma)

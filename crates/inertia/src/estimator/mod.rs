@@ -24,6 +24,7 @@ pub mod jackknife;
 pub mod momentum;
 pub mod momentum_rows;
 pub mod observability;
+pub mod prior;
 pub mod qr;
 pub mod recursive;
 pub mod resample;
@@ -52,6 +53,9 @@ pub struct Estimate {
     /// Standard deviations per element and principal moment, when the estimator has an
     /// uncertainty model ([`uncertainty`]).
     pub uncertainty: Option<uncertainty::Uncertainty>,
+    /// How a Gaussian prior sat with the data at this solve ([`prior`]), when one was
+    /// given.
+    pub prior: Option<prior::PriorFit>,
 }
 
 impl Estimate {

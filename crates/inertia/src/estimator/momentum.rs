@@ -16,7 +16,9 @@
 //!
 //! The baseline makes no observability test: its estimates carry
 //! [`Observability::Unchecked`]. A non-finite state is reported as
-//! [`Unobservable::Diverged`], never as an answer.
+//! [`Unobservable::Diverged`], and a J that is not a physical inertia (a principal moment
+//! ≤ 0, or a broken triangle inequality) as [`Unobservable::NotPhysical`]: never as an
+//! answer.
 
 use super::observability::{Observability, Unobservable};
 use super::{Estimate, EstimatorError, InvalidArgument};
@@ -25,6 +27,30 @@ use crate::sample::Sample;
 use crate::solver::{Residuals, Solution, SolveStatus};
 use crate::tensor::{matrix_from_j, InertiaVector};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+/// Relative tolerance of the triangle test of [`not_physical`]: `Σ`'s smallest eigenvalue
+/// may be down to `−1e-3 · tr(J)`.
+pub const NOT_PHYSICAL_TOLERANCE: f64 = 1e-3;
+
+/// Why a finite `j` is not a physical inertia, if it is not: a principal moment ≤ 0, or
+/// `Σ = ½ tr(J) I − J` below `−NOT_PHYSICAL_TOLERANCE · tr(J)` (a triangle inequality of
+/// the principal moments broken; docs/conventions.md §4).
+#[must_use]
+pub fn not_physical(j: &InertiaVector) -> Option<Unobservable> {
+    let m = matrix_from_j(j);
+    let min_moment_kg_m2 = crate::eigen3::symmetric_eigen3(&m).0.min();
+    let sigma = Matrix3::identity() * (0.5 * m.trace()) - m;
+    let min_second_moment_kg_m2 = crate::eigen3::symmetric_eigen3(&sigma).0.min();
+    // A flat body's J sits on the triangle boundary (the paper's nearly does): there a
+    // violation within the noise is not a refusal.
+    let tolerance = NOT_PHYSICAL_TOLERANCE * crate::math::abs(m.trace());
+    (!(min_moment_kg_m2 > 0.0 && min_second_moment_kg_m2 >= -tolerance)).then_some(
+        Unobservable::NotPhysical {
+            min_moment_kg_m2,
+            min_second_moment_kg_m2,
+        },
+    )
+}
 
 /// Default initial covariance scale (units of the unknowns squared).
 pub const DEFAULT_P0: f64 = 1e6;
@@ -147,15 +173,17 @@ impl MomentumRls {
     fn estimate(&self, t_s: f64) -> Estimate {
         let j = self.j();
         let finite = j.iter().all(|v| v.is_finite());
+        let observability = if !finite {
+            Observability::NotObservable(Unobservable::Diverged)
+        } else if let Some(reason) = not_physical(&j) {
+            Observability::NotObservable(reason)
+        } else {
+            Observability::Unchecked
+        };
         Estimate {
             t_s,
             rows: 3 * self.updates,
-            observability: if finite {
-                Observability::Unchecked
-            } else {
-                Observability::NotObservable(Unobservable::Diverged)
-            },
-            solution: finite.then_some(Solution {
+            solution: observability.has_answer().then_some(Solution {
                 j,
                 objective: 0.0,
                 status: SolveStatus::RecursiveLeastSquares,
@@ -163,6 +191,8 @@ impl MomentumRls {
                 residuals: Residuals::default(),
             }),
             uncertainty: None,
+            prior: None,
+            observability,
         }
     }
 

@@ -118,6 +118,21 @@ pub enum Unobservable {
         /// Residual variance over the part the stated density implies.
         ratio: f64,
     },
+    /// The data contradict the Gaussian prior beyond both their noises
+    /// ([`super::prior::PriorFit::conflicts`]).
+    PriorConflict {
+        /// Prior-data disagreement, a χ² with at most `rows` degrees of freedom.
+        chi2: f64,
+        /// Rows of the prior.
+        rows: usize,
+    },
+    /// The unconstrained answer (the momentum RLS baseline) is not a physical inertia.
+    NotPhysical {
+        /// Smallest principal moment, kg m².
+        min_moment_kg_m2: f64,
+        /// Smallest eigenvalue of `½ tr(J) I − J` (the second-moment matrix), kg m².
+        min_second_moment_kg_m2: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -197,6 +212,22 @@ impl core::fmt::Display for Unobservable {
                 "the residuals are {} the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (--gyro-noise is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)",
                 crate::text::Times(*ratio)
             ),
+            Unobservable::PriorConflict { chi2, rows } => write!(
+                f,
+                "the data contradict the prior: disagreement χ² = {} on {rows} prior elements (threshold {}); the prior is wrong by more than its σ (check --prior-sigma and the products-of-inertia convention, --products)",
+                crate::text::Num(*chi2),
+                super::prior::RESIDUAL_VARIANCE_ALLOWANCE
+                    * super::prior::CHI2_999[(*rows).clamp(1, 6) - 1]
+            ),
+            Unobservable::NotPhysical {
+                min_moment_kg_m2,
+                min_second_moment_kg_m2,
+            } => write!(
+                f,
+                "the unconstrained least-squares J is not a physical inertia (smallest principal moment {}, smallest eigenvalue of ½ tr(J) I − J {} kg m²): the data do not determine J; a constrained estimator reports what they do determine",
+                crate::text::Num(*min_moment_kg_m2),
+                crate::text::Num(*min_second_moment_kg_m2)
+            ),
             Unobservable::IllConditioned {
                 condition,
                 threshold,
@@ -219,7 +250,9 @@ pub enum Observability {
         /// `σ_1/σ_6` of `R`.
         condition: f64,
     },
-    /// The data leave one direction open, which the a-priori bounds pin.
+    /// The data alone fall short (the reason), and the prior knowledge determines the
+    /// answer with them: the a-priori bounds pin one open direction, or a Gaussian prior
+    /// supplies the missing information (its σ is in the answer's).
     FromPrior(Unobservable),
     /// Nothing determines J: no answer.
     NotObservable(Unobservable),
@@ -274,7 +307,15 @@ impl core::fmt::Display for Observability {
                     "determined by the data (condition number {condition:.3e})"
                 )
             }
-            Observability::FromPrior(r) => write!(f, "answer leans on the prior bounds: {r}"),
+            Observability::FromPrior(r @ Unobservable::ConflictsWithConstraints { .. }) => {
+                write!(f, "answer leans on the constraint set: {r}")
+            }
+            Observability::FromPrior(r) => {
+                write!(
+                    f,
+                    "determined with the prior knowledge; the data alone fall short: {r}"
+                )
+            }
             Observability::NotObservable(r) => write!(f, "NOT OBSERVABLE: {r}"),
             Observability::Unchecked => {
                 f.write_str("recursive least squares (no observability test, unconstrained)")

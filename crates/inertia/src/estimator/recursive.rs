@@ -92,6 +92,8 @@ impl RecursiveSettings {
 pub struct RecursiveEstimator<S: RowSource, B: Backend> {
     source: S,
     qr: RecursiveQr,
+    /// `qr` with the prior knowledge stacked on, at the last solve.
+    solved: RecursiveQr,
     svd: SvdTracker,
     sv: nalgebra::Vector6<f64>,
     constraints: Constraints,
@@ -115,6 +117,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         Ok(Self {
             source,
             qr: RecursiveQr::new(),
+            solved: RecursiveQr::new(),
             svd: SvdTracker::new(),
             sv: nalgebra::Vector6::zeros(),
             constraints,
@@ -154,10 +157,14 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// Solve with the data so far, stamped `t_s`.
     pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
-        self.sv = self.svd.singular_values(&self.qr.r);
+        let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
+        self.solved = solved;
+        self.sv = self.svd.singular_values(&self.solved.r);
         let e = estimate_from(
             &mut self.backend,
             &self.qr,
+            &self.solved,
+            fit,
             &self.sv,
             &self.constraints,
             &self.settings,
@@ -172,7 +179,14 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// SVD; see [`super::uncertainty`]).
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {
-        super::uncertainty::noise_sigma(&self.qr, &self.sv, self.svd.v())
+        super::uncertainty::noise_sigma(&self.solved, &self.sv, self.svd.v())
+    }
+
+    /// The least-squares state with the prior knowledge stacked on, at the last solve
+    /// ([`super::prior::augment`]).
+    #[must_use]
+    pub fn solved(&self) -> &RecursiveQr {
+        &self.solved
     }
 
     /// The least-squares state.
@@ -203,33 +217,39 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     #[must_use]
     pub fn observability(&self) -> Observability {
         assess(
-            &self.qr,
+            &super::prior::augment(&self.qr, &self.constraints).0,
             self.constraints.set().has_bounds(),
             &self.settings.observability,
         )
     }
 }
 
-/// Assess and solve the state `qr` whose `R` has singular values `sv`: the estimate
-/// stamped `t_s`. Shared by the recursive estimators.
+/// Assess and solve the state `solved` (the data's state `data` with the prior knowledge
+/// of `constraints` stacked on, [`super::prior::augment`], giving `fit`), whose `R` has
+/// singular values `sv`: the estimate stamped `t_s`. Shared by the recursive estimators.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn estimate_from<B: Backend + ?Sized>(
     backend: &mut B,
-    qr: &RecursiveQr,
+    data: &RecursiveQr,
+    solved: &RecursiveQr,
+    fit: Option<super::prior::PriorFit>,
     sv: &nalgebra::Vector6<f64>,
     constraints: &Constraints,
     settings: &RecursiveSettings,
     warm: Option<&crate::tensor::InertiaVector>,
     t_s: f64,
 ) -> Result<Estimate, EstimatorError> {
-    let observability = assess_with(
-        qr,
-        sv,
-        constraints.set().has_bounds(),
+    let has_bounds = constraints.set().has_bounds();
+    let observability = with_prior(
+        assess_with(solved, sv, has_bounds, &settings.observability),
+        data,
+        fit.as_ref(),
+        constraints,
         &settings.observability,
     );
     let (solution, observability) = solve_with(
         backend,
-        qr,
+        solved,
         constraints,
         observability,
         settings.gyro_noise_rad_s_rthz,
@@ -237,11 +257,47 @@ pub(crate) fn estimate_from<B: Backend + ?Sized>(
     )?;
     Ok(Estimate {
         t_s,
-        rows: qr.rows,
+        rows: data.rows,
         observability,
         solution,
         uncertainty: None,
+        prior: fit,
     })
+}
+
+/// The status of an answer with a Gaussian prior: withdrawn when the prior and the data
+/// disagree ([`super::prior::PriorFit::conflicts`]); "determined with the prior" when
+/// the data alone (equalities eliminated) would not determine J.
+pub(crate) fn with_prior(
+    observability: Observability,
+    data: &RecursiveQr,
+    fit: Option<&super::prior::PriorFit>,
+    constraints: &Constraints,
+    settings: &ObservabilitySettings,
+) -> Observability {
+    let Some(fit) = fit else {
+        return observability;
+    };
+    if !observability.has_answer() {
+        return observability;
+    }
+    if fit.conflicts() {
+        return Observability::NotObservable(super::observability::Unobservable::PriorConflict {
+            chi2: fit.chi2,
+            rows: fit.rows,
+        });
+    }
+    if let Observability::Determined { .. } = observability {
+        let alone = assess(
+            &super::prior::eliminate(data, constraints),
+            constraints.set().has_bounds(),
+            settings,
+        );
+        if let Some(reason) = alone.reason() {
+            return Observability::FromPrior(reason);
+        }
+    }
+    observability
 }
 
 /// Solve (with errors-in-variables compensation when a gyro noise is given) when the

@@ -19,6 +19,7 @@ use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry
 use super::settings::PipelineConfig;
 use super::standing::{Standing, RULE_OUT_AFTER};
 use super::PipelineError;
+use crate::constraints::Constraints;
 use crate::estimator::audit::audit;
 use crate::estimator::compensation::compensate;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
@@ -29,6 +30,7 @@ use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RhoModel, RotationSource, Stencil};
 use crate::estimator::observability::{Observability, Unobservable};
+use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
 use crate::estimator::uncertainty::{noise_sigma, with_bias};
@@ -120,6 +122,7 @@ fn model_spread(
     best: &RecursiveQr,
     others: impl Iterator<Item = RecursiveQr>,
     gyro: Option<f64>,
+    constraints: &Constraints,
 ) -> [f64; 6] {
     let mut out = [0.0; 6];
     let v_best = best.residual_variance();
@@ -128,14 +131,14 @@ fn model_spread(
         return out;
     }
     let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
-    let Some(j_best) = own_solution(best, gyro) else {
+    let Some(j_best) = own_solution(best, gyro, constraints) else {
         return out;
     };
     for qr in others {
         if !(qr.residual_variance() <= ratio * v_best) {
             continue;
         }
-        if let Some(j) = own_solution(&qr, gyro) {
+        if let Some(j) = own_solution(&qr, gyro, constraints) {
             for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
                 *o = o.max((a - b).abs());
             }
@@ -152,8 +155,16 @@ fn model_spread(
 /// `ρ` holds, less when the commands change several times per telemetry step), so the
 /// conservative `p = 2` is used: `|ĵ(h) − ĵ(2h)|/3`. It catches what the noise σ cannot:
 /// a bias shared by every chain, such as the remainder at 1 Hz telemetry.
-fn discretisation_bias(full: &RecursiveQr, half: &RecursiveQr, gyro: Option<f64>) -> [f64; 6] {
-    match (own_solution(full, gyro), own_solution(half, gyro)) {
+fn discretisation_bias(
+    full: &RecursiveQr,
+    half: &RecursiveQr,
+    gyro: Option<f64>,
+    constraints: &Constraints,
+) -> [f64; 6] {
+    match (
+        own_solution(full, gyro, constraints),
+        own_solution(half, gyro, constraints),
+    ) {
         (Some(a), Some(b)) => core::array::from_fn(|k| (a[k] - b[k]).abs() / 3.0),
         _ => [0.0; 6],
     }
@@ -163,7 +174,21 @@ fn discretisation_bias(full: &RecursiveQr, half: &RecursiveQr, gyro: Option<f64>
 /// compensated like the estimate when a gyro noise density is given (the compensation's
 /// size depends on the step and the row model, so uncompensated solutions would differ
 /// by it and not by what is being measured).
-fn own_solution(qr: &RecursiveQr, gyro: Option<f64>) -> Option<InertiaVector> {
+///
+/// The prior knowledge of `constraints` is stacked on first ([`prior::augment`]), as for
+/// the estimate: without it the directions the data leave open would count as bias.
+fn own_solution(
+    qr: &RecursiveQr,
+    gyro: Option<f64>,
+    constraints: &Constraints,
+) -> Option<InertiaVector> {
+    let augmented;
+    let qr = if prior::applies(constraints) {
+        augmented = prior::augment(qr, constraints).0;
+        &augmented
+    } else {
+        qr
+    };
     match gyro.and_then(|g| compensate(qr, g)) {
         Some((r, z)) => unconstrained_minimiser(&r, &z),
         None => unconstrained_minimiser(&qr.r, &qr.z),
@@ -504,12 +529,18 @@ impl Estimator for DiscreteMomentum {
                     .enumerate()
                     .filter(|&(i, _)| i != self.chosen && self.standing.live(i))
                     .map(|(_, c)| c.qr().reduced());
-                let spread = model_spread(&best, others, self.config.gyro_noise_rad_s_rthz);
+                let spread = model_spread(
+                    &best,
+                    others,
+                    self.config.gyro_noise_rad_s_rthz,
+                    &self.config.constraints,
+                );
                 let discretisation = match (self.candidates.first(), self.shadow.as_deref()) {
                     (Some(first), Some(shadow)) => discretisation_bias(
                         &first.qr().reduced(),
                         &shadow.qr().reduced(),
                         self.config.gyro_noise_rad_s_rthz,
+                        &self.config.constraints,
                     ),
                     _ => [0.0; 6],
                 };
@@ -523,7 +554,7 @@ impl Estimator for DiscreteMomentum {
         };
         audit(
             &mut e,
-            c.reduced(),
+            c.solved(),
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
         );
@@ -625,8 +656,14 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
             c.gyro_noise_rad_s_rthz,
         )
         .map_err(wrap)?;
+        // With prior knowledge, σ is the least-squares one of the data and the prior
+        // together (the batch jackknife's delete-one solves carry no prior).
+        let (solved, _) = prior::augment(&b.qr, &c.constraints);
+        let jackknife = b
+            .jackknife_sigma_kg_m2
+            .filter(|_| !prior::applies(&c.constraints));
         let svd = nalgebra::SVD::try_new(
-            b.qr.r,
+            solved.r,
             false,
             true,
             f64::EPSILON,
@@ -634,8 +671,8 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         );
         let noise = svd.and_then(|svd| {
             let v_t = svd.v_t?;
-            noise_sigma(&b.qr, &svd.singular_values, &v_t.transpose())
-                .map(|ls| robust_sigma(&ls, b.jackknife_sigma_kg_m2.as_ref()))
+            noise_sigma(&solved, &svd.singular_values, &v_t.transpose())
+                .map(|ls| robust_sigma(&ls, jackknife.as_ref()))
         });
         Ok((e, noise))
     };
@@ -647,7 +684,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
                 .enumerate()
                 .filter(|&(i, _)| i != chosen)
                 .map(|(_, (_, b))| b.qr);
-            let spread = model_spread(qr, others, c.gyro_noise_rad_s_rthz);
+            let spread = model_spread(qr, others, c.gyro_noise_rad_s_rthz, &c.constraints);
             // As in the recursive path: the first candidate on every other sample.
             let half: Vec<Sample> = samples
                 .chunks_exact(2)
@@ -655,7 +692,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
                 .collect();
             let discretisation = match (reduced.first(), c.gyro_noise_rad_s_rthz) {
                 (Some((first, full)), gyro) => match reduce_batch(&half, first) {
-                    Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro),
+                    Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &c.constraints),
                     Err(_) => [0.0; 6],
                 },
                 _ => [0.0; 6],
@@ -682,7 +719,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     }
     audit(
         &mut estimate,
-        qr,
+        &prior::augment(qr, &c.constraints).0,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
     );

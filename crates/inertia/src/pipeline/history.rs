@@ -238,6 +238,7 @@ mod tests {
                 t_s: 0.1 * k as f64,
                 rows: 3 * k,
                 observability,
+                prior: None,
                 solution: if has {
                     solution([1.0, 2.0, 3.0, -0.01, 1e-17, f64::NAN], k as u32)
                 } else {

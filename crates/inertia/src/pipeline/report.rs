@@ -115,6 +115,10 @@ pub struct Report {
     pub torque_bias_nm: Option<[f64; 3]>,
     /// The element bounds the answer sits on: they, not the data, hold it there.
     pub active_bounds: std::vec::Vec<ActiveBound>,
+    /// How the Gaussian prior sat with the data (`chi2`, `rows`, and per element the
+    /// fraction of the information from the data, `data_share`; `null` for an element
+    /// fixed by an equality).
+    pub prior: Option<crate::estimator::prior::PriorFit>,
     /// Steps where the attitude jumped against the gyro, kept (`--glitches keep`): how
     /// many, and the first [`crate::telemetry::glitch::LISTED`].
     pub glitches: Option<Glitches>,
@@ -177,6 +181,7 @@ impl Report {
                 .j()
                 .map(|j| config.constraints().set().active_bounds(&j).collect())
                 .unwrap_or_default(),
+            prior: estimate.prior,
             glitches: None,
             residual_consistency: None,
             gyro_density_ratio: None,
@@ -359,6 +364,28 @@ impl fmt::Display for Report {
                 s,
                 "active bounds (they, not the data, hold the answer there): {}",
                 list.join(", ")
+            )?;
+        }
+        if let Some(p) = &self.prior {
+            let shares: std::vec::Vec<String> = COMPONENT_NAMES
+                .iter()
+                .zip(&p.data_share)
+                .map(|(name, d)| match d {
+                    Some(d) => format!("{name} {:.0} %", 100.0 * d),
+                    None => format!("{name} fixed"),
+                })
+                .collect();
+            writeln!(
+                s,
+                "information from the data (the rest from the prior): {}",
+                shares.join(", ")
+            )?;
+            writeln!(
+                s,
+                "prior-data disagreement: χ² = {:.2} on {} elements (conflict above {:.1})",
+                p.chi2,
+                p.rows,
+                p.threshold()
             )?;
         }
         if let Some(t) = self.torque_bias_nm {

@@ -129,7 +129,7 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
         }
         audit(
             &mut e,
-            self.main.qr(),
+            self.main.solved(),
             self.epsilon_kg_m2,
             self.observability.max_relative_sigma,
         );
@@ -182,7 +182,7 @@ fn run_batch<S: RowSource + Default>(
     .map_err(wrap)?;
     audit(
         &mut estimate,
-        &qr,
+        &crate::estimator::prior::augment(&qr, &c.constraints).0,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
     );

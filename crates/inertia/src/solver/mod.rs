@@ -139,7 +139,75 @@ pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<Ine
     Some(x)
 }
 
-/// Solve `minimise ‖R j − z‖², j ∈ C` with `backend` (see the module docs).
+/// A least-squares pair with the fixed elements eliminated ([`eliminate_fixed`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eliminated {
+    /// Upper-triangular factor of the reduced problem (with the rows `c x_k = c v_k`).
+    pub r: Matrix6<f64>,
+    /// Its right-hand side.
+    pub z: Vector6<f64>,
+    /// Residual sum of squares the fixed values add (the data's least-squares `j` need
+    /// not have those values).
+    pub extra_rss: f64,
+    /// Number of fixed elements.
+    pub fixed: usize,
+    /// `c`, the scale of the fixed elements' rows.
+    pub scale: f64,
+}
+
+/// Eliminate the elements fixed by equalities from `‖R j − z‖²`: with `j = j_f + P x`
+/// (`P` keeps the free elements, `j_f` holds the fixed values) the objective is
+/// `‖R P x − (z − R j_f)‖²`, whose columns of the fixed elements are zero. Each fixed
+/// element then gets the row `c x_k = c v_k`, `c` the root-mean-square column norm of
+/// `R P` (1 when it is zero), so that the returned triangular pair has the reduced
+/// problem's singular values besides `c`, and the fixed values as its exact minimiser in
+/// those coordinates.
+#[must_use]
+pub fn eliminate_fixed(r: &Matrix6<f64>, z: &Vector6<f64>, fixed: &[Option<f64>; 6]) -> Eliminated {
+    let mut out = Eliminated {
+        r: *r,
+        z: *z,
+        extra_rss: 0.0,
+        fixed: 0,
+        scale: 1.0,
+    };
+    let mut free_norm2 = 0.0;
+    let mut n_free = 0usize;
+    for (k, v) in fixed.iter().enumerate() {
+        match v {
+            Some(v) => {
+                out.z -= r.column(k) * *v;
+                out.r.column_mut(k).fill(0.0);
+                out.fixed += 1;
+            }
+            None => {
+                free_norm2 += r.column(k).norm_squared();
+                n_free += 1;
+            }
+        }
+    }
+    if out.fixed == 0 {
+        return out;
+    }
+    if n_free > 0 && free_norm2 > 0.0 {
+        out.scale = crate::math::sqrt(free_norm2 / n_free as f64);
+    }
+    let c = out.scale;
+    for (k, v) in fixed.iter().enumerate() {
+        if let Some(v) = v {
+            let left = crate::givens::fold_row(
+                &mut out.r,
+                &Vector6::ith(k, c),
+                Some((&mut out.z, c * *v)),
+            );
+            out.extra_rss += left * left;
+        }
+    }
+    out
+}
+
+/// Solve `minimise ‖R j − z‖², j ∈ C` with `backend` (see the module docs). Elements
+/// fixed by an equality are eliminated ([`eliminate_fixed`]) and returned exactly.
 pub fn solve(
     backend: &mut dyn Backend,
     r: &Matrix6<f64>,
@@ -150,6 +218,24 @@ pub fn solve(
     if !r.iter().chain(z.iter()).all(|v| v.is_finite()) {
         return Err(SolveError::NonFinite);
     }
+    if constraints.fixed().iter().any(Option::is_some) {
+        let e = eliminate_fixed(r, z, constraints.fixed());
+        let warm = warm.map(|w| constraints.with_fixed(w));
+        let mut sol = solve_free(backend, &e.r, &e.z, constraints, warm.as_ref())?;
+        sol.j = constraints.with_fixed(&sol.j);
+        sol.objective = (r * sol.j - z).norm_squared();
+        return Ok(sol);
+    }
+    solve_free(backend, r, z, constraints, warm)
+}
+
+fn solve_free(
+    backend: &mut dyn Backend,
+    r: &Matrix6<f64>,
+    z: &Vector6<f64>,
+    constraints: &Constraints,
+    warm: Option<&InertiaVector>,
+) -> Result<Solution, SolveError> {
     if let Some(j) = unconstrained_minimiser(r, z) {
         if constraints.strictly_feasible(&j) {
             return Ok(Solution {
