@@ -176,11 +176,8 @@ fn bad_settings_name_the_setting() {
     ];
     for (s, status, word) in cases {
         // SAFETY: valid pointers.
-        assert_eq!(
-            unsafe { inertia_estimator_new(&s, &mut est) },
-            status,
-            "{word}"
-        );
+        let got = unsafe { inertia_estimator_new(&s, &mut est) };
+        assert_eq!(got, status, "{word}");
         assert!(est.is_null());
         assert!(last_error().contains(word), "{word}: {}", last_error());
     }
@@ -330,10 +327,8 @@ fn messages_are_copied_like_snprintf() {
     };
     let mut est = null_mut();
     // SAFETY: valid pointers.
-    assert_eq!(
-        unsafe { inertia_estimator_new(&s, &mut est) },
-        InertiaStatus::InvalidSetting
-    );
+    let got = unsafe { inertia_estimator_new(&s, &mut est) };
+    assert_eq!(got, InertiaStatus::InvalidSetting);
     let whole = last_error();
     let mut small = [0xAAu8; 8];
     // SAFETY: `small` is writable for its length.
