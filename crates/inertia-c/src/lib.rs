@@ -748,6 +748,11 @@ fn reason(r: Unobservable) -> InertiaReason {
 
 /// Run `f` with panics caught: a panic becomes `INERTIA_STATUS_PANIC` with its message.
 fn guard(f: impl FnOnce() -> InertiaStatus) -> InertiaStatus {
+    guard_or(InertiaStatus::Panic, f)
+}
+
+/// Run `f` with panics caught: a panic records its message and gives `on_panic`.
+fn guard_or<T>(on_panic: T, f: impl FnOnce() -> T) -> T {
     match std::panic::catch_unwind(AssertUnwindSafe(f)) {
         Ok(s) => s,
         Err(payload) => {
@@ -756,10 +761,8 @@ fn guard(f: impl FnOnce() -> InertiaStatus) -> InertiaStatus {
                 .copied()
                 .or_else(|| payload.downcast_ref::<String>().map(String::as_str))
                 .unwrap_or("(no message)");
-            fail(
-                InertiaStatus::Panic,
-                format_args!("internal error (a bug in inertia): {what}"),
-            )
+            record(format_args!("internal error (a bug in inertia): {what}"));
+            on_panic
         }
     }
 }
@@ -974,12 +977,14 @@ pub unsafe extern "C" fn inertia_estimator_reason(
     let Some(e) = (unsafe { est.as_ref() }) else {
         return 0;
     };
-    let mut m = message::Buffer::new();
-    if let Some(r) = e.last.and_then(|l| l.observability.reason()) {
-        let _ = write!(m, "{r}");
-    }
-    // SAFETY: `buf` is NULL or valid for `len` bytes (contract).
-    unsafe { m.copy_to(buf, len) }
+    guard_or(0, || {
+        let mut m = message::Buffer::new();
+        if let Some(r) = e.last.and_then(|l| l.observability.reason()) {
+            let _ = write!(m, "{r}");
+        }
+        // SAFETY: `buf` is NULL or valid for `len` bytes (contract).
+        unsafe { m.copy_to(buf, len) }
+    })
 }
 
 /// Start again from no data with the same settings (also clears a stop). Allocates for a
@@ -1032,7 +1037,7 @@ pub unsafe extern "C" fn inertia_estimator_free(est: *mut InertiaEstimator) {
 #[no_mangle]
 pub unsafe extern "C" fn inertia_last_error_message(buf: *mut c_char, len: usize) -> usize {
     // SAFETY: forwarded contract.
-    unsafe { message::last_to(buf, len) }
+    guard_or(0, || unsafe { message::last_to(buf, len) })
 }
 
 /// The name of a status code (a static string, e.g. `"INERTIA_STATUS_DATA"`;
@@ -1070,4 +1075,38 @@ pub extern "C" fn inertia_status_name(status: i32) -> *const c_char {
         InertiaStatus::Panic => c"INERTIA_STATUS_PANIC",
     };
     s.as_ptr()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_a_status_and_a_message() {
+        let status = guard(|| panic!("boom {}", 42));
+        assert_eq!(status, InertiaStatus::Panic);
+        let mut buf = [0u8; 128];
+        // SAFETY: `buf` is writable for its length.
+        let n = unsafe { inertia_last_error_message(buf.as_mut_ptr().cast(), buf.len()) };
+        let text = core::str::from_utf8(&buf[..n]).unwrap();
+        assert_eq!(text, "internal error (a bug in inertia): boom 42");
+        assert_eq!(guard_or(7usize, || panic!("again")), 7);
+    }
+
+    #[test]
+    fn messages_are_cut_at_character_boundaries() {
+        let mut m = message::Buffer::new();
+        let long = "é".repeat(message::CAPACITY); // 2 bytes each
+        write!(m, "{long}").unwrap();
+        let mut out = [0xFFu8; 6];
+        // SAFETY: `out` is writable for its length.
+        let n = unsafe { m.copy_to(out.as_mut_ptr().cast(), out.len()) };
+        assert_eq!(n, 2 * message::CAPACITY);
+        // 5 bytes of room: two whole "é" and the NUL.
+        assert_eq!(&out[..5], "éé\0".as_bytes());
+        let mut empty = [0xFFu8; 1];
+        // SAFETY: as above.
+        unsafe { m.copy_to(empty.as_mut_ptr().cast(), 1) };
+        assert_eq!(empty[0], 0);
+    }
 }

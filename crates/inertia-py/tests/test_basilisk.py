@@ -364,6 +364,20 @@ def test_cli_estimates_the_total_inertia_from_converted_data(tmp_path):
     assert rel_err(J_abs, I_SC) > 1e-2
 
 
+def test_cli_refuses_the_conjugated_reading(tmp_path):
+    """The module docs' claim: reading σ_BN's quaternion as N -> B (conjugated) is caught by
+    the library's convention check, which names --jpl."""
+    exe = inertia_bin()
+    if exe is None:
+        pytest.skip("no inertia binary (set INERTIA_BIN or cargo build --release -p inertia-cli)")
+    d = converted(simulate())
+    d["q"] = d["q"] * np.array([-1.0, -1.0, -1.0, 1.0])
+    path = tmp_path / "conjugated.csv"
+    bsk.to_csv(path, d)
+    out = subprocess.run([str(exe), "estimate", str(path)], capture_output=True, text=True)
+    assert out.returncode == 2 and "--jpl" in out.stderr, out.stderr
+
+
 # --------------------------------------------------------- end to end, Basilisk itself
 
 
