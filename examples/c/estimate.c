@@ -13,12 +13,43 @@
  * Prints the status, J, j with σ, at full precision (%.17g). Exit codes: 0 success,
  * 2 bad input or an estimator error (the message on standard error), 3 file unreadable.
  * .ci/c checks the printed j against `inertia estimate --json` on the same file.
+ *
+ * Built with -DINERTIA_COUNT_ALLOCATIONS and linked with
+ * -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=posix_memalign,--wrap=aligned_alloc
+ * it also counts the heap allocations the library makes inside the inertia_* calls
+ * (creation, pushes, reading the estimate) and prints them; .ci/c requires 0 in caller
+ * storage.
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "inertia.h"
+
+#ifdef INERTIA_COUNT_ALLOCATIONS
+/* Every allocation of the static library goes through these (the linker's --wrap
+ * redirects the library's references to malloc & co.). */
+static unsigned long allocations;
+void *__real_malloc(size_t n);
+void *__real_calloc(size_t n, size_t size);
+void *__real_realloc(void *p, size_t n);
+int __real_posix_memalign(void **p, size_t align, size_t n);
+void *__real_aligned_alloc(size_t align, size_t n);
+void *__wrap_malloc(size_t n) { allocations++; return __real_malloc(n); }
+void *__wrap_calloc(size_t n, size_t size) { allocations++; return __real_calloc(n, size); }
+void *__wrap_realloc(void *p, size_t n) { allocations++; return __real_realloc(p, n); }
+int __wrap_posix_memalign(void **p, size_t align, size_t n) {
+    allocations++;
+    return __real_posix_memalign(p, align, n);
+}
+void *__wrap_aligned_alloc(size_t align, size_t n) {
+    allocations++;
+    return __real_aligned_alloc(align, n);
+}
+#define ALLOCATIONS() allocations
+#else
+#define ALLOCATIONS() 0UL
+#endif
 
 #define MAX_LINE 4096
 #define MAX_COLUMNS 64
@@ -95,6 +126,7 @@ int main(int argc, char **argv) {
 
     InertiaEstimator *est = NULL;
     enum InertiaStatus status;
+    unsigned long allocations_at_start = ALLOCATIONS();
     if (use_storage) {
         if (inertia_estimator_size() > sizeof storage || inertia_estimator_align() > 64) {
             fprintf(stderr, "the static storage is too small: %zu bytes aligned to %zu needed\n",
@@ -105,6 +137,9 @@ int main(int argc, char **argv) {
     } else {
         status = inertia_estimator_new(&settings, &est);
     }
+    unsigned long creation_allocations = ALLOCATIONS() - allocations_at_start;
+    unsigned long push_allocations = 0;
+    (void)creation_allocations; /* printed only when counting */
     if (status != INERTIA_STATUS_OK) {
         fail_with_message("creating the estimator", status);
         return 2;
@@ -189,7 +224,9 @@ int main(int argc, char **argv) {
         for (int k = 0; k < 3; k++) s.tau_nm[k] = has_tau ? values[idx[8 + k]] : 0.0;
         for (int k = 0; k < 3; k++) s.w_rad_s[k] = has_w ? values[idx[11 + k]] : 0.0;
         s.has_w = (uint8_t)has_w;
+        unsigned long before = ALLOCATIONS();
         status = inertia_estimator_push(est, &s);
+        push_allocations += ALLOCATIONS() - before;
         if (status != INERTIA_STATUS_OK) {
             char where[512];
             snprintf(where, sizeof where, "%s:%ld", path, line_number);
@@ -206,9 +243,11 @@ int main(int argc, char **argv) {
 
     if (code == 0) {
         InertiaEstimate e;
+        unsigned long before = ALLOCATIONS();
         inertia_estimator_get(est, &e);
         char reason[512];
         inertia_estimator_reason(est, reason, sizeof reason);
+        push_allocations += ALLOCATIONS() - before;
         printf("estimator: %s (%s)\n", estimator_kind_name(settings.estimator),
                use_storage ? "caller storage" : "heap");
         printf("samples: %llu, t = %.17g s\n", (unsigned long long)e.samples, e.t_s);
@@ -226,6 +265,10 @@ int main(int argc, char **argv) {
         } else {
             printf("no answer\n");
         }
+#ifdef INERTIA_COUNT_ALLOCATIONS
+        printf("allocations: creation %lu, pushes and reads %lu (%llu pushes)\n",
+               creation_allocations, push_allocations, (unsigned long long)e.samples);
+#endif
     }
     inertia_estimator_free(est);
     return code;
