@@ -7,8 +7,10 @@
 //!
 //! * **On the heap**: [`inertia_estimator_new`] / [`inertia_estimator_free`]. Every
 //!   estimator of the library, through [`inertia::pipeline::Pipeline`] (the default,
-//!   `discrete-momentum`, among them). Its pushes allocate: the discrete momentum
-//!   estimator's bookkeeping uses the heap (`tests/no_alloc.rs` measures how much).
+//!   `discrete-momentum`, among them). Creation and the first pushes allocate (the
+//!   discrete momentum estimator builds its candidates from the first samples);
+//!   `tests/no_alloc.rs` requires that no push after the first 100 samples of a slew
+//!   does, a measurement rather than a guarantee for every input.
 //! * **In caller storage**: [`inertia_estimator_size`], [`inertia_estimator_align`],
 //!   [`inertia_estimator_init`]. The `variational` and `finite-difference` estimators
 //!   with the native solver, in fixed-size state. Neither `init`, nor a push, nor reading
