@@ -266,6 +266,9 @@ struct DiscreteMomentum {
     samples: usize,
     /// The even sample waiting for its successor (the shadow's next sample).
     held: Option<Sample>,
+    /// The other candidates' answers for [`reconcile`], kept between solves so that a
+    /// push does not allocate.
+    others: Vec<(InertiaVector, [f64; 6])>,
 }
 
 /// A candidate's own answer, for the cross-check.
@@ -356,6 +359,7 @@ impl DiscreteMomentum {
             density_ratio: None,
             samples: 0,
             held: None,
+            others: Vec::new(),
         })
     }
 
@@ -429,7 +433,8 @@ impl DiscreteMomentum {
             .candidates
             .get(self.chosen)
             .map_or(f64::INFINITY, |c| c.qr().residual_variance());
-        let mut others: Vec<(InertiaVector, [f64; 6])> = Vec::new();
+        let others = &mut self.others;
+        others.clear();
         for (i, (c, check)) in self.candidates.iter_mut().zip(&mut self.checks).enumerate() {
             if i == self.chosen
                 || !self.standing.live(i)
@@ -452,7 +457,7 @@ impl DiscreteMomentum {
                 others.push((k.j, k.sigma));
             }
         }
-        reconcile(e, &others, self.config.observability.max_relative_sigma);
+        reconcile(e, others, self.config.observability.max_relative_sigma);
         Ok(())
     }
 }
