@@ -81,6 +81,10 @@ typedef enum InertiaReason {
   INERTIA_REASON_ILL_CONDITIONED = 11,
   // A reason this version of the header does not name.
   INERTIA_REASON_OTHER = 12,
+  // The data contradict the Gaussian prior (`prior_chi2` above its threshold).
+  INERTIA_REASON_PRIOR_CONFLICT = 13,
+  // The momentum baseline's unconstrained J is not a physical inertia.
+  INERTIA_REASON_NOT_PHYSICAL = 14,
 } InertiaReason;
 
 // The estimators (`InertiaSettings::estimator`).
@@ -150,8 +154,15 @@ typedef struct InertiaSettings {
   // Lower bound per element `[J11, J22, J33, J12, J13, J23]`, kg m²; `-INFINITY`
   // (default) for none. Products are tensor entries (`J12 = −Σ m x y`).
   double bound_lower_kg_m2[6];
-  // Upper bound per element, kg m²; `INFINITY` (default) for none.
+  // Upper bound per element, kg m²; `INFINITY` (default) for none. A lower bound
+  // equal to the upper one is an equality: the solver eliminates that element.
   double bound_upper_kg_m2[6];
+  // Gaussian prior mean per element, kg m² (tensor entries; negate a CAD tool's
+  // products of inertia). Used when `prior_sigma_kg_m2` is set.
+  double prior_mean_kg_m2[6];
+  // Gaussian prior standard deviation per element, kg m², each finite and > 0; all
+  // zero (default) for no prior.
+  double prior_sigma_kg_m2[6];
   // Solve every this many samples (default 1).
   uint32_t solve_every;
   // Memory time constant, s; 0 (default) for none.
@@ -217,6 +228,11 @@ typedef struct InertiaEstimate {
   uint64_t rows;
   // Samples pushed since creation or the last reset.
   uint64_t samples;
+  // With a Gaussian prior: the fraction of the information on each element from the
+  // data (the rest from the prior); NaN without a prior or for a fixed element.
+  double prior_data_share[6];
+  // With a Gaussian prior: the prior-data disagreement χ² (NaN without a prior).
+  double prior_chi2;
 } InertiaEstimate;
 
 #ifdef __cplusplus

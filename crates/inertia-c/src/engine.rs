@@ -144,7 +144,7 @@ impl<S: RowSource + Default> Fixed<S> {
         }
         audit(
             &mut e,
-            self.main.qr(),
+            self.main.solved(),
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
         );

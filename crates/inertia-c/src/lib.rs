@@ -157,8 +157,15 @@ pub struct InertiaSettings {
     /// Lower bound per element `[J11, J22, J33, J12, J13, J23]`, kg m²; `-INFINITY`
     /// (default) for none. Products are tensor entries (`J12 = −Σ m x y`).
     pub bound_lower_kg_m2: [f64; 6],
-    /// Upper bound per element, kg m²; `INFINITY` (default) for none.
+    /// Upper bound per element, kg m²; `INFINITY` (default) for none. A lower bound
+    /// equal to the upper one is an equality: the solver eliminates that element.
     pub bound_upper_kg_m2: [f64; 6],
+    /// Gaussian prior mean per element, kg m² (tensor entries; negate a CAD tool's
+    /// products of inertia). Used when `prior_sigma_kg_m2` is set.
+    pub prior_mean_kg_m2: [f64; 6],
+    /// Gaussian prior standard deviation per element, kg m², each finite and > 0; all
+    /// zero (default) for no prior.
+    pub prior_sigma_kg_m2: [f64; 6],
     /// Solve every this many samples (default 1).
     pub solve_every: u32,
     /// Memory time constant, s; 0 (default) for none.
@@ -248,6 +255,10 @@ pub enum InertiaReason {
     IllConditioned = 11,
     /// A reason this version of the header does not name.
     Other = 12,
+    /// The data contradict the Gaussian prior (`prior_chi2` above its threshold).
+    PriorConflict = 13,
+    /// The momentum baseline's unconstrained J is not a physical inertia.
+    NotPhysical = 14,
 }
 
 /// The current estimate.
@@ -276,6 +287,11 @@ pub struct InertiaEstimate {
     pub rows: u64,
     /// Samples pushed since creation or the last reset.
     pub samples: u64,
+    /// With a Gaussian prior: the fraction of the information on each element from the
+    /// data (the rest from the prior); NaN without a prior or for a fixed element.
+    pub prior_data_share: [f64; 6],
+    /// With a Gaussian prior: the prior-data disagreement χ² (NaN without a prior).
+    pub prior_chi2: f64,
 }
 
 /// An estimator (opaque).
@@ -422,6 +438,13 @@ impl Plan {
             if l.is_some() || u.is_some() {
                 constraints = constraints.with_bounds(*c, l, u);
             }
+        }
+        // A prior is given when any σ is; the library checks each value (finite, > 0).
+        if s.prior_sigma_kg_m2.iter().any(|&v| v != 0.0) {
+            constraints.prior = Some(inertia::constraints::GaussianPrior {
+                mean_kg_m2: s.prior_mean_kg_m2,
+                sigma_kg_m2: s.prior_sigma_kg_m2,
+            });
         }
         if s.solve_every == 0 {
             return Err(fail(
@@ -703,6 +726,8 @@ impl InertiaEstimator {
             condition: nan,
             rows: 0,
             samples: self.samples,
+            prior_data_share: [nan; 6],
+            prior_chi2: nan,
         };
         let Some(e) = self.last else { return out };
         out.t_s = e.t_s;
@@ -727,6 +752,10 @@ impl InertiaEstimator {
             out.has_sigma = 1;
             out.sigma = s;
         }
+        if let Some(p) = e.prior {
+            out.prior_chi2 = p.chi2;
+            out.prior_data_share = p.data_share.map(|d| d.unwrap_or(f64::NAN));
+        }
         out
     }
 }
@@ -744,6 +773,8 @@ fn reason(r: Unobservable) -> InertiaReason {
         Unobservable::Inconsistent { .. } => InertiaReason::Inconsistent,
         Unobservable::DensityOverstated { .. } => InertiaReason::DensityOverstated,
         Unobservable::IllConditioned { .. } => InertiaReason::IllConditioned,
+        Unobservable::PriorConflict { .. } => InertiaReason::PriorConflict,
+        Unobservable::NotPhysical { .. } => InertiaReason::NotPhysical,
         _ => InertiaReason::Other,
     }
 }
@@ -780,6 +811,8 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         constraints: InertiaConstraintKind::Physical as u32,
         bound_lower_kg_m2: [f64::NEG_INFINITY; 6],
         bound_upper_kg_m2: [f64::INFINITY; 6],
+        prior_mean_kg_m2: [0.0; 6],
+        prior_sigma_kg_m2: [0.0; 6],
         solve_every: 1,
         memory_s: 0.0,
         resample_s: 0.0,

@@ -60,6 +60,33 @@ fn variational_spin_paper_constraints_and_j33_bound() {
     assert!(compare(Scenario::spin(), s, "spin") > 1000);
 }
 
+/// Prior knowledge (issue 13) in caller storage as on the heap: an equality and a
+/// Gaussian prior on the spin, where the data alone lean on the constraint set.
+#[test]
+fn variational_spin_with_an_equality_and_a_gaussian_prior() {
+    let mut s = variational();
+    let truth = inertia::tensor::j_from_matrix(&Common::paper().inertia_kg_m2);
+    s.bound_lower_kg_m2[3] = truth[3];
+    s.bound_upper_kg_m2[3] = truth[3];
+    s.prior_mean_kg_m2 = core::array::from_fn(|k| truth[k] * 1.01);
+    s.prior_sigma_kg_m2 = core::array::from_fn(|k| 0.05 * truth[k].abs().max(0.5));
+    assert!(compare(Scenario::spin(), s, "spin, prior") > 1000);
+    let run = Scenario::spin().simulate(&Common::paper()).unwrap();
+    let e = new(&s);
+    for x in &run.samples {
+        assert_eq!(push(e, &c_sample(x)), InertiaStatus::Ok, "{}", last_error());
+    }
+    let out = get(e);
+    free(e);
+    assert_eq!(out.j[3], truth[3], "the equality holds exactly");
+    assert!(out.prior_chi2.is_finite(), "{out:?}");
+    assert!(
+        out.prior_data_share[3].is_nan(),
+        "a fixed element has no share"
+    );
+    assert!(out.prior_data_share[0] > 0.0 && out.prior_data_share[0] <= 1.0);
+}
+
 #[test]
 fn variational_with_compensation_memory_and_every() {
     let mut s = variational();

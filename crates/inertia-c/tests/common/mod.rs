@@ -80,6 +80,8 @@ pub fn same(a: &InertiaEstimate, b: &InertiaEstimate) -> bool {
             e.j.iter()
                 .chain(&e.sigma)
                 .chain(e.inertia.iter().flatten())
+                .chain(&e.prior_data_share)
+                .chain([&e.prior_chi2])
                 .map(|x| x.to_bits()),
         );
         v

@@ -98,7 +98,11 @@ pub fn solve_reduced(
 ) -> Result<Estimate, EstimatorError> {
     let (solved, fit) = super::prior::augment(qr, constraints);
     let observability = super::recursive::with_prior(
-        assess(&solved, constraints.set().has_bounds(), observability),
+        assess(
+            &solved,
+            constraints.set().has_bounds(),
+            &super::recursive::combined_settings(observability, fit.as_ref()),
+        ),
         qr,
         fit.as_ref(),
         constraints,

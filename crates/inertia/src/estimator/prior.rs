@@ -24,7 +24,9 @@
 //!   [`RESIDUAL_VARIANCE_ALLOWANCE`] times the 99.9 % point of `χ²_p` the answer is
 //!   withdrawn as [`super::observability::Unobservable::PriorConflict`].
 //!
-//! With noise-free data (`ρ² = 0`) `s` is floored at `1e-12 · c · min σ_k` (`c` the
+//! Without excitation (`y ≡ 0`) the data fix only the direction of `j`: `s² = σ_6²
+//! ‖μ‖²/(rows − 5)`, the misfit of that direction at the prior's size, and the scale
+//! is the prior's alone (the data's information along it is removed). With noise-free data (`ρ² = 0`) `s` is floored at `1e-12 · c · min σ_k` (`c` the
 //! root-mean-square column norm of `R`), so that the prior still fixes the directions the
 //! data leave open, with its own σ there.
 
@@ -35,6 +37,11 @@ use nalgebra::Vector6;
 
 /// 99.9 % points of `χ²_k`, `k = 1 … 6`.
 pub const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
+
+/// Floor of the residual scale `s`, relative to `c · min σ_k` (`c` the root-mean-square
+/// column norm of `R`): data that fit (nearly) exactly still leave the prior a weight
+/// within `10⁻¹²` of theirs in the normal equations, which the solvers resolve.
+pub const SCALE_FLOOR: f64 = 1e-6;
 
 /// How much the residual scale `s` may understate the noise of `ĵ`: the conflict test
 /// flags `χ² > RESIDUAL_VARIANCE_ALLOWANCE · χ²_{p, 0.999}`. The rows' errors are
@@ -116,10 +123,28 @@ pub fn augment(qr: &RecursiveQr, constraints: &Constraints) -> (RecursiveQr, Opt
         return (out, None);
     };
     let sigma_min = p.sigma_kg_m2.iter().fold(f64::INFINITY, |a, &b| a.min(b));
-    let floor = 1e-12 * scale * sigma_min;
+    let floor = SCALE_FLOOR * scale * sigma_min;
     let dof = out.residual_dof();
+    // Without rotor momentum or known torque (`y ≡ 0`, and no equality giving a scale)
+    // the data fix only the direction `v_6` of `j`: their least-squares `j` is 0 and fits
+    // exactly. The misfit of that direction, `σ_6² ‖j‖²/(rows − 5)` at the prior's
+    // `‖j‖`, measures the noise (as [`super::observability::direction_relative_sigma`]
+    // does), and the data's information along `v_6` is removed: the scale is the
+    // prior's alone.
+    let mut scale_free = 0.0;
+    if out.y_energy == 0.0 && dof > 0.0 {
+        let svd = out.r.svd(false, true);
+        if let Some(v_t) = svd.v_t {
+            let (i, smin) = svd.singular_values.argmin();
+            let v = v_t.row(i).transpose();
+            let norm2: f64 = p.mean_kg_m2.iter().map(|m| m * m).sum();
+            scale_free = smin * smin * norm2 / (dof + 1.0);
+            let projected = out.r - out.r * v * v.transpose();
+            out.r = projected.qr().r();
+        }
+    }
     let s = if dof > 0.0 {
-        crate::math::sqrt(out.rss / dof).max(floor)
+        crate::math::sqrt((out.rss / dof).max(scale_free)).max(floor)
     } else {
         floor
     };

@@ -241,7 +241,12 @@ pub(crate) fn estimate_from<B: Backend + ?Sized>(
 ) -> Result<Estimate, EstimatorError> {
     let has_bounds = constraints.set().has_bounds();
     let observability = with_prior(
-        assess_with(solved, sv, has_bounds, &settings.observability),
+        assess_with(
+            solved,
+            sv,
+            has_bounds,
+            &combined_settings(&settings.observability, fit.as_ref()),
+        ),
         data,
         fit.as_ref(),
         constraints,
@@ -263,6 +268,22 @@ pub(crate) fn estimate_from<B: Backend + ?Sized>(
         uncertainty: None,
         prior: fit,
     })
+}
+
+/// The observability thresholds of the problem with a Gaussian prior: no condition-number
+/// test (the prior's rows are weighed against data that may fix other directions far
+/// more sharply; the posterior σ, which the relative-σ test checks, is what counts).
+pub(crate) fn combined_settings(
+    settings: &ObservabilitySettings,
+    fit: Option<&super::prior::PriorFit>,
+) -> ObservabilitySettings {
+    match fit {
+        Some(_) => ObservabilitySettings {
+            condition_threshold: f64::INFINITY,
+            ..*settings
+        },
+        None => *settings,
+    }
 }
 
 /// The status of an answer with a Gaussian prior: withdrawn when the prior and the data
