@@ -7,7 +7,7 @@ use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 create_exception!(
-    _inertia,
+    inertia,
     DataError,
     PyValueError,
     "Bad input data: the message names the file, line and column (or the argument and \

@@ -126,6 +126,11 @@ impl Telemetry {
     fn __len__(&self) -> usize {
         self.samples.len()
     }
+    /// The quaternion columns' names (for messages).
+    #[getter]
+    fn q_columns(&self) -> String {
+        self.q_columns.clone()
+    }
 
     /// Estimate from these samples (see `inertia.estimate`).
     #[pyo3(signature = (kwargs=None))]
@@ -461,6 +466,52 @@ fn samples_from_arrays<'py>(
     })
 }
 
+/// Telemetry rebuilt from what a `Telemetry` held (unpickling): the values were
+/// checked when it was made, so they are taken as they are, bit for bit.
+#[pyfunction]
+#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns))]
+#[allow(clippy::too_many_arguments)]
+fn restore<'py>(
+    t: PyReadonlyArrayDyn<'py, f64>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    rho: PyReadonlyArrayDyn<'py, f64>,
+    tau: PyReadonlyArrayDyn<'py, f64>,
+    w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    file: Option<String>,
+    lines: Option<Vec<u64>>,
+    stats: (usize, usize, usize, f64, f64),
+    q_columns: String,
+) -> PyResult<Telemetry> {
+    let rows = rows(&t, &q, &rho, Some(&tau), w.as_ref())?;
+    if lines.as_ref().is_some_and(|l| l.len() != rows.len()) {
+        return Err(value_error("lines: one per sample"));
+    }
+    let samples = rows
+        .iter()
+        .map(|r| Sample {
+            t_s: r.t,
+            q: inertia::attitude::Quaternion::from_xyzw(r.q),
+            rho_nms: r.rho.into(),
+            tau_nm: r.tau.unwrap_or_default().into(),
+            omega_rad_s: r.w.map(Into::into),
+        })
+        .collect();
+    let (rows_read, renormalised, sign_flips, min_step_s, max_step_s) = stats;
+    Ok(Telemetry {
+        samples,
+        lines,
+        file,
+        stats: Stats {
+            rows: rows_read,
+            renormalised,
+            sign_flips,
+            min_step_s,
+            max_step_s,
+        },
+        q_columns,
+    })
+}
+
 /// The registered estimators: `(name, summary)`.
 #[pyfunction]
 fn estimators() -> Vec<(&'static str, &'static str)> {
@@ -480,6 +531,7 @@ fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(samples_from_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(estimators, m)?)?;
+    m.add_function(wrap_pyfunction!(restore, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
     Ok(())
 }

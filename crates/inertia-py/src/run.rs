@@ -82,7 +82,26 @@ impl Origin {
             PipelineError::Estimator { source, .. } => format!("{at} {source}"),
             other => format!("{at} {other}"),
         };
-        Failure::Data(m, line)
+        Failure::Data(python_options(m), line)
+    }
+}
+
+/// The message with the keyword arguments for the command-line options it names
+/// (`--jpl`, `--scalar-first`, `--glitches keep`), after it.
+pub fn python_options(m: String) -> String {
+    let names: Vec<&str> = [
+        ("--scalar-first", "scalar_first=True"),
+        ("--jpl", "jpl=True"),
+        ("--glitches keep", "glitches=\"keep\""),
+    ]
+    .iter()
+    .filter(|(cli, _)| m.contains(cli))
+    .map(|(_, py)| *py)
+    .collect();
+    if names.is_empty() {
+        m
+    } else {
+        format!("{m} [in Python: {}]", names.join(", "))
     }
 }
 

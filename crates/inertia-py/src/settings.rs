@@ -214,8 +214,9 @@ impl<'py> Kwargs<'py> {
     pub fn finish(self) -> PyResult<()> {
         if let Some((k, _)) = self.dict.iter().next() {
             return Err(type_error(format!(
-                "{}() got an unexpected keyword argument {k}",
-                self.function
+                "{}() got an unexpected keyword argument {}",
+                self.function,
+                k.repr()?
             )));
         }
         Ok(())

@@ -101,13 +101,13 @@ impl State {
 }
 
 fn data_message(e: PipelineError, i: usize) -> String {
-    match e {
+    crate::run::python_options(match e {
         PipelineError::Estimator {
             source: inertia::estimator::EstimatorError::Solve(s),
             ..
         } => format!("sample {i}: the solver failed on these data: {s}"),
         other => format!("sample {i}: {other}"),
-    }
+    })
 }
 
 impl Stream {

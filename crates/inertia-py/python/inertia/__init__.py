@@ -266,12 +266,17 @@ class Telemetry:
         return pd.DataFrame(cols)
 
     def __reduce__(self):
-        # Rebuilt from the arrays (which the checks leave as they are, to rounding).
-        return (_telemetry_from_arrays, (self.t, self.q, self.rho, self.tau, self.w))
+        st = self.stats
+        state = (st["rows"], st["renormalised"], st["sign_flips"], st["min_step_s"], st["max_step_s"])
+        lines = None if self.lines is None else [int(x) for x in self.lines]
+        return (
+            _restore_telemetry,
+            (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state, self._native.q_columns),
+        )
 
 
-def _telemetry_from_arrays(t, q, rho, tau, w) -> Telemetry:
-    return Telemetry.from_arrays(t, q, rho, tau, w)
+def _restore_telemetry(*state) -> Telemetry:
+    return Telemetry(_inertia.restore(*state))
 
 
 def read_csv(
@@ -368,11 +373,12 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
             return None
         return np.column_stack([_float_array(n, need(n), "(N,)") for n in block])
 
-    t = need(names[0])
-    if np.issubdtype(t.dtype, np.datetime64):
-        # Elapsed seconds since the first row (numpy's datetimes have no leap seconds).
-        t = (t - t[0]) / np.timedelta64(1, "s")
-    t = _float_array(names[0], t, "(N,)")
+    need(names[0])
+    t = df[names[0]]
+    if str(t.dtype).startswith("datetime64"):
+        # Elapsed seconds since the first row (pandas' datetimes have no leap seconds).
+        t = (t - t.iloc[0]).dt.total_seconds()
+    t = _float_array(names[0], t.to_numpy(), "(N,)")
     q = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[1:5]])
     rho = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[5:8]])
     return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
