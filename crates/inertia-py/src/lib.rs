@@ -39,6 +39,8 @@ pub struct Telemetry {
     pub file: Option<String>,
     pub stats: Stats,
     pub q_columns: String,
+    /// The name in reports and messages: the file's, `<arrays>` or `<simulated>`.
+    pub label: String,
 }
 
 fn column<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -131,6 +133,11 @@ impl Telemetry {
     fn q_columns(&self) -> String {
         self.q_columns.clone()
     }
+    /// The name in reports: the file's, `<arrays>` or `<simulated>`.
+    #[getter]
+    fn label(&self) -> String {
+        self.label.clone()
+    }
 
     /// Estimate from these samples (see `inertia.estimate`).
     #[pyo3(signature = (kwargs=None))]
@@ -164,7 +171,7 @@ impl Telemetry {
             },
             _ => Origin::Memory {
                 naming: Naming::Arrays,
-                label: self.file.clone().unwrap_or_else(|| "<simulated>".into()),
+                label: self.label.clone(),
             },
         };
         let out = py
@@ -321,6 +328,7 @@ fn read(path: &std::path::Path, options: CsvOptions) -> Result<Telemetry, Failur
             max_step_s: st.max_step_s,
         },
         q_columns: reader.quaternion_columns(),
+        label: reader.file().to_string(),
     })
 }
 
@@ -463,13 +471,14 @@ fn samples_from_arrays<'py>(
         file: None,
         stats,
         q_columns: "q".into(),
+        label: "<arrays>".into(),
     })
 }
 
 /// Telemetry rebuilt from what a `Telemetry` held (unpickling): the values were
 /// checked when it was made, so they are taken as they are, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns))]
+#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label))]
 #[allow(clippy::too_many_arguments)]
 fn restore<'py>(
     t: PyReadonlyArrayDyn<'py, f64>,
@@ -481,6 +490,7 @@ fn restore<'py>(
     lines: Option<Vec<u64>>,
     stats: (usize, usize, usize, f64, f64),
     q_columns: String,
+    label: String,
 ) -> PyResult<Telemetry> {
     let rows = rows(&t, &q, &rho, Some(&tau), w.as_ref())?;
     if lines.as_ref().is_some_and(|l| l.len() != rows.len()) {
@@ -509,6 +519,7 @@ fn restore<'py>(
             max_step_s,
         },
         q_columns,
+        label,
     })
 }
 

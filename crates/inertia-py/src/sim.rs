@@ -246,6 +246,7 @@ pub fn simulate<'py>(
                     file: None,
                     stats: checker.stats,
                     q_columns: "q".into(),
+                    label: "<simulated>".into(),
                 },
                 out.inertia_at(t_end),
                 out.inertia_kg_m2,

@@ -161,6 +161,9 @@ def test_results_pickle(slew):
     for a in ("t", "q", "rho", "tau", "w"):
         np.testing.assert_array_equal(getattr(t2, a), getattr(tel, a))
     assert t2.stats == tel.stats
+    assert inertia.estimate(t2).to_dict() == inertia.estimate(tel).to_dict()
+    arrays = inertia.Telemetry.from_arrays(tel.t, tel.q, tel.rho, tel.tau, tel.w)
+    assert inertia.estimate(arrays).report["file"] == "<arrays>"
     np.testing.assert_array_equal(inertia.estimate(t2).inertia, inertia.estimate(tel).inertia)
     sim = pickle.loads(pickle.dumps(slew))
     np.testing.assert_array_equal(sim.inertia, truth)
@@ -231,5 +234,7 @@ def test_read_csv_stats_and_lines(tmp_path, slew):
     assert r.stats["renormalised"] == 50 and r.stats["sign_flips"] == 10
     assert [int(x) for x in r.lines] == list(range(2, 52))
     np.testing.assert_allclose(np.linalg.norm(r.q, axis=1), 1.0, atol=1e-15)
+    r2 = pickle.loads(pickle.dumps(r))
+    assert r2.file == r.file and list(r2.lines) == list(r.lines) and r2.stats == r.stats
     with pytest.raises(OSError, match="cannot read"):
         inertia.read_csv(tmp_path / "absent.csv")

@@ -271,7 +271,8 @@ class Telemetry:
         lines = None if self.lines is None else [int(x) for x in self.lines]
         return (
             _restore_telemetry,
-            (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state, self._native.q_columns),
+            (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state,
+             self._native.q_columns, self._native.label),
         )
 
 

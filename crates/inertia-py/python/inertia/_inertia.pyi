@@ -21,6 +21,7 @@ class Telemetry:
     lines: Optional[np.ndarray]
     stats: Dict[str, Any]
     q_columns: str
+    label: str
     def __len__(self) -> int: ...
     def estimate(self, kwargs: Optional[Dict[str, Any]] = ...) -> _Result: ...
 
