@@ -435,7 +435,10 @@ def estimate(
     * a pandas DataFrame with the CSV column names (``t``, ``q_x`` …, renamed by
       ``columns=``), as the only positional argument;
     * a :class:`Telemetry` (from :func:`read_csv` or :func:`simulate`);
-    * a path: the file is read with :func:`read_csv` first.
+    * a path: the file is read with :func:`read_csv` first. Unlike the CLI, which
+      streams, the whole file is read before the estimator runs (about 0.1 kB of
+      memory per sample), so when a file holds both a bad row and, earlier, a step the
+      estimator stops on, the bad row is reported.
 
     Settings (the command line's options, same names and defaults):
         estimator: ``"discrete-momentum"`` (default), ``"variational"`` (the paper's),
