@@ -175,17 +175,7 @@ impl Telemetry {
             },
         };
         let out = py
-            .allow_threads(|| {
-                run::run(
-                    &self.samples,
-                    &self.stats,
-                    &origin,
-                    config,
-                    s.batch,
-                    s.history,
-                    s.truth.as_ref(),
-                )
-            })
+            .allow_threads(|| run::run(&self.samples, &self.stats, &origin, config, &s))
             .map_err(|f| f.into_py(py))?;
         result(py, &out.report, out.history.as_deref())
     }
@@ -432,15 +422,7 @@ fn estimate_arrays<'py>(
     let out = py
         .allow_threads(|| {
             let (samples, stats) = check_rows(&rows, &conv, &naming)?;
-            run::run(
-                &samples,
-                &stats,
-                &origin,
-                config,
-                s.batch,
-                s.history,
-                s.truth.as_ref(),
-            )
+            run::run(&samples, &stats, &origin, config, &s)
         })
         .map_err(|f| f.into_py(py))?;
     result(py, &out.report, out.history.as_deref())

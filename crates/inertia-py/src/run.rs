@@ -5,13 +5,13 @@
 
 use crate::errors::Failure;
 use crate::samples::{Naming, Stats};
+use crate::settings::RunSettings;
 use inertia::discrete::RowError;
 use inertia::estimator::{Estimate, EstimatorError};
 use inertia::pipeline::report::{InputSummary, Report};
 use inertia::pipeline::{self, Pipeline, PipelineConfig, PipelineError, MAX_RESAMPLE_FACTOR};
 use inertia::sample::Sample;
 use inertia::text::Num;
-use nalgebra::Matrix3;
 
 /// How many recent samples the command line keeps to name the line of an error.
 const RECENT: usize = 8;
@@ -166,10 +166,9 @@ pub fn run(
     stats: &Stats,
     origin: &Origin,
     config: PipelineConfig,
-    batch: bool,
-    history: bool,
-    truth: Option<&Matrix3<f64>>,
+    settings: &RunSettings,
 ) -> Result<Output, Failure> {
+    let (batch, history, truth) = (settings.batch, settings.history, settings.truth.as_ref());
     let entry = config.estimator();
     if entry.capabilities.needs_gyro && samples.iter().any(|s| s.omega_rad_s.is_none()) {
         return Err(match origin {

@@ -385,11 +385,23 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
     return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
 
 
-def _settings(**kw: Any) -> Dict[str, Any]:
+#: The estimation settings, as :func:`estimate` and :class:`Estimator` name them (the
+#: command line's options).
+_SETTINGS = (
+    "estimator", "constraints", "bounds", "nominal", "tolerance", "gyro_noise", "memory",
+    "resample", "every", "rotation_source", "rho_model", "torque_bias", "chain", "glitches",
+    "solver", "uncertainty",
+)
+#: How the data are read.
+_CONVENTIONS = ("scalar_first", "jpl", "unit_tolerance", "period_tolerance")
+
+
+def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
+    """The named arguments, with matrices as nested lists for the native side."""
+    kw = {k: arguments[k] for k in names}
     for key in ("nominal", "truth"):
         if kw.get(key) is not None:
-            m = _float_array(key, kw[key], "(3, 3)")
-            kw[key] = m.tolist()
+            kw[key] = _float_array(key, kw[key], "(3, 3)").tolist()
     return kw
 
 
@@ -470,17 +482,9 @@ def estimate(
         DataError: bad data, with the CLI's message.
         ValueError, TypeError: an invalid argument, named.
     """
-    settings = _settings(
-        estimator=estimator, constraints=constraints, bounds=bounds, nominal=nominal,
-        tolerance=tolerance, gyro_noise=gyro_noise, memory=memory, resample=resample,
-        every=every, rotation_source=rotation_source, rho_model=rho_model,
-        torque_bias=torque_bias, chain=chain, glitches=glitches, solver=solver,
-        uncertainty=uncertainty, batch=batch, history=history, truth=truth,
-    )
-    conventions = dict(
-        scalar_first=scalar_first, jpl=jpl, unit_tolerance=unit_tolerance,
-        period_tolerance=period_tolerance,
-    )
+    arguments = locals()
+    settings = _settings(arguments, (*_SETTINGS, "batch", "history", "truth"))
+    conventions = _settings(arguments, _CONVENTIONS)
     single = q is None and rho is None and tau is None and w is None
     if isinstance(t, Telemetry) or isinstance(t, (str, os.PathLike)) or _is_frame(t):
         if not single:
@@ -558,16 +562,7 @@ class Estimator:
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> None:
-        self._native = _inertia.Stream(
-            kwargs=_settings(
-                estimator=estimator, constraints=constraints, bounds=bounds, nominal=nominal,
-                tolerance=tolerance, gyro_noise=gyro_noise, memory=memory, resample=resample,
-                every=every, rotation_source=rotation_source, rho_model=rho_model,
-                torque_bias=torque_bias, chain=chain, glitches=glitches, solver=solver,
-                uncertainty=uncertainty, scalar_first=scalar_first, jpl=jpl,
-                unit_tolerance=unit_tolerance, period_tolerance=period_tolerance,
-            )
-        )
+        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_SETTINGS, *_CONVENTIONS)))
 
     def push(self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
         """Push one sample: ``t`` s, ``q`` (4,), ``rho`` (3,) N m s, ``tau`` (3,) N m,
