@@ -60,6 +60,8 @@ def test_report_matches_cli(cli, files, name, options, kwargs):
     got = inertia.estimate(str(path), **kwargs)
     assert differences(expected, got.to_dict()) <= TOL
     assert got.status == expected["status"]
+    # The readable report is the CLI's, line for line.
+    assert got.text == run_cli(cli, "estimate", path, *options).stdout
     if expected["inertia"] is not None:
         assert np.abs(got.inertia - np.array(expected["inertia"])).max() <= TOL * np.abs(got.inertia).max()
     # The same numbers as arrays (the input summary names `<arrays>` instead of the file).
