@@ -1,0 +1,649 @@
+"""Estimate a spacecraft's inertia tensor from attitude telemetry.
+
+The Python interface of the ``inertia`` Rust library. Every computation is the
+library's: the CSV reader, the estimation pipeline and its report, the simulator, run
+as ``inertia estimate`` and ``inertia simulate`` run them, so results and messages are
+the command line's. This module only converts arguments and results.
+
+Units are SI throughout: time s, angles rad, rates rad/s, rotor momentum N m s, torque
+N m, inertia kg m². Vectors are in body axes. Quaternions are ``[x, y, z, w]``, scalar
+last, Hamilton, body → inertial, unless ``scalar_first=True`` (columns hold
+``[w, x, y, z]``) or ``jpl=True`` (JPL/Shuster: inertial → body, scalar last) says
+otherwise, as the command line's ``--scalar-first`` and ``--jpl``.
+
+Quick start::
+
+    import inertia
+    sim = inertia.simulate("slew", seed=1)             # telemetry and the true J
+    est = inertia.estimate(sim.telemetry)               # the CLI's default estimator
+    print(est.status, est.inertia, est.sigma)
+
+``inertia.DataError`` (a ``ValueError``) is raised for bad data, with the command
+line's message (file, line and column for a file; argument and row for arrays);
+invalid arguments raise ``ValueError`` or ``TypeError`` naming the argument; a file that
+cannot be read raises ``OSError``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _inertia
+from ._inertia import DataError
+
+# The Basilisk converter (`inertia.basilisk`, pure numpy) is written separately; once it
+# is in the package it can be imported here (`from . import basilisk`).
+
+__all__ = [
+    "DEFAULT_ESTIMATOR",
+    "HISTORY_COLUMNS",
+    "DataError",
+    "Estimate",
+    "Estimator",
+    "Simulation",
+    "Telemetry",
+    "estimate",
+    "estimators",
+    "read_csv",
+    "simulate",
+]
+
+__version__ = "0.1.0"
+
+#: The estimator ``inertia estimate`` runs by default (the discrete momentum estimator).
+DEFAULT_ESTIMATOR: str = _inertia.DEFAULT_ESTIMATOR
+
+#: Columns of an estimate history (the CLI's ``-o`` CSV, schema version 1).
+HISTORY_COLUMNS: Tuple[str, ...] = (
+    "t", "J11", "J22", "J33", "J12", "J13", "J23", "status", "condition", "iterations",
+    "sJ11", "sJ22", "sJ33", "sJ12", "sJ13", "sJ23", "reason",
+)
+
+#: The CSV column names, in the order t, q (4), rho (3), tau (3), w (3).
+CSV_COLUMNS: Tuple[str, ...] = (
+    "t", "q_x", "q_y", "q_z", "q_w", "rho_x", "rho_y", "rho_z",
+    "tau_x", "tau_y", "tau_z", "w_x", "w_y", "w_z",
+)
+
+
+def _pandas(what: str):
+    try:
+        import pandas
+    except ImportError as e:  # pragma: no cover - exercised without pandas only
+        raise ImportError(
+            f"{what} needs pandas, which is not installed: pip install pandas"
+        ) from e
+    return pandas
+
+
+def estimators() -> List[Tuple[str, str]]:
+    """The estimators that can be named in ``estimator=``: ``(name, summary)`` pairs."""
+    return list(_inertia.estimators())
+
+
+# --------------------------------------------------------------------------- results
+
+
+def _array(v: Any) -> Optional[np.ndarray]:
+    return None if v is None else np.array(v, dtype=np.float64)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Estimate:
+    """The result of an estimation run: the command line's report.
+
+    Attributes:
+        inertia: J, kg m², 3×3 (``None`` when the data cannot determine J).
+        j: ``[J11, J22, J33, J12, J13, J23]``, kg m² (products are tensor entries,
+            ``J12 = −Σ m x y``).
+        sigma: one standard deviation of each element of ``j``, kg m² (noise and
+            discretisation bias), or ``None`` for estimators without an uncertainty
+            model.
+        status: ``"determined"``, ``"from_prior"``, ``"not_observable"`` or
+            ``"unchecked"``.
+        reason: why the data fall short, when they do (else ``None``).
+        condition: σ₁/σ₆ of the information factor R when determined.
+        principal_moments: ascending, kg m² (3,).
+        principal_moments_sigma: their standard deviations, kg m² (3,).
+        principal_axes: the principal axes as columns, body axes (3×3).
+        t: time of the estimate, s.
+        samples: samples the estimator saw (after resampling).
+        estimator: the estimator's name.
+        relative_error: ‖J − J_true‖_F/‖J_true‖_F when ``truth=`` was given.
+        torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,).
+        report: the whole report as a dict (the ``inertia estimate --json`` schema).
+        text: the readable report (``inertia estimate`` without ``--json``).
+
+    With ``history=True`` the estimate history is ``.history`` (a pandas DataFrame with
+    :data:`HISTORY_COLUMNS`; pandas is needed only then). Estimates pickle.
+    """
+
+    inertia: Optional[np.ndarray]
+    j: Optional[np.ndarray]
+    sigma: Optional[np.ndarray]
+    status: str
+    reason: Optional[str]
+    condition: Optional[float]
+    principal_moments: Optional[np.ndarray]
+    principal_moments_sigma: Optional[np.ndarray]
+    principal_axes: Optional[np.ndarray]
+    t: float
+    samples: int
+    estimator: str
+    relative_error: Optional[float]
+    torque_bias_nm: Optional[np.ndarray]
+    report: Dict[str, Any] = dataclasses.field(repr=False)
+    text: str = dataclasses.field(repr=False)
+    history_columns: Optional[Dict[str, Any]] = dataclasses.field(default=None, repr=False)
+
+    @classmethod
+    def _from_native(cls, native: Tuple[str, str, Optional[Dict[str, Any]]]) -> "Estimate":
+        report_json, text, history = native
+        r = json.loads(report_json)
+        return cls(
+            inertia=_array(r["inertia"]),
+            j=_array(r["j"]),
+            sigma=_array(r["sigma"]),
+            status=r["status"],
+            reason=r["reason"],
+            condition=r["condition"],
+            principal_moments=_array(r["principal_moments"]),
+            principal_moments_sigma=_array(r["principal_moments_sigma"]),
+            principal_axes=_array(r["principal_axes"]),
+            t=r["t"],
+            samples=r["samples"],
+            estimator=r["estimator"],
+            relative_error=r["relative_error"],
+            torque_bias_nm=_array(r["torque_bias_nm"]),
+            report=r,
+            text=text,
+            history_columns=history,
+        )
+
+    @property
+    def determined(self) -> bool:
+        """``True`` when the data determine J (status ``"determined"``)."""
+        return self.status == "determined"
+
+    @property
+    def history(self):
+        """The estimate history as a pandas DataFrame (``history=True`` runs only).
+
+        Columns :data:`HISTORY_COLUMNS`: ``t`` s; ``J..`` and ``sJ..`` kg m² (NaN where
+        not available); ``status``; ``condition``; ``iterations``; ``reason``.
+        """
+        if self.history_columns is None:
+            raise ValueError("no history: estimate with history=True")
+        pd = _pandas("Estimate.history")
+        return pd.DataFrame({c: self.history_columns[c] for c in HISTORY_COLUMNS})
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The report as a JSON-compatible dict: the ``inertia estimate --json`` object."""
+        return json.loads(json.dumps(self.report))
+
+    def __str__(self) -> str:
+        return self.text
+
+
+# ------------------------------------------------------------------------- telemetry
+
+
+class Telemetry:
+    """Telemetry held in memory, checked, in this library's convention.
+
+    Made by :func:`read_csv`, :func:`simulate` or :meth:`Telemetry.from_arrays`.
+    Attributes (numpy arrays, SI units, body axes): ``t`` (N,) s; ``q`` (N, 4)
+    ``[x, y, z, w]`` Hamilton body → inertial, unit norm; ``rho`` (N, 3) N m s; ``tau``
+    (N, 3) N m; ``w`` (N, 3) rad/s or ``None``; ``file`` and ``lines`` (each sample's
+    line) for a file; ``stats``: what the reader counted.
+    """
+
+    __slots__ = ("_native",)
+
+    def __init__(self, native: "_inertia.Telemetry") -> None:
+        self._native = native
+
+    @classmethod
+    def from_arrays(
+        cls,
+        t: Any,
+        q: Any,
+        rho: Any,
+        tau: Any = None,
+        w: Any = None,
+        *,
+        scalar_first: bool = False,
+        jpl: bool = False,
+        unit_tolerance: Optional[float] = None,
+        period_tolerance: Optional[float] = None,
+    ) -> "Telemetry":
+        """Check arrays (shapes as for :func:`estimate`) into telemetry."""
+        a = _arrays(t, q, rho, tau, w)
+        return cls(
+            _inertia.samples_from_arrays(
+                *a,
+                kwargs=dict(
+                    scalar_first=scalar_first,
+                    jpl=jpl,
+                    unit_tolerance=unit_tolerance,
+                    period_tolerance=period_tolerance,
+                ),
+            )
+        )
+
+    t = property(lambda self: self._native.t, doc="Time, s (N,).")
+    q = property(lambda self: self._native.q, doc="Quaternions [x, y, z, w] (N, 4).")
+    rho = property(lambda self: self._native.rho, doc="Rotor momentum, N m s (N, 3).")
+    tau = property(lambda self: self._native.tau, doc="Known torque, N m (N, 3).")
+    w = property(lambda self: self._native.w, doc="Gyro rates, rad/s (N, 3), or None.")
+    file = property(lambda self: self._native.file, doc="The file's name, or None.")
+    lines = property(lambda self: self._native.lines, doc="Each sample's line, or None.")
+    stats = property(lambda self: self._native.stats, doc="What the reader counted.")
+
+    def __len__(self) -> int:
+        return len(self._native)
+
+    def __repr__(self) -> str:
+        src = f" from {self.file!r}" if self.file else ""
+        gyro = "with" if self.w is not None else "without"
+        return f"<inertia.Telemetry: {len(self)} samples{src}, {gyro} gyro rates>"
+
+    def to_dataframe(self):
+        """A pandas DataFrame with the CSV column names (``w_*`` only with rates)."""
+        pd = _pandas("Telemetry.to_dataframe")
+        cols: Dict[str, np.ndarray] = {"t": self.t}
+        for name, block in (("q", self.q), ("rho", self.rho), ("tau", self.tau), ("w", self.w)):
+            if block is None:
+                continue
+            axes = "xyzw" if name == "q" else "xyz"
+            for k, a in enumerate(axes):
+                cols[f"{name}_{a}"] = block[:, k]
+        return pd.DataFrame(cols)
+
+    def __reduce__(self):
+        st = self.stats
+        state = (st["rows"], st["renormalised"], st["sign_flips"], st["min_step_s"], st["max_step_s"])
+        lines = None if self.lines is None else [int(x) for x in self.lines]
+        return (
+            _restore_telemetry,
+            (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state,
+             self._native.q_columns, self._native.label),
+        )
+
+
+def _restore_telemetry(*state) -> Telemetry:
+    return Telemetry(_inertia.restore(*state))
+
+
+def read_csv(
+    path: Union[str, "os.PathLike[str]"],
+    *,
+    scalar_first: bool = False,
+    jpl: bool = False,
+    columns: Optional[Mapping[str, str]] = None,
+    unit_tolerance: Optional[float] = None,
+    period_tolerance: Optional[float] = None,
+) -> Telemetry:
+    """Read a telemetry CSV file as ``inertia estimate`` reads it.
+
+    Columns (matched by name, extra ones ignored): ``t`` (s, or ISO-8601 UTC time
+    stamps), ``q_x,q_y,q_z,q_w``, ``rho_x,rho_y,rho_z`` (N m s), optional
+    ``tau_x,tau_y,tau_z`` (N m) and ``w_x,w_y,w_z`` (rad/s).
+
+    Args:
+        path: the file.
+        scalar_first: the quaternion columns hold ``[w, x, y, z]`` (``--scalar-first``).
+        jpl: JPL/Shuster quaternions, inertial → body (``--jpl``).
+        columns: renamed columns, ``{"t": "time", "rho_x": "hw_x"}`` (``--column``).
+        unit_tolerance: largest ``| |q| − 1 |`` renormalised (default 1e-3).
+        period_tolerance: strict mode: a step differing from the first by more than
+            this (relative) is an error.
+
+    Raises:
+        DataError: the CLI's message, ``FILE:LINE: column …``; ``.line`` is the line.
+        OSError: the file cannot be read.
+    """
+    return Telemetry(
+        _inertia.read_csv(
+            os.fspath(path),
+            kwargs=dict(
+                scalar_first=scalar_first,
+                jpl=jpl,
+                columns=None if columns is None else dict(columns),
+                unit_tolerance=unit_tolerance,
+                period_tolerance=period_tolerance,
+            ),
+        )
+    )
+
+
+# ------------------------------------------------------------------------ estimation
+
+
+def _float_array(name: str, x: Any, shape: str) -> np.ndarray:
+    try:
+        a = np.asarray(x)
+    except Exception as e:  # noqa: BLE001 - anything numpy cannot take
+        raise TypeError(f"{name}: expected an array of numbers {shape}, got {type(x).__name__}") from e
+    if a.dtype.kind not in "iuf":
+        raise TypeError(
+            f"{name}: expected an array of numbers {shape}, got an array of dtype {a.dtype}"
+        )
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _arrays(t, q, rho, tau, w):
+    return (
+        _float_array("t", t, "(N,)"),
+        _float_array("q", q, "(N, 4)"),
+        _float_array("rho", rho, "(N, 3)"),
+        None if tau is None else _float_array("tau", tau, "(N, 3)"),
+        None if w is None else _float_array("w", w, "(N, 3)"),
+    )
+
+
+def _is_frame(x: Any) -> bool:
+    return hasattr(x, "columns") and hasattr(x, "iloc")
+
+
+def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
+    names = list(CSV_COLUMNS)
+    for k, v in (columns or {}).items():
+        if k not in CSV_COLUMNS:
+            raise ValueError(
+                f"columns: unknown column {k!r} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
+            )
+        names[CSV_COLUMNS.index(k)] = v
+    present = [str(c) for c in df.columns]
+    if len(set(present)) != len(present):
+        dup = next(c for c in present if present.count(c) > 1)
+        raise DataError(f"<DataFrame>: column `{dup}` appears twice")
+
+    def need(n: str) -> np.ndarray:
+        if n not in present:
+            raise DataError(f"<DataFrame>: missing column `{n}` (columns present: {','.join(present)})")
+        return df[n].to_numpy()
+
+    def optional(block: List[str]) -> Optional[np.ndarray]:
+        if not any(n in present for n in block):
+            return None
+        return np.column_stack([_float_array(n, need(n), "(N,)") for n in block])
+
+    need(names[0])
+    t = df[names[0]]
+    if str(t.dtype).startswith("datetime64"):
+        # Elapsed seconds since the first row (pandas' datetimes have no leap seconds).
+        t = (t - t.iloc[0]).dt.total_seconds()
+    t = _float_array(names[0], t.to_numpy(), "(N,)")
+    q = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[1:5]])
+    rho = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[5:8]])
+    return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
+
+
+#: The estimation settings, as :func:`estimate` and :class:`Estimator` name them (the
+#: command line's options).
+_SETTINGS = (
+    "estimator", "constraints", "bounds", "nominal", "tolerance", "gyro_noise", "memory",
+    "resample", "every", "rotation_source", "rho_model", "torque_bias", "chain", "glitches",
+    "solver", "uncertainty",
+)
+#: How the data are read.
+_CONVENTIONS = ("scalar_first", "jpl", "unit_tolerance", "period_tolerance")
+
+
+def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
+    """The named arguments, with matrices as nested lists for the native side."""
+    kw = {k: arguments[k] for k in names}
+    for key in ("nominal", "truth"):
+        if kw.get(key) is not None:
+            kw[key] = _float_array(key, kw[key], "(3, 3)").tolist()
+    return kw
+
+
+def estimate(
+    t: Any,
+    q: Any = None,
+    rho: Any = None,
+    *,
+    tau: Any = None,
+    w: Any = None,
+    estimator: str = DEFAULT_ESTIMATOR,
+    constraints: str = "physical",
+    bounds: Union[None, str, Sequence[str], Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
+    nominal: Any = None,
+    tolerance: Union[None, float, str] = None,
+    gyro_noise: Optional[float] = None,
+    memory: Optional[float] = None,
+    resample: Optional[float] = None,
+    every: int = 1,
+    rotation_source: Optional[str] = None,
+    rho_model: str = "auto",
+    torque_bias: bool = True,
+    chain: float = 30.0,
+    glitches: str = "stop",
+    solver: str = "native",
+    uncertainty: bool = True,
+    batch: bool = False,
+    history: bool = False,
+    truth: Any = None,
+    scalar_first: bool = False,
+    jpl: bool = False,
+    columns: Optional[Mapping[str, str]] = None,
+    unit_tolerance: Optional[float] = None,
+    period_tolerance: Optional[float] = None,
+) -> Estimate:
+    """Estimate the inertia tensor, as ``inertia estimate`` does.
+
+    The data are one of:
+
+    * arrays ``t`` (N,) s, ``q`` (N, 4), ``rho`` (N, 3) N m s, and optionally
+      ``tau=`` (N, 3) N m (known external torque) and ``w=`` (N, 3) rad/s (gyro rate
+      averaged over [t_k, t_{k+1}]);
+    * a pandas DataFrame with the CSV column names (``t``, ``q_x`` …, renamed by
+      ``columns=``), as the only positional argument;
+    * a :class:`Telemetry` (from :func:`read_csv` or :func:`simulate`);
+    * a path: the file is read with :func:`read_csv` first. Unlike the CLI, which
+      streams, the whole file is read before the estimator runs (about 0.1 kB of
+      memory per sample), so when a file holds both a bad row and, earlier, a step the
+      estimator stops on, the bad row is reported.
+
+    Settings (the command line's options, same names and defaults):
+        estimator: ``"discrete-momentum"`` (default), ``"variational"`` (the paper's),
+            ``"finite-difference"``, ``"momentum"`` (:func:`estimators`).
+        constraints: ``"physical"`` (J ⪰ εI and Σ = ½tr(J)I − J ⪰ 0), ``"paper"``,
+            ``"positive-definite"``.
+        bounds: element bounds, kg m²: ``{"J33": (2.7, 3.3), "J12": (None, 0.05)}`` or
+            ``["J33=2.7:3.3"]`` (``--bound``).
+        nominal, tolerance: a nominal 3×3 J (kg m²) bounding every element within a
+            fraction (``0.1`` or ``"10%"``).
+        gyro_noise: the gyro's rate-noise density, deg/s/√Hz (errors-in-variables
+            compensation).
+        memory: forgetting time constant, s. resample: resampling period, s.
+        every: solve every N samples. rotation_source: ``"attitude"`` or ``"gyro"``
+            (default: chosen from the data). rho_model: ``"auto"``, ``"smooth"``,
+            ``"held"``, ``"plain"``. torque_bias: estimate an unknown constant torque.
+            chain: momentum chain, s (0: chains end only at gaps). glitches: ``"stop"``
+            or ``"keep"``. solver: ``"native"``. uncertainty: compute σ.
+        batch: one batch solve instead of the recursive estimator (``--batch``).
+        history: keep every estimate (``Estimate.history``, the CLI's ``-o``).
+        truth: the true J (3×3, kg m²), for ``Estimate.relative_error``.
+
+    Input conventions (arrays, DataFrame, path): ``scalar_first``, ``jpl``,
+    ``unit_tolerance``, ``period_tolerance``; ``columns`` for a DataFrame or a path.
+
+    The GIL is released while the data are checked and the estimator runs.
+
+    Raises:
+        DataError: bad data, with the CLI's message.
+        ValueError, TypeError: an invalid argument, named.
+    """
+    arguments = locals()
+    settings = _settings(arguments, (*_SETTINGS, "batch", "history", "truth"))
+    conventions = _settings(arguments, _CONVENTIONS)
+    single = q is None and rho is None and tau is None and w is None
+    if isinstance(t, Telemetry) or isinstance(t, (str, os.PathLike)) or _is_frame(t):
+        if not single:
+            raise TypeError(
+                "estimate(data): q, rho, tau and w are given only with arrays (t, q, rho)"
+            )
+    if isinstance(t, (str, os.PathLike)):
+        telemetry = read_csv(t, columns=columns, **conventions)
+        return Estimate._from_native(telemetry._native.estimate(kwargs=settings))
+    if isinstance(t, Telemetry):
+        if columns is not None:
+            raise ValueError("columns: these samples were already read; give it to read_csv")
+        # Conventions belong to reading: the native side names one given here.
+        given = {k: v for k, v in conventions.items() if v not in (None, False)}
+        return Estimate._from_native(t._native.estimate(kwargs={**settings, **given}))
+    if columns is not None and not _is_frame(t):
+        raise ValueError("columns: applies to a DataFrame or a file")
+    if _is_frame(t):
+        names, arrays = _frame_arrays(t, columns)
+        return Estimate._from_native(
+            _inertia.estimate_arrays(
+                *arrays, kwargs={**settings, **conventions}, frame_columns=names, label="<DataFrame>"
+            )
+        )
+    if q is None or rho is None:
+        raise TypeError("estimate(t, q, rho): q and rho are required with an array t")
+    return Estimate._from_native(
+        _inertia.estimate_arrays(*_arrays(t, q, rho, tau, w), kwargs={**settings, **conventions})
+    )
+
+
+# ------------------------------------------------------------------------- streaming
+
+
+def _vector(name: str, x: Any, n: int) -> Optional[List[float]]:
+    if x is None:
+        return None
+    a = _float_array(name, x, f"({n},)")
+    if a.shape != (n,):
+        raise ValueError(f"{name}: expected {n} numbers, got shape {a.shape}")
+    return a.tolist()
+
+
+class Estimator:
+    """A streaming estimator: push samples one at a time (or in blocks).
+
+    Takes the settings of :func:`estimate` (not ``batch``, ``history``, ``truth``) and
+    the input conventions (``scalar_first``, ``jpl``, ``unit_tolerance``,
+    ``period_tolerance``). Each sample is checked as a file's row is. Pushing the
+    samples of a file one by one gives the same estimate as :func:`estimate` on it.
+    The GIL is released while a sample is processed.
+    """
+
+    def __init__(
+        self,
+        *,
+        estimator: str = DEFAULT_ESTIMATOR,
+        constraints: str = "physical",
+        bounds: Any = None,
+        nominal: Any = None,
+        tolerance: Union[None, float, str] = None,
+        gyro_noise: Optional[float] = None,
+        memory: Optional[float] = None,
+        resample: Optional[float] = None,
+        every: int = 1,
+        rotation_source: Optional[str] = None,
+        rho_model: str = "auto",
+        torque_bias: bool = True,
+        chain: float = 30.0,
+        glitches: str = "stop",
+        solver: str = "native",
+        uncertainty: bool = True,
+        scalar_first: bool = False,
+        jpl: bool = False,
+        unit_tolerance: Optional[float] = None,
+        period_tolerance: Optional[float] = None,
+    ) -> None:
+        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_SETTINGS, *_CONVENTIONS)))
+
+    def push(self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
+        """Push one sample: ``t`` s, ``q`` (4,), ``rho`` (3,) N m s, ``tau`` (3,) N m,
+        ``w`` (3,) rad/s. Returns the estimate it produced, or ``None``."""
+        try:
+            t = float(t)
+        except (TypeError, ValueError) as e:
+            raise TypeError(f"t: expected a number (s), got {type(t).__name__}") from e
+        produced = self._native.push(
+            t, _vector("q", q, 4), _vector("rho", rho, 3), _vector("tau", tau, 3), _vector("w", w, 3)
+        )
+        return self.estimate if produced else None
+
+    def push_many(self, t: Any, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
+        """Push a block of samples (arrays as for :func:`estimate`). Returns the newest
+        estimate after the block, or ``None`` when the block produced none."""
+        n = self._native.push_many(*_arrays(t, q, rho, tau, w))
+        return self.estimate if n else None
+
+    @property
+    def estimate(self) -> Optional[Estimate]:
+        """The newest estimate, or ``None`` before one."""
+        r = self._native.report()
+        return None if r is None else Estimate._from_native((r[0], r[1], None))
+
+    @property
+    def samples(self) -> int:
+        """Samples accepted so far."""
+        return self._native.samples
+
+
+# ------------------------------------------------------------------------ simulation
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Simulation:
+    """Simulated telemetry and the truth. Unpacks as ``telemetry, inertia``.
+
+    Attributes:
+        telemetry: the telemetry, as :func:`read_csv` would read the file that
+            ``inertia simulate`` writes with the same settings.
+        inertia: the true J at the end of the run, kg m² (3×3; the CLI's truth file).
+        inertia_initial: the true J at the start, kg m².
+        scenario: the scenario's or preset's name.
+        positions: the inertial orbit position at each sample, m (N, 3), with gravity
+            gradient (the CLI's ``r_x,r_y,r_z`` columns), else ``None``.
+    """
+
+    telemetry: Telemetry
+    inertia: np.ndarray
+    inertia_initial: np.ndarray
+    scenario: str
+    positions: Optional[np.ndarray] = None
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter((self.telemetry, self.inertia))
+
+
+def simulate(scenario: Optional[str] = None, **options: Any) -> Simulation:
+    """Simulate telemetry as ``inertia simulate`` does.
+
+    ``scenario`` is ``"slew"`` (300 s of rest-to-rest slews on reaction wheels) or
+    ``"spin"`` (180 s major-axis spin with one wheel pulse), or give
+    ``preset="small-sat"`` or ``"microsat"``. Every option of ``inertia simulate`` is a
+    keyword argument with ``-`` written ``_`` and ``X:Y:Z`` values as three numbers:
+    ``duration`` (s), ``dt`` (s, default 0.1), ``telemetry_dt`` (s), ``seed`` (default 1),
+    ``gyro_noise`` (deg/s/√Hz) or ``gyro_arw_deg_rthr`` (deg/√h), ``gyro_bias_deg_h``,
+    ``gyro_bias_instability_deg_h``, ``gyro_bias_correlation_s``, ``disturbance``
+    (N m/√Hz), ``attitude`` (``"truth"``, ``"gyro"``, ``"star-tracker"``, ``"mekf"``),
+    ``star_tracker_arcsec``, ``star_tracker_boresight``, ``star_tracker_hz``,
+    ``mekf_raw_rates``, ``controller_hz``, ``command_phase`` (s),
+    ``wheel_quantization_nms``, ``wheel_noise_nms``, ``wheel_skew_s``,
+    ``wheel_scale_error``, ``wheel_misalignment_deg`` (deg),
+    ``gravity_gradient_altitude_km``, ``orbit_inclination_deg``,
+    ``constant_torque_nm`` (N m), ``inertia_step`` ``(T, SCALE)``, ``inertia_ramp``
+    ``(T0, T1, SCALE)``.
+
+    The same settings and seed give the same samples as the CLI's file, bit for bit.
+    """
+    kwargs = dict(options)
+    if scenario is not None:
+        kwargs["scenario"] = scenario
+    tel, end, start, name, positions = _inertia.simulate(kwargs=kwargs)
+    return Simulation(Telemetry(tel), end, start, name, positions)

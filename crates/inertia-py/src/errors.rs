@@ -1,0 +1,59 @@
+//! Python exceptions. Messages are the command line's, word for word: a data error
+//! names the file, line and column (`f.csv:9: columns `q_x,q_y,q_z,q_w`: …`) or, for
+//! arrays, the argument and row (`q[9]: …`).
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+create_exception!(
+    inertia,
+    DataError,
+    PyValueError,
+    "Bad input data: the message names the file, line and column (or the argument and \
+     row) as `inertia estimate` does, and `.line` holds the 1-based line of a file when \
+     there is one (else None)."
+);
+
+pub fn value_error(m: impl Into<String>) -> PyErr {
+    PyValueError::new_err(m.into())
+}
+
+pub fn type_error(m: impl Into<String>) -> PyErr {
+    PyTypeError::new_err(m.into())
+}
+
+/// A data error, with the line of the file it names (if any) as `.line`.
+pub fn data_error(py: Python<'_>, message: String, line: Option<u64>) -> PyErr {
+    let e = DataError::new_err(message);
+    // Setting an attribute on a fresh exception object does not fail in practice; if
+    // it did, the message still names the line.
+    let _ = e.value(py).setattr("line", line);
+    e
+}
+
+/// An input that cannot be read (the command line's exit code 3).
+pub fn io_error(m: String) -> PyErr {
+    PyOSError::new_err(m)
+}
+
+/// A failure of a run, before it becomes a Python exception (built without the GIL).
+#[derive(Debug)]
+pub enum Failure {
+    /// Bad data, with the file's line when known.
+    Data(String, Option<u64>),
+    /// A bad argument (`ValueError`).
+    Argument(String),
+    /// An input that cannot be read.
+    Io(String),
+}
+
+impl Failure {
+    pub fn into_py(self, py: Python<'_>) -> PyErr {
+        match self {
+            Failure::Data(m, line) => data_error(py, m, line),
+            Failure::Argument(m) => value_error(m),
+            Failure::Io(m) => io_error(m),
+        }
+    }
+}

@@ -1,0 +1,530 @@
+//! `inertia._inertia`: the native half of the `inertia` Python package.
+//!
+//! A thin layer over the library, in the manner of Clarabel.rs's Python interface: every
+//! computation is the library's (the CSV reader, `pipeline::Pipeline`/`pipeline::batch`,
+//! `pipeline::report::Report`, `sim`), called as the command line calls it, so results
+//! and messages are the command line's. This module converts arguments and arrays,
+//! releases the GIL around reading, simulating and estimating, and returns the report as
+//! its JSON text (the `--json` schema), which the Python half turns into an `Estimate`.
+
+mod errors;
+mod run;
+mod samples;
+mod settings;
+mod sim;
+mod stream;
+
+use errors::{type_error, value_error, DataError, Failure};
+use inertia::estimator::Estimate;
+use inertia::pipeline::history::HEADER;
+use inertia::pipeline::report::Report;
+use inertia::sample::Sample;
+use inertia::telemetry::csv::{ColumnNames, CsvOptions, TelemetryError, TelemetryReader};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use run::Origin;
+use samples::{Checker, Naming, Row, Stats};
+use settings::{Convention, Kwargs};
+
+/// Telemetry held in memory: what `read_csv` read or `simulate` made, checked and in
+/// this library's convention (Hamilton, body → inertial, scalar last).
+#[pyclass(module = "inertia._inertia", frozen)]
+pub struct Telemetry {
+    pub samples: Vec<Sample>,
+    /// Each sample's line in its file.
+    pub lines: Option<Vec<u64>>,
+    /// The file's name as given.
+    pub file: Option<String>,
+    pub stats: Stats,
+    pub q_columns: String,
+    /// The name in reports and messages: the file's, `<arrays>` or `<simulated>`.
+    pub label: String,
+}
+
+fn column<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    Array1::from_vec(v).into_pyarray(py)
+}
+
+pub fn matrix<'py, const N: usize>(
+    py: Python<'py>,
+    rows: impl ExactSizeIterator<Item = [f64; N]>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = rows.len();
+    let flat: Vec<f64> = rows.flatten().collect();
+    Array2::from_shape_vec((n, N), flat)
+        .map(|a| a.into_pyarray(py))
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
+}
+
+/// A 3×3 matrix as a numpy array.
+pub fn matrix3<'py>(
+    py: Python<'py>,
+    m: &nalgebra::Matrix3<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    matrix(py, (0..3).map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]]))
+}
+
+#[pymethods]
+impl Telemetry {
+    /// Time, s (N,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        column(py, self.samples.iter().map(|s| s.t_s).collect())
+    }
+    /// Attitude quaternions (N, 4): [x, y, z, w], Hamilton, body → inertial, unit norm.
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, self.samples.iter().map(|s| s.q.to_xyzw()))
+    }
+    /// Total rotor angular momentum, N m s, body axes (N, 3).
+    #[getter]
+    fn rho<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, self.samples.iter().map(|s| s.rho_nms.into()))
+    }
+    /// Known external torque, N m, body axes (N, 3) (zeros when none was given).
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        matrix(py, self.samples.iter().map(|s| s.tau_nm.into()))
+    }
+    /// Gyro rate averaged over [t_k, t_{k+1}], rad/s, body axes (N, 3), or None.
+    #[getter]
+    fn w<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let rates: Option<Vec<[f64; 3]>> = self
+            .samples
+            .iter()
+            .map(|s| s.omega_rad_s.map(Into::into))
+            .collect();
+        rates
+            .filter(|r| !r.is_empty())
+            .map(|r| matrix(py, r.into_iter()))
+            .transpose()
+    }
+    /// The file's name, or None.
+    #[getter]
+    fn file(&self) -> Option<String> {
+        self.file.clone()
+    }
+    /// Each sample's 1-based line in its file, or None.
+    #[getter]
+    fn lines<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<u64>>> {
+        self.lines
+            .clone()
+            .map(|l| Array1::from_vec(l).into_pyarray(py))
+    }
+    /// What the reader counted: rows, renormalised quaternions, sign flips, the shortest
+    /// and longest step (s).
+    #[getter]
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("rows", self.stats.rows)?;
+        d.set_item("renormalised", self.stats.renormalised)?;
+        d.set_item("sign_flips", self.stats.sign_flips)?;
+        d.set_item("min_step_s", self.stats.min_step_s)?;
+        d.set_item("max_step_s", self.stats.max_step_s)?;
+        Ok(d)
+    }
+    fn __len__(&self) -> usize {
+        self.samples.len()
+    }
+    /// The quaternion columns' names (for messages).
+    #[getter]
+    fn q_columns(&self) -> String {
+        self.q_columns.clone()
+    }
+    /// The name in reports: the file's, `<arrays>` or `<simulated>`.
+    #[getter]
+    fn label(&self) -> String {
+        self.label.clone()
+    }
+
+    /// Estimate from these samples (see `inertia.estimate`).
+    #[pyo3(signature = (kwargs=None))]
+    fn estimate<'py>(
+        &self,
+        py: Python<'py>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let kw = Kwargs::new(kwargs, py, "estimate")?;
+        for name in [
+            "scalar_first",
+            "jpl",
+            "unit_tolerance",
+            "period_tolerance",
+            "columns",
+        ] {
+            if kw.take(name)?.is_some() {
+                return Err(value_error(format!(
+                    "{name}: these samples were already read and checked; give it to read_csv"
+                )));
+            }
+        }
+        let s = settings::run(&kw)?;
+        kw.finish()?;
+        let config = s.pipeline.validate().map_err(settings::settings_error)?;
+        let origin = match (&self.file, &self.lines) {
+            (Some(name), Some(lines)) => Origin::File {
+                name: name.clone(),
+                lines: lines.clone(),
+                q_columns: self.q_columns.clone(),
+            },
+            _ => Origin::Memory {
+                naming: Naming::Arrays,
+                label: self.label.clone(),
+            },
+        };
+        let out = py
+            .allow_threads(|| run::run(&self.samples, &self.stats, &origin, config, &s))
+            .map_err(|f| f.into_py(py))?;
+        result(py, &out.report, out.history.as_deref())
+    }
+}
+
+/// `(report JSON, report text, history columns or None)`.
+fn result<'py>(
+    py: Python<'py>,
+    report: &Report,
+    history: Option<&[Estimate]>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let json = serde_json::to_string(report)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let text = report.to_string();
+    let h = history.map(|h| history_columns(py, h)).transpose()?;
+    Ok((json, text, h).into_pyobject(py)?.into_any())
+}
+
+/// The history as columns (`inertia::pipeline::history::HEADER`): floats (NaN where
+/// not available), `status` and `reason` as lists of strings (`reason` None where none).
+fn history_columns<'py>(py: Python<'py>, h: &[Estimate]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let nan = f64::NAN;
+    d.set_item(HEADER[0], column(py, h.iter().map(|e| e.t_s).collect()))?;
+    for k in 0..6 {
+        d.set_item(
+            HEADER[1 + k],
+            column(py, h.iter().map(|e| e.j().map_or(nan, |j| j[k])).collect()),
+        )?;
+        d.set_item(
+            HEADER[10 + k],
+            column(
+                py,
+                h.iter()
+                    .map(|e| e.sigma_kg_m2().map_or(nan, |s| s[k]))
+                    .collect(),
+            ),
+        )?;
+    }
+    d.set_item(
+        "status",
+        PyList::new(py, h.iter().map(|e| e.observability.code()))?,
+    )?;
+    d.set_item(
+        "condition",
+        column(
+            py,
+            h.iter()
+                .map(|e| e.observability.condition().unwrap_or(nan))
+                .collect(),
+        ),
+    )?;
+    d.set_item(
+        "iterations",
+        column(
+            py,
+            h.iter()
+                .map(|e| e.solution.map_or(nan, |s| f64::from(s.iterations)))
+                .collect(),
+        ),
+    )?;
+    d.set_item(
+        "reason",
+        PyList::new(
+            py,
+            h.iter()
+                .map(|e| e.observability.reason().map(|r| r.to_string())),
+        )?,
+    )?;
+    Ok(d)
+}
+
+/// Read a telemetry CSV file as `inertia estimate` reads it.
+#[pyfunction]
+#[pyo3(signature = (path, kwargs=None))]
+fn read_csv(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Telemetry> {
+    let kw = Kwargs::new(kwargs, py, "read_csv")?;
+    let conv = settings::convention(&kw)?;
+    let mut columns = ColumnNames::default();
+    if let Some(c) = kw.take("columns")? {
+        let map: std::collections::BTreeMap<String, String> = c.extract().map_err(|_| {
+            type_error(
+                "columns: expected a dict {default name: name in the file}, e.g. {\"t\": \"time\"}",
+            )
+        })?;
+        for (k, v) in map {
+            if !columns.rename(k.trim(), v.trim()) {
+                return Err(value_error(format!(
+                    "columns: unknown column {k:?} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
+                )));
+            }
+        }
+    }
+    kw.finish()?;
+    let options = CsvOptions {
+        quaternion: conv.format,
+        columns,
+        unit_tolerance: conv.unit_tolerance,
+        period_tolerance: conv.period_tolerance,
+        delimiter: b',',
+    };
+    py.allow_threads(|| read(&path, options))
+        .map_err(|f| f.into_py(py))
+}
+
+fn telemetry_failure(e: TelemetryError) -> Failure {
+    match e {
+        TelemetryError::Io { .. } => Failure::Io(e.to_string()),
+        other => {
+            let line = other.line();
+            Failure::Data(other.to_string(), line)
+        }
+    }
+}
+
+fn read(path: &std::path::Path, options: CsvOptions) -> Result<Telemetry, Failure> {
+    let f = std::fs::File::open(path)
+        .map_err(|e| Failure::Io(format!("cannot read {}: {e}", path.display())))?;
+    let name = path.display().to_string();
+    let mut reader = TelemetryReader::new(f, &name, options).map_err(telemetry_failure)?;
+    let (mut samples, mut lines) = (Vec::new(), Vec::new());
+    while let Some(item) = reader.next() {
+        samples.push(item.map_err(telemetry_failure)?);
+        lines.push(reader.last_line());
+    }
+    let st = reader.stats();
+    Ok(Telemetry {
+        samples,
+        lines: Some(lines),
+        file: Some(reader.file().to_string()),
+        stats: Stats {
+            rows: st.rows,
+            renormalised: st.renormalised,
+            sign_flips: st.sign_flips,
+            min_step_s: st.min_step_s,
+            max_step_s: st.max_step_s,
+        },
+        q_columns: reader.quaternion_columns(),
+        label: reader.file().to_string(),
+    })
+}
+
+/// Rows of float64 arrays, checked for shape against `t`.
+pub fn rows(
+    t: &PyReadonlyArrayDyn<'_, f64>,
+    q: &PyReadonlyArrayDyn<'_, f64>,
+    rho: &PyReadonlyArrayDyn<'_, f64>,
+    tau: Option<&PyReadonlyArrayDyn<'_, f64>>,
+    w: Option<&PyReadonlyArrayDyn<'_, f64>>,
+) -> PyResult<Vec<Row>> {
+    let t = t.as_array();
+    if t.ndim() != 1 {
+        return Err(value_error(format!(
+            "t: expected a 1-D array of times (N,), got shape {:?}",
+            t.shape()
+        )));
+    }
+    let n = t.len();
+    let check =
+        |name: &str, a: &numpy::ndarray::ArrayViewD<'_, f64>, cols: usize| -> PyResult<()> {
+            if a.shape() != [n, cols] {
+                return Err(value_error(format!(
+                    "{name}: expected shape (N, {cols}) = ({n}, {cols}) to match t, got {:?}",
+                    a.shape()
+                )));
+            }
+            Ok(())
+        };
+    let q = q.as_array();
+    let rho = rho.as_array();
+    check("q", &q, 4)?;
+    check("rho", &rho, 3)?;
+    let tau = tau.map(|a| a.as_array());
+    let w = w.map(|a| a.as_array());
+    if let Some(a) = &tau {
+        check("tau", a, 3)?;
+    }
+    if let Some(a) = &w {
+        check("w", a, 3)?;
+    }
+    let three =
+        |a: &numpy::ndarray::ArrayViewD<'_, f64>, i: usize| [a[[i, 0]], a[[i, 1]], a[[i, 2]]];
+    Ok((0..n)
+        .map(|i| Row {
+            t: t[[i]],
+            q: [q[[i, 0]], q[[i, 1]], q[[i, 2]], q[[i, 3]]],
+            rho: three(&rho, i),
+            tau: tau.as_ref().map(|a| three(a, i)),
+            w: w.as_ref().map(|a| three(a, i)),
+        })
+        .collect())
+}
+
+/// Check rows into samples (no GIL needed).
+fn check_rows(
+    rows: &[Row],
+    conv: &Convention,
+    naming: &Naming,
+) -> Result<(Vec<Sample>, Stats), Failure> {
+    let mut checker = Checker::default();
+    let samples = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| checker.sample(r, i, conv, naming))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|m| Failure::Data(m, None))?;
+    Ok((samples, checker.stats))
+}
+
+/// Estimate from arrays (or a table's columns, named by `frame_columns`).
+#[pyfunction]
+#[pyo3(signature = (t, q, rho, tau=None, w=None, kwargs=None, frame_columns=None, label=None))]
+#[allow(clippy::too_many_arguments)]
+fn estimate_arrays<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArrayDyn<'py, f64>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    rho: PyReadonlyArrayDyn<'py, f64>,
+    tau: Option<PyReadonlyArrayDyn<'py, f64>>,
+    w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+    frame_columns: Option<Vec<String>>,
+    label: Option<String>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kw = Kwargs::new(kwargs, py, "estimate")?;
+    let conv = settings::convention(&kw)?;
+    let s = settings::run(&kw)?;
+    kw.finish()?;
+    let config = s.pipeline.validate().map_err(settings::settings_error)?;
+    let rows = rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
+    let naming = match frame_columns {
+        Some(c) if c.len() == 14 => Naming::Frame(c),
+        Some(_) => return Err(value_error("frame_columns: expected 14 names")),
+        None => Naming::Arrays,
+    };
+    let origin = Origin::Memory {
+        naming: naming.clone(),
+        label: label.unwrap_or_else(|| "<arrays>".into()),
+    };
+    let out = py
+        .allow_threads(|| {
+            let (samples, stats) = check_rows(&rows, &conv, &naming)?;
+            run::run(&samples, &stats, &origin, config, &s)
+        })
+        .map_err(|f| f.into_py(py))?;
+    result(py, &out.report, out.history.as_deref())
+}
+
+/// Telemetry from arrays, checked (quaternion convention applied, renormalised).
+#[pyfunction]
+#[pyo3(signature = (t, q, rho, tau=None, w=None, kwargs=None))]
+fn samples_from_arrays<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArrayDyn<'py, f64>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    rho: PyReadonlyArrayDyn<'py, f64>,
+    tau: Option<PyReadonlyArrayDyn<'py, f64>>,
+    w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Telemetry> {
+    let kw = Kwargs::new(kwargs, py, "Telemetry")?;
+    let conv = settings::convention(&kw)?;
+    kw.finish()?;
+    let rows = rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
+    let (samples, stats) = py
+        .allow_threads(|| check_rows(&rows, &conv, &Naming::Arrays))
+        .map_err(|f| f.into_py(py))?;
+    Ok(Telemetry {
+        samples,
+        lines: None,
+        file: None,
+        stats,
+        q_columns: "q".into(),
+        label: "<arrays>".into(),
+    })
+}
+
+/// Telemetry rebuilt from what a `Telemetry` held (unpickling): the values were
+/// checked when it was made, so they are taken as they are, bit for bit.
+#[pyfunction]
+#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label))]
+#[allow(clippy::too_many_arguments)]
+fn restore<'py>(
+    t: PyReadonlyArrayDyn<'py, f64>,
+    q: PyReadonlyArrayDyn<'py, f64>,
+    rho: PyReadonlyArrayDyn<'py, f64>,
+    tau: PyReadonlyArrayDyn<'py, f64>,
+    w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    file: Option<String>,
+    lines: Option<Vec<u64>>,
+    stats: (usize, usize, usize, f64, f64),
+    q_columns: String,
+    label: String,
+) -> PyResult<Telemetry> {
+    let rows = rows(&t, &q, &rho, Some(&tau), w.as_ref())?;
+    if lines.as_ref().is_some_and(|l| l.len() != rows.len()) {
+        return Err(value_error("lines: one per sample"));
+    }
+    let samples = rows
+        .iter()
+        .map(|r| Sample {
+            t_s: r.t,
+            q: inertia::attitude::Quaternion::from_xyzw(r.q),
+            rho_nms: r.rho.into(),
+            tau_nm: r.tau.unwrap_or_default().into(),
+            omega_rad_s: r.w.map(Into::into),
+        })
+        .collect();
+    let (rows_read, renormalised, sign_flips, min_step_s, max_step_s) = stats;
+    Ok(Telemetry {
+        samples,
+        lines,
+        file,
+        stats: Stats {
+            rows: rows_read,
+            renormalised,
+            sign_flips,
+            min_step_s,
+            max_step_s,
+        },
+        q_columns,
+        label,
+    })
+}
+
+/// The registered estimators: `(name, summary)`.
+#[pyfunction]
+fn estimators() -> Vec<(&'static str, &'static str)> {
+    inertia::pipeline::registry::ESTIMATORS
+        .iter()
+        .map(|e| (e.name, e.summary))
+        .collect()
+}
+
+#[pymodule]
+fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("DataError", m.py().get_type::<DataError>())?;
+    m.add("DEFAULT_ESTIMATOR", settings::DEFAULT_ESTIMATOR)?;
+    m.add_class::<Telemetry>()?;
+    m.add_class::<stream::Stream>()?;
+    m.add_function(wrap_pyfunction!(read_csv, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(samples_from_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(estimators, m)?)?;
+    m.add_function(wrap_pyfunction!(restore, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,240 @@
+"""The package's own behaviour: recovery of the true J, streaming against one-shot and
+batch runs, DataFrames, pickling, the GIL, optional pandas."""
+
+import pickle
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import inertia
+
+
+@pytest.fixture(scope="module")
+def slew():
+    return inertia.simulate("slew", seed=3)
+
+
+def rel(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+@pytest.mark.parametrize(
+    "scenario, kwargs, limit",
+    [
+        ("slew", {}, 1e-4),
+        ("spin", dict(bounds={"J33": (2.7, 3.3)}), 1e-4),
+        ("slew", dict(estimator="variational"), 1e-3),
+        ("spin", dict(estimator="variational", bounds=["J33=2.7:3.3"], constraints="paper"), 1e-3),
+    ],
+)
+def test_recovers_the_true_inertia(scenario, kwargs, limit):
+    sim = inertia.simulate(scenario, seed=7)
+    tel, truth = sim
+    e = inertia.estimate(tel, truth=truth, **kwargs)
+    assert e.inertia.shape == (3, 3) and e.sigma.shape == (6,)
+    assert rel(e.inertia, truth) < limit
+    assert e.relative_error == pytest.approx(rel(e.inertia, truth), rel=1e-9)
+    # Principal moments and axes reconstruct J.
+    A, m = e.principal_axes, e.principal_moments
+    assert np.all(np.diff(m) >= 0)
+    assert np.allclose(A @ np.diag(m) @ A.T, e.inertia, atol=1e-9)
+    assert np.allclose(A.T @ A, np.eye(3), atol=1e-9)
+
+
+def test_inertia_change_in_simulation():
+    sim = inertia.simulate("slew", duration=400, inertia_step=(300, 1.1), seed=2)
+    np.testing.assert_allclose(sim.inertia, 1.1 * sim.inertia_initial, rtol=1e-15)
+    before = inertia.estimate(sim.telemetry.t[:2900], sim.telemetry.q[:2900], sim.telemetry.rho[:2900],
+                              tau=sim.telemetry.tau[:2900], w=sim.telemetry.w[:2900])
+    assert rel(before.inertia, sim.inertia_initial) < 1e-3
+
+
+def test_streaming_equals_one_shot(slew):
+    tel, _ = slew
+    one_shot = inertia.estimate(tel)
+    s = inertia.Estimator()
+    assert s.estimate is None
+    produced = []
+    for k in range(200):
+        e = s.push(tel.t[k], tel.q[k], tel.rho[k], tel.tau[k], tel.w[k])
+        if e is not None:
+            produced.append(e.t)
+    assert produced and produced[-1] == pytest.approx(tel.t[199])
+    last = s.push_many(tel.t[200:], tel.q[200:], tel.rho[200:], tau=tel.tau[200:], w=tel.w[200:])
+    assert s.samples == len(tel)
+    assert last.t == one_shot.t
+    np.testing.assert_allclose(last.inertia, one_shot.inertia, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(last.sigma, one_shot.sigma, rtol=0, atol=1e-12)
+    assert last.status == one_shot.status
+
+
+def test_streaming_agrees_with_batch(slew):
+    tel, truth = slew
+    stream = inertia.Estimator(estimator="variational")
+    stream.push_many(tel.t, tel.q, tel.rho, tel.tau, tel.w)
+    batch = inertia.estimate(tel, estimator="variational", batch=True)
+    assert batch.report["batch"] and not stream.estimate.report["batch"]
+    # Two solutions of the same least-squares problem, each within 1e-3 of the truth,
+    # closer still to each other.
+    assert rel(batch.inertia, truth) < 1e-3 and rel(stream.estimate.inertia, truth) < 1e-3
+    assert rel(stream.estimate.inertia, batch.inertia) < 1e-4
+
+
+def test_streaming_errors():
+    s = inertia.Estimator()
+    with pytest.raises(ValueError, match=r"^q: expected 4 numbers"):
+        s.push(0.0, [0, 0, 1], [0, 0, 0])
+    s.push(0.0, [0, 0, 0, 1], [0, 0, 0], w=[0, 0, 0])
+    with pytest.raises(inertia.DataError, match=r"^t\[1\]: time 0 s does not increase"):
+        s.push(0.0, [0, 0, 0, 1], [0, 0, 0], w=[0, 0, 0])
+    with pytest.raises(ValueError, match="^w: sample 1: gyro rates missing here but given"):
+        s.push(0.1, [0, 0, 0, 1], [0, 0, 0])
+    assert s.samples == 1  # rejected samples leave the estimator as it was
+    with pytest.raises(ValueError, match="memory=0.01: shorter than the sample period 0.1 s"):
+        m = inertia.Estimator(memory=0.01)
+        m.push(0.0, [0, 0, 0, 1], [0, 0, 0])
+        m.push(0.1, [0, 0, 0, 1], [0, 0, 0])
+
+
+def test_dataframe_input(slew):
+    pd = pytest.importorskip("pandas")
+    tel, _ = slew
+    df = tel.to_dataframe()
+    assert list(df.columns) == list(inertia.CSV_COLUMNS)
+    ref = inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=tel.w)
+    np.testing.assert_array_equal(inertia.estimate(df).inertia, ref.inertia)
+    # Renamed columns, extra columns, datetime time stamps.
+    renamed = df.rename(columns={"t": "time", "rho_x": "hw_x"}).assign(extra=1.0)
+    renamed["time"] = pd.Timestamp("2026-11-21T09:06:00Z") + pd.to_timedelta(renamed["time"], unit="s")
+    got = inertia.estimate(renamed, columns={"t": "time", "rho_x": "hw_x"})
+    np.testing.assert_allclose(got.inertia, ref.inertia, rtol=0, atol=1e-9)
+    with pytest.raises(inertia.DataError, match=r"missing column `rho_y` \(columns present: t,q_x"):
+        inertia.estimate(df.drop(columns=["rho_y"]))
+    with pytest.raises(inertia.DataError, match="missing column `w_z`"):
+        inertia.estimate(df.drop(columns=["w_z"]))
+    bad = df.copy()
+    bad.loc[12, "q_w"] = 2.0
+    with pytest.raises(inertia.DataError, match=r"^row 12: columns `q_x,q_y,q_z,q_w`: quaternion norm"):
+        inertia.estimate(bad)
+    with pytest.raises(TypeError, match="only with arrays"):
+        inertia.estimate(df, tel.q)
+
+
+def test_history_dataframe(slew):
+    tel, _ = slew
+    e = inertia.estimate(tel, history=True, estimator="variational")
+    h = e.history
+    assert list(h.columns) == list(inertia.HISTORY_COLUMNS)
+    assert len(h) > 0.9 * len(tel)
+    last = h.iloc[-1]
+    assert last["t"] == e.t and last["status"] == e.status
+    np.testing.assert_array_equal(last[["J11", "J22", "J33", "J12", "J13", "J23"]].to_numpy(float), e.j)
+    with pytest.raises(ValueError, match="history=True"):
+        inertia.estimate(tel).history
+
+
+def test_without_pandas_only_dataframes_fail(slew, monkeypatch):
+    tel, _ = slew
+    monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas now fails
+    e = inertia.estimate(tel, history=True)  # arrays work without pandas
+    assert e.history_columns["t"].shape[0] > 0
+    with pytest.raises(ImportError, match="needs pandas, which is not installed: pip install pandas"):
+        e.history
+    with pytest.raises(ImportError, match="pip install pandas"):
+        tel.to_dataframe()
+
+
+def test_results_pickle(slew):
+    tel, truth = slew
+    e = inertia.estimate(tel, truth=truth, history=True)
+    back = pickle.loads(pickle.dumps(e))
+    assert type(back) is inertia.Estimate
+    np.testing.assert_array_equal(back.inertia, e.inertia)
+    np.testing.assert_array_equal(back.sigma, e.sigma)
+    assert back.to_dict() == e.to_dict() and back.text == e.text
+    assert back.history.equals(e.history)
+    # Telemetry and simulations pickle too (rebuilt from their arrays).
+    t2 = pickle.loads(pickle.dumps(tel))
+    for a in ("t", "q", "rho", "tau", "w"):
+        np.testing.assert_array_equal(getattr(t2, a), getattr(tel, a))
+    assert t2.stats == tel.stats
+    assert inertia.estimate(t2).to_dict() == inertia.estimate(tel).to_dict()
+    arrays = inertia.Telemetry.from_arrays(tel.t, tel.q, tel.rho, tel.tau, tel.w)
+    assert inertia.estimate(arrays).report["file"] == "<arrays>"
+    np.testing.assert_array_equal(inertia.estimate(t2).inertia, inertia.estimate(tel).inertia)
+    sim = pickle.loads(pickle.dumps(slew))
+    np.testing.assert_array_equal(sim.inertia, truth)
+
+
+def test_to_dict_is_the_json_report(slew):
+    import json
+
+    e = inertia.estimate(slew.telemetry)
+    d = e.to_dict()
+    assert json.loads(json.dumps(d)) == d
+    assert d["schema_version"] == 1 and d["estimator"] == inertia.DEFAULT_ESTIMATOR == "discrete-momentum"
+    assert str(e).startswith("<simulated>: 3001 samples, h = 0.1 s")
+
+
+def test_gil_is_released_during_estimation():
+    """While another thread estimates, this thread keeps running Python code."""
+    tel = inertia.simulate("slew", duration=3000).telemetry
+    t0 = time.perf_counter()
+    inertia.estimate(tel)
+    alone = time.perf_counter() - t0
+    assert alone > 0.1, "too short to tell"
+    done = threading.Event()
+
+    def work():
+        inertia.estimate(tel)
+        done.set()
+
+    th = threading.Thread(target=work)
+    ticks = []
+    th.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    th.join()
+    gaps = np.diff(ticks)
+    # With the GIL held the whole estimate (`alone` seconds) would be one gap.
+    assert len(ticks) > 10 and gaps.max() < alone / 3, (gaps.max(), alone)
+
+
+def test_conventions_on_arrays(slew):
+    tel, _ = slew
+    ref = inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=tel.w)
+    wxyz = tel.q[:, [3, 0, 1, 2]]
+    got = inertia.estimate(tel.t, wxyz, tel.rho, tau=tel.tau, w=tel.w, scalar_first=True)
+    np.testing.assert_array_equal(got.inertia, ref.inertia)
+    got = inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=tel.w, jpl=True)
+    np.testing.assert_array_equal(got.inertia, ref.inertia)
+    # The inertial → body reading (conjugate) is caught against the gyro.
+    conj = tel.q * [-1, -1, -1, 1]
+    with pytest.raises(inertia.DataError, match="look conjugated"):
+        inertia.estimate(tel.t, conj, tel.rho, tau=tel.tau, w=tel.w)
+    # Conventions belong to reading: telemetry already read refuses them.
+    with pytest.raises(ValueError, match="^scalar_first: these samples were already read"):
+        inertia.estimate(tel, scalar_first=True)
+
+
+def test_read_csv_stats_and_lines(tmp_path, slew):
+    tel, _ = slew
+    p = tmp_path / "x.csv"
+    rows = ["t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z"]
+    for k in range(50):
+        q = tel.q[k] * (1 + 5e-4) * (-1 if k % 10 == 5 else 1)
+        rows.append(",".join(repr(float(v)) for v in [tel.t[k], *q, *tel.rho[k]]))
+    p.write_text("\n".join(rows) + "\n")
+    r = inertia.read_csv(p)
+    assert len(r) == 50 and r.w is None and r.file == str(p)
+    assert r.stats["renormalised"] == 50 and r.stats["sign_flips"] == 10
+    assert [int(x) for x in r.lines] == list(range(2, 52))
+    np.testing.assert_allclose(np.linalg.norm(r.q, axis=1), 1.0, atol=1e-15)
+    r2 = pickle.loads(pickle.dumps(r))
+    assert r2.file == r.file and list(r2.lines) == list(r.lines) and r2.stats == r.stats
+    with pytest.raises(OSError, match="cannot read"):
+        inertia.read_csv(tmp_path / "absent.csv")
