@@ -172,33 +172,13 @@ pub fn product_convention(a: Option<ProductsArg>) -> ProductConvention {
     }
 }
 
-/// Parse `Jij=LO:HI` into `(component, lower, upper)`. `LO = HI` is an equality.
+/// Parse `Jij=LO:HI` into `(component, lower, upper)` ([`inertia::constraints::parse_bound`]).
 pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), CliError> {
-    let bad = |why: &str| {
+    inertia::constraints::parse_bound(s).map_err(|why| {
         input(format!(
             "--bound {s:?}: {why} (expected e.g. J33=2.7:3.3, J12=:0.05)"
         ))
-    };
-    let (name, range) = s.split_once('=').ok_or_else(|| bad("missing `=`"))?;
-    let k = Component::from_name(name.trim()).ok_or_else(|| bad("unknown element"))?;
-    let (lo, hi) = range.split_once(':').ok_or_else(|| bad("missing `:`"))?;
-    let num = |t: &str| -> Result<Option<f64>, CliError> {
-        let t = t.trim();
-        if t.is_empty() {
-            return Ok(None);
-        }
-        let v: f64 = t.parse().map_err(|_| bad("not a number"))?;
-        if v.is_finite() {
-            Ok(Some(v))
-        } else {
-            Err(bad("not finite"))
-        }
-    };
-    let (l, h) = (num(lo)?, num(hi)?);
-    if l.is_none() && h.is_none() {
-        return Err(bad("no bound given"));
-    }
-    Ok((k, l, h))
+    })
 }
 
 /// Parse `10%` or `0.1`.

@@ -187,27 +187,7 @@ impl<'py> Kwargs<'py> {
 
     /// A 3×3 symmetric, finite matrix, kg m².
     pub fn matrix(&self, name: &str) -> PyResult<Option<Matrix3<f64>>> {
-        self.take(name)?
-            .map(|v| {
-                let rows: Vec<Vec<f64>> = v.extract().map_err(|_| {
-                    type_error(format!(
-                        "{name}: expected a 3×3 matrix of numbers, got {}",
-                        type_name(&v)
-                    ))
-                })?;
-                if rows.len() != 3 || rows.iter().any(|r| r.len() != 3) {
-                    return Err(value_error(format!("{name}: expected a 3×3 matrix")));
-                }
-                let m = Matrix3::from_fn(|r, c| rows[r][c]);
-                if !m.iter().all(|x| x.is_finite()) {
-                    return Err(value_error(format!("{name}: has non-finite entries")));
-                }
-                if (m - m.transpose()).norm() > 1e-9 * m.norm() {
-                    return Err(value_error(format!("{name}: is not symmetric")));
-                }
-                Ok(m)
-            })
-            .transpose()
+        self.take(name)?.map(|v| matrix_value(name, &v)).transpose()
     }
 
     /// No keyword left: an unknown one is a `TypeError`, as Python raises it.
@@ -221,6 +201,70 @@ impl<'py> Kwargs<'py> {
         }
         Ok(())
     }
+}
+
+/// A 3×3 symmetric, finite matrix.
+fn matrix_value(name: &str, v: &Bound<'_, PyAny>) -> PyResult<Matrix3<f64>> {
+    let rows: Vec<Vec<f64>> = v.extract().map_err(|_| {
+        type_error(format!(
+            "{name}: expected a 3×3 matrix of numbers, got {}",
+            type_name(v)
+        ))
+    })?;
+    if rows.len() != 3 || rows.iter().any(|r| r.len() != 3) {
+        return Err(value_error(format!("{name}: expected a 3×3 matrix")));
+    }
+    let m = Matrix3::from_fn(|r, c| rows[r][c]);
+    if !m.iter().all(|x| x.is_finite()) {
+        return Err(value_error(format!("{name}: has non-finite entries")));
+    }
+    if (m - m.transpose()).norm() > 1e-9 * m.norm() {
+        return Err(value_error(format!("{name}: is not symmetric")));
+    }
+    Ok(m)
+}
+
+/// `prior_sigma`: `"5%"` (relative), a number (kg m², every element) or a 3×3 matrix
+/// (kg m² per element).
+enum PriorSigma {
+    Relative(f64),
+    Elements([f64; 6]),
+}
+
+fn prior_sigma(v: &Bound<'_, PyAny>) -> PyResult<PriorSigma> {
+    let bad = |x: f64| value_error(format!("prior_sigma={}: must be finite and > 0", Num(x)));
+    if let Ok(s) = v.extract::<String>() {
+        let p = s
+            .trim()
+            .strip_suffix('%')
+            .and_then(|p| p.trim().parse::<f64>().ok())
+            .ok_or_else(|| {
+                value_error(format!(
+                    "prior_sigma={s:?}: expected a relative σ such as \"5%\", a number (kg m²) or a 3×3 matrix"
+                ))
+            })?
+            / 100.0;
+        return if p.is_finite() && p > 0.0 {
+            Ok(PriorSigma::Relative(p))
+        } else {
+            Err(bad(p))
+        };
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return if x.is_finite() && x > 0.0 {
+            Ok(PriorSigma::Elements([x; 6]))
+        } else {
+            Err(bad(x))
+        };
+    }
+    let m = matrix_value("prior_sigma", v)?;
+    let j = inertia::tensor::j_from_matrix(&m);
+    Ok(PriorSigma::Elements(core::array::from_fn(|k| j[k])))
+}
+
+/// `m` with its products read in `products` (`"cad"`: `+Σ m x y`, negated).
+fn to_tensor(m: Matrix3<f64>, cad: bool) -> Matrix3<f64> {
+    Matrix3::from_fn(|r, c| if r != c && cad { -m[(r, c)] } else { m[(r, c)] })
 }
 
 pub fn type_name(v: &Bound<'_, PyAny>) -> String {
@@ -269,33 +313,13 @@ pub fn convention(kw: &Kwargs<'_>) -> PyResult<Convention> {
 /// An element bound: the element, its lower and upper bound (kg m²).
 type ElementBound = (Component, Option<f64>, Option<f64>);
 
-/// `Jij=LO:HI` (the command line's `--bound`).
+/// `Jij=LO:HI` (the command line's `--bound`; [`inertia::constraints::parse_bound`]).
 fn parse_bound(s: &str) -> PyResult<ElementBound> {
-    let bad = |why: &str| {
+    inertia::constraints::parse_bound(s).map_err(|why| {
         value_error(format!(
             "bounds {s:?}: {why} (expected e.g. J33=2.7:3.3, J12=:0.05)"
         ))
-    };
-    let (name, range) = s.split_once('=').ok_or_else(|| bad("missing `=`"))?;
-    let k = Component::from_name(name.trim()).ok_or_else(|| bad("unknown element"))?;
-    let (lo, hi) = range.split_once(':').ok_or_else(|| bad("missing `:`"))?;
-    let num = |t: &str| -> PyResult<Option<f64>> {
-        let t = t.trim();
-        if t.is_empty() {
-            return Ok(None);
-        }
-        let v: f64 = t.parse().map_err(|_| bad("not a number"))?;
-        if v.is_finite() {
-            Ok(Some(v))
-        } else {
-            Err(bad("not finite"))
-        }
-    };
-    let (l, h) = (num(lo)?, num(hi)?);
-    if l.is_none() && h.is_none() {
-        return Err(bad("no bound given"));
-    }
-    Ok((k, l, h))
+    })
 }
 
 /// `bounds`: a mapping `{"J33": (2.7, 3.3), "J12": (None, 0.05)}`, or strings in the
@@ -388,7 +412,11 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         "positive-definite" => ConstraintSet::positive_definite(),
         _ => ConstraintSet::physical(),
     };
-    let nominal = kw.matrix("nominal")?;
+    let cad = kw
+        .choice("products", &["tensor", "cad"])?
+        .unwrap_or("tensor")
+        == "cad";
+    let nominal = kw.matrix("nominal")?.map(|m| to_tensor(m, cad));
     let tolerance = kw.take("tolerance")?.map(|v| fraction(&v)).transpose()?;
     match (nominal, tolerance) {
         (Some(n), Some(p)) => constraints = constraints.with_nominal_inertia(&n, p),
@@ -406,7 +434,37 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
     }
     if let Some(b) = kw.take("bounds")? {
         for (k, l, h) in bounds(&b)? {
+            // A CAD product bound `lo ≤ +Σ m x y ≤ hi` is `−hi ≤ J_ik ≤ −lo`.
+            let (l, h) = if cad && k.is_product() {
+                (h.map(|v| -v), l.map(|v| -v))
+            } else {
+                (l, h)
+            };
             constraints = constraints.with_bounds(k, l, h);
+        }
+    }
+    if kw.bool("diagonal", false)? {
+        constraints = constraints.diagonal();
+    }
+    let sigma = kw
+        .take("prior_sigma")?
+        .map(|v| prior_sigma(&v))
+        .transpose()?;
+    match (kw.matrix("prior")?.map(|m| to_tensor(m, cad)), sigma) {
+        (Some(m), Some(PriorSigma::Relative(f))) => {
+            constraints = constraints.with_relative_prior(&m, f);
+        }
+        (Some(m), Some(PriorSigma::Elements(s))) => constraints = constraints.with_prior(&m, s),
+        (None, None) => {}
+        (Some(_), None) => {
+            return Err(value_error(
+                "prior: needs prior_sigma (e.g. prior_sigma=\"5%\")",
+            ))
+        }
+        (None, Some(_)) => {
+            return Err(value_error(
+                "prior_sigma: needs prior (a 3×3 inertia, kg m²)",
+            ))
         }
     }
     let every = kw.usize("every", 1)?;

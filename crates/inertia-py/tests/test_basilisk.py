@@ -325,9 +325,9 @@ def test_time_units_and_validation():
 
 
 def inertia_bin():
-    env = os.environ.get("INERTIA_BIN")
+    env = os.environ.get("INERTIA_CLI") or os.environ.get("INERTIA_BIN")
     if env:
-        assert pathlib.Path(env).exists(), f"INERTIA_BIN={env} does not exist"
+        assert pathlib.Path(env).exists(), f"INERTIA_CLI/INERTIA_BIN={env} does not exist"
         return pathlib.Path(env)
     for p in (REPO / "target" / "release" / "inertia", REPO / "target" / "debug" / "inertia"):
         if p.exists():

@@ -26,6 +26,8 @@ CASES = [
     ("spin", ["--estimator", "finite-difference", "--every", "5"],
      dict(estimator="finite-difference", every=5)),
     ("smallsat", [], {}),
+    ("spin", ["--diagonal"], dict(diagonal=True)),
+    ("slew", ["--bound", "J12=0.0368:0.0368"], dict(bounds={"J12": (0.0368, 0.0368)})),
     ("smallsat", ["--rotation-source", "gyro", "--chain", "0"],
      dict(rotation_source="gyro", chain=0.0)),
 ]
@@ -221,3 +223,30 @@ def test_renamed_columns_match_cli(cli, files, tmp_path):
     expected = cli_estimate(cli, renamed, "--column", "t=time", "--column", "rho_x=hw_x")
     got = inertia.estimate(renamed, columns={"t": "time", "rho_x": "hw_x"})
     assert differences(expected, got.to_dict()) <= TOL
+
+
+@pytest.mark.parametrize("products", ["tensor", "cad"])
+def test_prior_matches_cli(cli, files, tmp_path, products):
+    """A CAD prior (issue 13) through the file and option of the CLI and the arguments
+    here, in either products-of-inertia convention."""
+    import json
+    path = files["spin"]
+    truth = np.array(json.loads(path.with_suffix(".truth.json").read_text())["inertia_kg_m2"])
+    prior = truth * np.where(np.eye(3) == 1, 1.02, 1.0)
+    if products == "cad":
+        prior = np.where(np.eye(3) == 1, prior, -prior)
+    f = tmp_path / "prior.json"
+    f.write_text(json.dumps({"inertia_kg_m2": prior.tolist()}))
+    options = ["--prior", str(f), "--prior-sigma", "5%", "--products", products]
+    expected = cli_estimate(cli, path, *options)
+    got = inertia.estimate(str(path), prior=prior, prior_sigma="5%", products=products)
+    assert differences(expected, got.to_dict()) <= TOL
+    assert got.to_dict()["prior"]["rows"] == 6
+    # σ per element as a matrix gives the same as the relative one it equals.
+    sigma = np.abs(truth * 1.02) * 0.05
+    d = np.sqrt(np.outer(np.diag(truth) * 1.02, np.diag(truth) * 1.02)) * 0.05
+    sigma = np.where(np.eye(3) == 1, sigma, d)
+    by_matrix = inertia.estimate(str(path), prior=prior, prior_sigma=sigma, products=products)
+    assert differences(expected, by_matrix.to_dict()) <= 1e-9
+    with pytest.raises(ValueError, match="prior_sigma"):
+        inertia.estimate(str(path), prior=prior)

@@ -388,7 +388,8 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
 #: The estimation settings, as :func:`estimate` and :class:`Estimator` name them (the
 #: command line's options).
 _SETTINGS = (
-    "estimator", "constraints", "bounds", "nominal", "tolerance", "gyro_noise", "memory",
+    "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
+    "prior_sigma", "products", "gyro_noise", "memory",
     "resample", "every", "rotation_source", "rho_model", "torque_bias", "chain", "glitches",
     "solver", "uncertainty",
 )
@@ -399,9 +400,12 @@ _CONVENTIONS = ("scalar_first", "jpl", "unit_tolerance", "period_tolerance")
 def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
     """The named arguments, with matrices as nested lists for the native side."""
     kw = {k: arguments[k] for k in names}
-    for key in ("nominal", "truth"):
+    for key in ("nominal", "truth", "prior"):
         if kw.get(key) is not None:
             kw[key] = _float_array(key, kw[key], "(3, 3)").tolist()
+    sigma = kw.get("prior_sigma")
+    if sigma is not None and not isinstance(sigma, (str, int, float)):
+        kw["prior_sigma"] = _float_array("prior_sigma", sigma, "(3, 3)").tolist()
     return kw
 
 
@@ -417,6 +421,10 @@ def estimate(
     bounds: Union[None, str, Sequence[str], Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
     nominal: Any = None,
     tolerance: Union[None, float, str] = None,
+    diagonal: bool = False,
+    prior: Any = None,
+    prior_sigma: Any = None,
+    products: str = "tensor",
     gyro_noise: Optional[float] = None,
     memory: Optional[float] = None,
     resample: Optional[float] = None,
@@ -461,6 +469,16 @@ def estimate(
             ``["J33=2.7:3.3"]`` (``--bound``).
         nominal, tolerance: a nominal 3×3 J (kg m²) bounding every element within a
             fraction (``0.1`` or ``"10%"``).
+        diagonal: fix every product of inertia at zero (an equality the solver
+            eliminates; ``bounds={"J12": (0, 0)}`` fixes one).
+        prior, prior_sigma: a Gaussian prior (e.g. from CAD): a 3×3 J, kg m², and its
+            standard deviation: ``"5%"`` (moments ±5 %·|J_ii|, products
+            ±5 %·√(J_ii J_jj)), a number (kg m², every element) or a 3×3 matrix.
+            ``Estimate.to_dict()["prior"]`` gives the prior-data χ² and the fraction of
+            each element's information from the data (``--prior``).
+        products: how products of inertia are written in ``nominal``, ``prior`` and
+            product ``bounds``: ``"tensor"`` (J12 = −Σ m x y, default) or ``"cad"``
+            (+Σ m x y).
         gyro_noise: the gyro's rate-noise density, deg/s/√Hz (errors-in-variables
             compensation).
         memory: forgetting time constant, s. resample: resampling period, s.
@@ -546,6 +564,10 @@ class Estimator:
         bounds: Any = None,
         nominal: Any = None,
         tolerance: Union[None, float, str] = None,
+        diagonal: bool = False,
+        prior: Any = None,
+        prior_sigma: Any = None,
+        products: str = "tensor",
         gyro_noise: Optional[float] = None,
         memory: Optional[float] = None,
         resample: Optional[float] = None,

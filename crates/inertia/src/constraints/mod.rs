@@ -156,6 +156,32 @@ impl Default for ConstraintSet {
     }
 }
 
+/// An element bound written `Jij=LO:HI` (`J33=2.7:3.3`, `J12=:0.05`, `J11=0.9:`, an
+/// equality `J12=0:0`): the element and its lower and upper bound, kg m². The error is
+/// why the text is not one (without the text itself, which the caller names).
+pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), &'static str> {
+    let (name, range) = s.split_once('=').ok_or("missing `=`")?;
+    let k = Component::from_name(name.trim()).ok_or("unknown element")?;
+    let (lo, hi) = range.split_once(':').ok_or("missing `:`")?;
+    let num = |t: &str| -> Result<Option<f64>, &'static str> {
+        let t = t.trim();
+        if t.is_empty() {
+            return Ok(None);
+        }
+        let v: f64 = t.parse().map_err(|_| "not a number")?;
+        if v.is_finite() {
+            Ok(Some(v))
+        } else {
+            Err("not finite")
+        }
+    };
+    let (l, h) = (num(lo)?, num(hi)?);
+    if l.is_none() && h.is_none() {
+        return Err("no bound given");
+    }
+    Ok((k, l, h))
+}
+
 /// Why a constraint set is unusable.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum ConstraintError {
