@@ -577,12 +577,11 @@ impl Plan {
             .constraints
             .validate()
             .map_err(|e| pipeline_fail(&PipelineError::Constraints(e)))?;
-        let observability = ObservabilitySettings::default();
         let config = FixedConfig {
             constraints,
             recursive: RecursiveSettings {
                 solve_every: self.solve_every,
-                observability,
+                observability: ObservabilitySettings::default(),
                 memory_s: self.memory_s,
                 gyro_noise_rad_s_rthz: self.gyro_noise.map(f64::to_radians),
             },
@@ -590,7 +589,6 @@ impl Plan {
             uncertainty: self.uncertainty && !fd,
             residual_test: self.memory_s.is_none(),
             glitches: self.glitches,
-            observability,
         };
         let engine = if fd {
             engine::Fixed::new(config).map(Engine::FiniteDifference)

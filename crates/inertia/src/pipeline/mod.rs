@@ -44,6 +44,7 @@
 //! # }
 //! ```
 
+mod checks;
 mod discrete_momentum;
 mod momentum;
 pub mod registry;
@@ -56,7 +57,9 @@ pub mod history;
 #[cfg(feature = "serde")]
 pub mod report;
 
+pub use checks::AttitudeChecks;
 pub use registry::{BatchOutput, Capabilities, Estimator};
+pub use sdp::Constrained;
 pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
@@ -188,8 +191,7 @@ pub struct Pipeline {
     input_samples: usize,
     estimator_samples: usize,
     last: Option<Estimate>,
-    convention: ConventionCheck,
-    glitch: GlitchCheck,
+    checks: AttitudeChecks,
     /// The previous input sample's time and the step that ended at it.
     previous: Option<(f64, Option<f64>)>,
 }
@@ -228,8 +230,7 @@ impl Pipeline {
             input_samples: 0,
             estimator_samples: 0,
             last: None,
-            convention: ConventionCheck::default(),
-            glitch: GlitchCheck::default(),
+            checks: AttitudeChecks::default(),
             previous: None,
         })
     }
@@ -275,31 +276,8 @@ impl Pipeline {
                 (!before.is_some_and(|b| crate::sample::is_gap(b, step))).then_some(step)
             }),
         ));
-        if let Some(glitch) = self.glitch.push(s) {
-            if self.config.glitches == GlitchPolicy::Stop {
-                return Err(PipelineError::AttitudeGlitch {
-                    sample: index,
-                    glitch,
-                });
-            }
-        }
+        self.checks.push(index, s, self.config.glitches)?;
         self.input_samples += 1;
-        if self.convention.steps() < crate::telemetry::convention::STEPS_NEEDED {
-            self.convention.push(s);
-            if let Verdict::Wrong {
-                reading,
-                as_read,
-                fixed,
-            } = self.convention.verdict()
-            {
-                return Err(PipelineError::AttitudeConvention {
-                    fix: reading.fix(),
-                    as_read,
-                    fixed,
-                    steps: self.convention.steps(),
-                });
-            }
-        }
         let Self {
             resampler,
             estimator,
@@ -339,14 +317,14 @@ impl Pipeline {
     /// [`GlitchPolicy::Keep`] ([`crate::telemetry::glitch`]).
     #[must_use]
     pub fn glitches(&self) -> &GlitchCheck {
-        &self.glitch
+        self.checks.glitches()
     }
 
     /// How the attitude compares with the gyro rates so far
     /// ([`crate::telemetry::convention`]).
     #[must_use]
     pub fn attitude_check(&self) -> Verdict {
-        self.convention.verdict()
+        self.checks.verdict()
     }
 
     /// The newest estimate.
@@ -444,18 +422,6 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
             }
         }
     }
-    if let Verdict::Wrong {
-        reading,
-        as_read,
-        fixed,
-    } = check.verdict()
-    {
-        return Err(PipelineError::AttitudeConvention {
-            fix: reading.fix(),
-            as_read,
-            fixed,
-            steps: check.steps(),
-        });
-    }
+    checks::convention_error(&check)?;
     run(samples, config)
 }

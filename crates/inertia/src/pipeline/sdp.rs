@@ -46,12 +46,15 @@ pub(crate) const FINITE_DIFFERENCE: EstimatorEntry = EstimatorEntry {
     batch: Some(run_batch::<FiniteDifferenceRows>),
 };
 
-type Recursive<S> = RecursiveEstimator<S, Box<dyn Backend + Send>>;
-
-/// The recursive estimator and, for the uncertainty, its shadow on every other sample.
-struct Sdp<S: RowSource> {
-    main: Recursive<S>,
-    shadow: Option<Box<Recursive<S>>>,
+/// The recursive constrained least-squares estimator as the pipeline runs it: the
+/// estimator, its half-rate shadow for the uncertainty model, the status audit and the
+/// residual test, after every solve. Generic over the backend so that a fixed-size build
+/// (the C API's caller storage, with [`crate::solver::native::NativeSolver`]) takes the
+/// same steps as the pipeline (which boxes its backend).
+#[derive(Debug, Clone)]
+pub struct Constrained<S: RowSource, B: Backend> {
+    main: RecursiveEstimator<S, B>,
+    shadow: Option<RecursiveEstimator<S, B>>,
     samples: usize,
     /// The main estimator's residual record (none under forgetting).
     residuals: Option<ResidualSegments>,
@@ -59,56 +62,49 @@ struct Sdp<S: RowSource> {
     epsilon_kg_m2: f64,
 }
 
-fn settings(c: &PipelineConfig) -> RecursiveSettings {
-    RecursiveSettings {
-        solve_every: c.solve_every,
-        observability: c.observability,
-        memory_s: c.memory_s,
-        gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz,
+impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
+    /// The estimator with `settings` under `constraints`, each solve by a backend from
+    /// `backend`. With `uncertainty`, a shadow on every other sample measures the
+    /// discretisation bias (twice the step, the same memory in seconds; it measures only
+    /// the slowly varying bias, so it solves every 8th of its samples, a bias estimate at
+    /// most 1.6 s old at h = 0.1 s). With `residual_test`, the residuals are recorded for
+    /// [`crate::estimator::consistency`] (not under forgetting).
+    pub fn new(
+        constraints: crate::constraints::Constraints,
+        settings: RecursiveSettings,
+        uncertainty: bool,
+        residual_test: bool,
+        mut backend: impl FnMut() -> B,
+    ) -> Result<Self, EstimatorError> {
+        let main = RecursiveEstimator::new(S::default(), constraints, backend(), settings)?;
+        let shadow = if uncertainty {
+            let s = RecursiveSettings {
+                solve_every: settings.solve_every.div_ceil(2).max(8),
+                ..settings
+            };
+            Some(RecursiveEstimator::new(
+                S::default(),
+                constraints,
+                backend(),
+                s,
+            )?)
+        } else {
+            None
+        };
+        Ok(Self {
+            main,
+            shadow,
+            samples: 0,
+            residuals: residual_test.then(ResidualSegments::new),
+            observability: settings.observability,
+            epsilon_kg_m2: constraints.set().epsilon_kg_m2,
+        })
     }
 }
 
-fn recursive<S: RowSource + Default>(
-    c: &PipelineConfig,
-    settings: RecursiveSettings,
-) -> Result<Recursive<S>, PipelineError> {
-    let backend = registry::build_backend(c.backend);
-    RecursiveEstimator::new(S::default(), c.constraints, backend, settings).map_err(|source| {
-        PipelineError::Estimator {
-            sample: None,
-            source,
-        }
-    })
-}
-
-fn build<S: RowSource + Default + Send + 'static>(
-    c: &PipelineConfig,
-) -> Result<Box<dyn Estimator>, PipelineError> {
-    let main = recursive::<S>(c, settings(c))?;
-    // The shadow sees every other sample: twice the step, the same memory in seconds.
-    // It measures only the slowly varying discretisation bias, so it solves every 8th of
-    // its samples (a bias estimate at most 1.6 s old at h = 0.1 s).
-    let shadow = if c.uncertainty {
-        let s = RecursiveSettings {
-            solve_every: c.solve_every.div_ceil(2).max(8),
-            ..settings(c)
-        };
-        Some(Box::new(recursive::<S>(c, s)?))
-    } else {
-        None
-    };
-    Ok(Box::new(Sdp {
-        main,
-        shadow,
-        samples: 0,
-        residuals: c.memory_s.is_none().then(ResidualSegments::new),
-        observability: c.observability,
-        epsilon_kg_m2: c.constraints.set().epsilon_kg_m2,
-    }))
-}
-
-impl<S: RowSource + Send> Estimator for Sdp<S> {
-    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+impl<S: RowSource, B: Backend> Constrained<S, B> {
+    /// Feed one sample; the estimate when a solve was due.
+    pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         if let Some(half) = self.shadow.as_mut() {
             if self.samples.is_multiple_of(2) {
                 half.push(s)?;
@@ -144,6 +140,50 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
         Ok(Some(e))
     }
 
+    /// The main estimator.
+    #[must_use]
+    pub fn main(&self) -> &RecursiveEstimator<S, B> {
+        &self.main
+    }
+
+    /// The span whose residuals stand out most.
+    #[must_use]
+    pub fn residual_consistency(&self) -> Option<Worst> {
+        self.residuals.as_ref()?.worst()
+    }
+}
+
+fn settings(c: &PipelineConfig) -> RecursiveSettings {
+    RecursiveSettings {
+        solve_every: c.solve_every,
+        observability: c.observability,
+        memory_s: c.memory_s,
+        gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz,
+    }
+}
+
+fn build<S: RowSource + Default + Send + 'static>(
+    c: &PipelineConfig,
+) -> Result<Box<dyn Estimator>, PipelineError> {
+    let adapter = Constrained::<S, Box<dyn Backend + Send>>::new(
+        c.constraints,
+        settings(c),
+        c.uncertainty,
+        c.memory_s.is_none(),
+        || registry::build_backend(c.backend),
+    )
+    .map_err(|source| PipelineError::Estimator {
+        sample: None,
+        source,
+    })?;
+    Ok(Box::new(adapter))
+}
+
+impl<S: RowSource + Send, B: Backend + Send> Estimator for Constrained<S, B> {
+    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+        Constrained::push(self, s)
+    }
+
     fn gaps(&self) -> usize {
         self.main.gaps()
     }
@@ -153,7 +193,7 @@ impl<S: RowSource + Send> Estimator for Sdp<S> {
     }
 
     fn residual_consistency(&self) -> Option<Worst> {
-        self.residuals.as_ref()?.worst()
+        Constrained::residual_consistency(self)
     }
 }
 
