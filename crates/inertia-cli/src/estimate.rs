@@ -60,21 +60,10 @@ fn check_against_step(config: &PipelineConfig, dt: f64, at: &str) -> Result<(), 
 /// `(time, line)` pairs: the reader may be ahead of the estimator (resampling reads the
 /// next samples first, and the half-rate shadow's step ends at a later sample).
 fn step_end_line(e: &PipelineError, recent: &VecDeque<(f64, u64)>) -> Option<u64> {
-    let PipelineError::Estimator {
-        source:
-            EstimatorError::Row {
-                source: RowError::StepTooLarge { t1_s, .. },
-                ..
-            },
-        ..
-    } = e
-    else {
-        return None;
-    };
-    let tol = 1e-9 * (1.0 + t1_s.abs());
+    let end = e.step_end_s()?;
     recent
         .iter()
-        .find(|(t, _)| *t >= t1_s - tol)
+        .find(|(t, _)| PipelineError::ends_step(*t, end))
         .map(|&(_, line)| line)
 }
 

@@ -141,22 +141,11 @@ pub fn check_against_step(config: &PipelineConfig, dt: f64, at: &str) -> Result<
 /// The sample that ends a step too large for |φ| < 1, among the `RECENT` samples up to
 /// `i` (as the CLI finds its line).
 fn step_end(e: &PipelineError, samples: &[Sample], i: usize) -> Option<usize> {
-    let PipelineError::Estimator {
-        source:
-            EstimatorError::Row {
-                source: RowError::StepTooLarge { t1_s, .. },
-                ..
-            },
-        ..
-    } = e
-    else {
-        return None;
-    };
-    let tol = 1e-9 * (1.0 + t1_s.abs());
+    let end = e.step_end_s()?;
     let from = (i + 1).saturating_sub(RECENT);
     samples[from..=i]
         .iter()
-        .position(|s| s.t_s >= t1_s - tol)
+        .position(|s| PipelineError::ends_step(s.t_s, end))
         .map(|k| from + k)
 }
 

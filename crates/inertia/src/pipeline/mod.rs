@@ -183,6 +183,34 @@ impl PipelineError {
     }
 }
 
+impl PipelineError {
+    /// For a step too large for the rows (`|φ| ≥ 1`), the time its end sample has, s,
+    /// and otherwise `None`: how a caller that holds the samples' lines finds the line to
+    /// name ([`Self::ends_step`]); the estimator may be behind the reader (resampling
+    /// reads ahead, the half-rate shadow's step ends at a later sample).
+    #[must_use]
+    pub fn step_end_s(&self) -> Option<f64> {
+        match self {
+            PipelineError::Estimator {
+                source:
+                    EstimatorError::Row {
+                        source: crate::discrete::RowError::StepTooLarge { t1_s, .. },
+                        ..
+                    },
+                ..
+            } => Some(*t1_s),
+            _ => None,
+        }
+    }
+
+    /// Whether a sample at `t_s` is at or after the step end `step_end_s` (to 1e-9 of its
+    /// size): the first such sample ends the step.
+    #[must_use]
+    pub fn ends_step(t_s: f64, step_end_s: f64) -> bool {
+        t_s >= step_end_s - 1e-9 * (1.0 + step_end_s.abs())
+    }
+}
+
 /// An estimator fed sample by sample, with optional resampling in front.
 pub struct Pipeline {
     config: PipelineConfig,
