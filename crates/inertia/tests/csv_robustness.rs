@@ -120,3 +120,42 @@ proptest! {
         }
     }
 }
+
+/// Errors name the file's own line whatever the line ends and blank lines (the `csv`
+/// crate's record positions are a line short after CRLF, rust-csv #395, and name the
+/// blank line before a record, #208): a bad number and a short record, on line 9 after
+/// two blank lines, with LF and with CRLF line ends, and the last good row's line.
+#[test]
+fn errors_name_the_physical_line_with_crlf_and_blank_lines() {
+    let lines: Vec<&str> = valid_file().lines().collect();
+    for eol in ["\n", "\r\n"] {
+        for bad in ["number", "short"] {
+            // Header, 2 rows, 2 blank lines, rows: the 4th row after the blanks is line 9.
+            let mut out: Vec<String> = lines[..3].iter().map(|s| s.to_string()).collect();
+            out.extend([String::new(), String::new()]);
+            out.extend(lines[3..10].iter().map(|s| s.to_string()));
+            let target = 8; // 0-based index of physical line 9
+            let mut fields: Vec<String> = out[target].split(',').map(str::to_string).collect();
+            match bad {
+                "number" => fields[5] = "abc".into(),
+                _ => {
+                    fields.pop();
+                }
+            }
+            out[target] = fields.join(",");
+            let text = out.join(eol) + eol;
+            let mut reader =
+                TelemetryReader::new(text.as_bytes(), "lines.csv", CsvOptions::default()).unwrap();
+            let mut last_good = 0;
+            let err = loop {
+                match reader.next().expect("an error before the end") {
+                    Ok(_) => last_good = reader.last_line(),
+                    Err(e) => break e,
+                }
+            };
+            assert_eq!(err.line(), Some(9), "{bad} {eol:?}: {err}");
+            assert_eq!(last_good, 8, "{bad} {eol:?}");
+            assert!(err.to_string().starts_with("lines.csv:9:"), "{err}");
+        }
+    }
+}

@@ -349,6 +349,8 @@ struct Indices {
 pub struct TelemetryReader<R: Read> {
     reader: csv::Reader<LineCap<R>>,
     record: csv::StringRecord,
+    /// 1-based line of the last record read.
+    line: u64,
     file: String,
     options: CsvOptions,
     idx: Indices,
@@ -388,6 +390,8 @@ impl<R: Read> TelemetryReader<R> {
             .iter()
             .map(|h| h.trim().to_string())
             .collect();
+        // The header's line.
+        let _ = reader.get_mut().claim_line();
         let mut seen = HashMap::with_capacity(headers.len());
         for (j, h) in headers.iter().enumerate() {
             if let Some(i) = seen.insert(h.as_str(), j) {
@@ -442,6 +446,7 @@ impl<R: Read> TelemetryReader<R> {
             time_origin: None,
             clock: Clock::default(),
             failed: false,
+            line: 0,
         })
     }
 
@@ -472,7 +477,7 @@ impl<R: Read> TelemetryReader<R> {
     /// Line (1-based) of the last record read.
     #[must_use]
     pub fn last_line(&self) -> u64 {
-        self.record.position().map_or(0, csv::Position::line)
+        self.line
     }
 
     /// The file name used in messages.
@@ -733,9 +738,26 @@ impl<R: Read> Iterator for TelemetryReader<R> {
         self.record = record;
         let item = match res {
             Ok(false) => return None,
-            Err(e) => Err(csv_error(&self.file, e)),
+            Err(e) => {
+                let line = self.reader.get_mut().claim_line();
+                Err(match (csv_error(&self.file, e), line) {
+                    (TelemetryError::Malformed { file, message, .. }, Some(line)) => {
+                        TelemetryError::Malformed {
+                            file,
+                            line,
+                            message,
+                        }
+                    }
+                    (other, _) => other,
+                })
+            }
             Ok(true) => {
-                let line = self.record.position().map_or(0, csv::Position::line);
+                let line = self
+                    .reader
+                    .get_mut()
+                    .claim_line()
+                    .unwrap_or_else(|| self.record.position().map_or(0, csv::Position::line));
+                self.line = line;
                 self.parse_row(line)
             }
         };
