@@ -95,17 +95,8 @@ impl InertiaFile {
             (None, Some(b)) => b,
             (None, None) => ProductsArg::Tensor,
         };
-        let c = product_convention(Some(convention));
-        let to_tensor = |m: [[f64; 3]; 3]| {
-            Matrix3::from_fn(|r, k| {
-                if r == k {
-                    m[r][k]
-                } else {
-                    c.to_tensor(m[r][k])
-                }
-            })
-        };
-        let m = to_tensor(f.inertia_kg_m2);
+        let m = product_convention(Some(convention))
+            .matrix_to_tensor(&Matrix3::from_fn(|r, k| f.inertia_kg_m2[r][k]));
         check_matrix(path, "inertia_kg_m2", &m)?;
         let sigma_kg_m2 = match f.sigma_kg_m2 {
             Some(s) => {
@@ -213,15 +204,7 @@ pub fn constraint_set(
     }
     for b in bounds {
         let (k, l, h) = parse_bound(b)?;
-        // A CAD product bound `lo ≤ +Σ m x y ≤ hi` is `−hi ≤ J_ik ≤ −lo`.
-        let (l, h) = if k.is_product() {
-            match products {
-                ProductConvention::Cad => (h.map(|v| -v), l.map(|v| -v)),
-                _ => (l, h),
-            }
-        } else {
-            (l, h)
-        };
+        let (l, h) = products.bound_to_tensor(k, l, h);
         set = set.with_bounds(k, l, h);
     }
     Ok(set)

@@ -3,7 +3,7 @@
 //! Bad values raise `ValueError` (or `TypeError` for a wrong type) naming the argument.
 
 use crate::errors::{type_error, value_error};
-use inertia::constraints::ConstraintSet;
+use inertia::constraints::{ConstraintSet, ProductConvention};
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{PipelineError, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 use inertia::telemetry::csv::{QuaternionFormat, DEFAULT_UNIT_TOLERANCE};
@@ -262,11 +262,6 @@ fn prior_sigma(v: &Bound<'_, PyAny>) -> PyResult<PriorSigma> {
     Ok(PriorSigma::Elements(core::array::from_fn(|k| j[k])))
 }
 
-/// `m` with its products read in `products` (`"cad"`: `+Σ m x y`, negated).
-fn to_tensor(m: Matrix3<f64>, cad: bool) -> Matrix3<f64> {
-    Matrix3::from_fn(|r, c| if r != c && cad { -m[(r, c)] } else { m[(r, c)] })
-}
-
 pub fn type_name(v: &Bound<'_, PyAny>) -> String {
     v.get_type()
         .name()
@@ -412,11 +407,11 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         "positive-definite" => ConstraintSet::positive_definite(),
         _ => ConstraintSet::physical(),
     };
-    let cad = kw
-        .choice("products", &["tensor", "cad"])?
-        .unwrap_or("tensor")
-        == "cad";
-    let nominal = kw.matrix("nominal")?.map(|m| to_tensor(m, cad));
+    let products = match kw.choice("products", &["tensor", "cad"])? {
+        Some("cad") => ProductConvention::Cad,
+        _ => ProductConvention::Tensor,
+    };
+    let nominal = kw.matrix("nominal")?.map(|m| products.matrix_to_tensor(&m));
     let tolerance = kw.take("tolerance")?.map(|v| fraction(&v)).transpose()?;
     match (nominal, tolerance) {
         (Some(n), Some(p)) => constraints = constraints.with_nominal_inertia(&n, p),
@@ -434,12 +429,7 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
     }
     if let Some(b) = kw.take("bounds")? {
         for (k, l, h) in bounds(&b)? {
-            // A CAD product bound `lo ≤ +Σ m x y ≤ hi` is `−hi ≤ J_ik ≤ −lo`.
-            let (l, h) = if cad && k.is_product() {
-                (h.map(|v| -v), l.map(|v| -v))
-            } else {
-                (l, h)
-            };
+            let (l, h) = products.bound_to_tensor(k, l, h);
             constraints = constraints.with_bounds(k, l, h);
         }
     }
@@ -450,7 +440,10 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         .take("prior_sigma")?
         .map(|v| prior_sigma(&v))
         .transpose()?;
-    match (kw.matrix("prior")?.map(|m| to_tensor(m, cad)), sigma) {
+    match (
+        kw.matrix("prior")?.map(|m| products.matrix_to_tensor(&m)),
+        sigma,
+    ) {
         (Some(m), Some(PriorSigma::Relative(f))) => {
             constraints = constraints.with_relative_prior(&m, f);
         }

@@ -209,3 +209,32 @@ fn svd_tracker_matches_reference_svd() {
         }
     }
 }
+
+/// The products-of-inertia convention (issue 13): a CAD product `+Σ m x y` is the tensor
+/// entry negated, for matrices (moments untouched, twice is the identity) and for
+/// bounds (`lo ≤ P ≤ hi` is `−hi ≤ J_ik ≤ −lo`; a moment's bound is unchanged).
+#[test]
+fn cad_products_convert_to_tensor_entries() {
+    use inertia::constraints::ProductConvention;
+    use inertia::tensor::Component;
+    let m = nalgebra::Matrix3::new(1.0, 0.02, -0.03, 0.02, 2.0, 0.04, -0.03, 0.04, 3.0);
+    let t = ProductConvention::Cad.matrix_to_tensor(&m);
+    assert_eq!(t.diagonal(), m.diagonal());
+    assert_eq!(t[(0, 1)], -0.02);
+    assert_eq!(t[(2, 0)], 0.03);
+    assert_eq!(ProductConvention::Cad.matrix_to_tensor(&t), m);
+    assert_eq!(ProductConvention::Tensor.matrix_to_tensor(&m), m);
+    let cad = ProductConvention::Cad;
+    assert_eq!(
+        cad.bound_to_tensor(Component::J12, Some(0.01), Some(0.03)),
+        (Some(-0.03), Some(-0.01))
+    );
+    assert_eq!(
+        cad.bound_to_tensor(Component::J13, None, Some(0.05)),
+        (Some(-0.05), None)
+    );
+    assert_eq!(
+        cad.bound_to_tensor(Component::J33, Some(2.7), Some(3.3)),
+        (Some(2.7), Some(3.3))
+    );
+}

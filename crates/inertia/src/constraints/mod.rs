@@ -136,6 +136,37 @@ impl ProductConvention {
             ProductConvention::Cad => -product,
         }
     }
+
+    /// A matrix whose off-diagonal entries are products in this convention, in tensor
+    /// entries.
+    #[must_use]
+    pub fn matrix_to_tensor(self, m: &Matrix3<f64>) -> Matrix3<f64> {
+        Matrix3::from_fn(|r, c| {
+            if r == c {
+                m[(r, c)]
+            } else {
+                self.to_tensor(m[(r, c)])
+            }
+        })
+    }
+
+    /// A bound `lower ≤ x ≤ upper` on `component` written in this convention, as a bound
+    /// on the tensor entry: a CAD product bound `lo ≤ +Σ m x y ≤ hi` is
+    /// `−hi ≤ J_ik ≤ −lo`; moments are unchanged.
+    #[must_use]
+    pub fn bound_to_tensor(
+        self,
+        component: Component,
+        lower: Option<f64>,
+        upper: Option<f64>,
+    ) -> (Option<f64>, Option<f64>) {
+        match self {
+            ProductConvention::Cad if component.is_product() => {
+                (upper.map(|v| -v), lower.map(|v| -v))
+            }
+            _ => (lower, upper),
+        }
+    }
 }
 
 impl Consistency {
