@@ -341,7 +341,8 @@ pub struct EstimateArgs {
     pub prior_sigma: Option<String>,
     /// How products of inertia are written in `--prior`, `--nominal` and `--bound Jij`
     /// (i ≠ j): `tensor` (J12 = −Σ m x y, this tool's convention) or `cad` (I_xy = +Σ m x y,
-    /// what CAD tools report). Default: the file's `products_of_inertia`, else tensor.
+    /// what CAD tools report). Default tensor; a `--prior`/`--nominal` file's own
+    /// `products_of_inertia` applies to that file (and must agree with this option).
     #[arg(long, value_enum, value_name = "CONVENTION")]
     pub products: Option<ProductsArg>,
     /// Solve every N samples (recursive estimators).

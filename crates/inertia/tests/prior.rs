@@ -192,13 +192,21 @@ fn diagonal_equalities_determine_a_diagonal_body_and_are_exact() {
             alone.observability
         );
         let e = run(est, ConstraintSet::physical().diagonal(), &data);
+        // The data alone determine three directions: the equalities the other three.
         assert!(
-            matches!(e.observability, Observability::Determined { .. }),
+            matches!(e.observability, Observability::FromPrior(_)),
             "{est}: {}",
             e.observability
         );
         let j = e.j().unwrap();
         assert_eq!([j[3], j[4], j[5]], [0.0; 3], "{est}: fixed elements exact");
+        if let Some(s) = e.sigma_kg_m2() {
+            assert_eq!(
+                [s[3], s[4], s[5]],
+                [0.0; 3],
+                "{est}: fixed elements have σ 0"
+            );
+        }
         let err = relative_frobenius_error(&e.inertia().unwrap(), &truth);
         assert!(err < 1e-4, "{est}: {err}");
         assert!(e.within_3sigma(&truth).unwrap(), "{est}");
@@ -336,9 +344,6 @@ fn a_pure_spin_takes_its_scale_from_the_prior() {
                     Observability::FromPrior(Unobservable::NoExcitation)
                         if est == "variational" => {}
                     Observability::NotObservable(Unobservable::PriorConflict { .. }) => {
-                        if seed == 1 {
-                            println!("DBG {est} {:?} rows {}", e.prior, e.rows);
-                        }
                         refused += 1;
                         continue;
                     }
@@ -431,4 +436,65 @@ fn eliminated_equalities_match_least_squares_on_the_free_columns() {
         }
     }
     assert!(compared > 300, "{compared}");
+}
+
+/// Equalities the data cannot check are not "determined by the data": a body with a
+/// product of inertia 0.1 kg m², forced diagonal, on data that determine three of the six
+/// directions, is answered as determined with the prior knowledge (the data cannot tell
+/// the equality is wrong, and say so).
+#[test]
+fn a_wrong_equality_is_not_determined_by_the_data() {
+    let truth = Matrix3::new(1.0, 0.1, 0.0, 0.1, 2.0, 0.0, 0.0, 0.0, 3.0);
+    let data = equal_torque(quiet(2, truth));
+    for est in ["variational", "discrete-momentum"] {
+        let e = run(est, ConstraintSet::physical().diagonal(), &data);
+        assert!(
+            matches!(e.observability, Observability::FromPrior(_)),
+            "{est}: {}",
+            e.observability
+        );
+    }
+}
+
+/// Equalities the data contradict, on data that determine J: the answer leans on the
+/// constraint set (`equality_chi2`), as on an active bound.
+#[test]
+fn an_equality_the_data_contradict_leans_on_the_constraint_set() {
+    let truth = Common::paper().inertia_kg_m2;
+    let run_ = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let alone = run("variational", ConstraintSet::physical(), &run_.samples);
+    assert!(matches!(
+        alone.observability,
+        Observability::Determined { .. } | Observability::FromPrior(_)
+    ));
+    // J12 is 0.0368: fixing it at 0 contradicts the data.
+    let e = run(
+        "variational",
+        ConstraintSet::physical().with_equality(inertia::tensor::Component::J12, 0.0),
+        &run_.samples,
+    );
+    assert!(
+        matches!(
+            e.observability,
+            Observability::FromPrior(Unobservable::ConflictsWithConstraints { .. })
+        ),
+        "{}",
+        e.observability
+    );
+    // Fixed at its true value: no conflict.
+    let t = j_from_matrix(&truth);
+    let e = run(
+        "variational",
+        ConstraintSet::physical().with_equality(inertia::tensor::Component::J12, t[3]),
+        &run_.samples,
+    );
+    assert!(
+        !matches!(
+            e.observability,
+            Observability::FromPrior(Unobservable::ConflictsWithConstraints { .. })
+                | Observability::NotObservable(_)
+        ),
+        "{}",
+        e.observability
+    );
 }

@@ -185,6 +185,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {
         super::uncertainty::noise_sigma(&self.solved, &self.sv, self.svd.v())
+            .map(|s| super::prior::zero_fixed(s, &self.constraints))
     }
 
     /// The delete-a-group jackknife σ per element over the completed chains

@@ -63,9 +63,10 @@ pub fn jackknife_sigma(estimates: &[InertiaVector]) -> Option<[f64; 6]> {
 /// jackknife σ (when there is one), kg m².
 #[must_use]
 pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [f64; 6] {
+    // An element the least squares fix exactly (an equality, σ 0) stays fixed.
     core::array::from_fn(|k| match jackknife {
-        Some(jk) => least_squares[k].max(jk[k]),
-        None => least_squares[k],
+        Some(jk) if least_squares[k] > 0.0 => least_squares[k].max(jk[k]),
+        _ => least_squares[k],
     })
 }
 

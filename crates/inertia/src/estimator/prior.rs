@@ -26,9 +26,11 @@
 //!
 //! Without excitation (`y ≡ 0`) the data fix only the direction of `j`: `s² = σ_6²
 //! ‖μ‖²/(rows − 5)`, the misfit of that direction at the prior's size, and the scale
-//! is the prior's alone (the data's information along it is removed). With noise-free data (`ρ² = 0`) `s` is floored at `1e-12 · c · min σ_k` (`c` the
-//! root-mean-square column norm of `R`), so that the prior still fixes the directions the
-//! data leave open, with its own σ there.
+//! is the prior's alone (the data's information along it is removed).
+//!
+//! With noise-free data (`ρ² = 0`) `s` is floored at [`SCALE_FLOOR`]` · c · min σ_k` (`c`
+//! the root-mean-square column norm of `R`), so that the prior still fixes the directions
+//! the data leave open, with its own σ there, in a problem the solvers resolve.
 
 use super::qr::RecursiveQr;
 use crate::constraints::Constraints;
@@ -40,8 +42,8 @@ pub const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
 
 /// Floor of the residual scale `s`, relative to `c · min σ_k` (`c` the root-mean-square
 /// column norm of `R`): data that fit (nearly) exactly still leave the prior a weight
-/// within `10⁻¹²` of theirs in the normal equations, which the solvers resolve.
-pub const SCALE_FLOOR: f64 = 1e-6;
+/// within `10⁻⁸` of theirs in the normal equations, which the solvers resolve.
+pub const SCALE_FLOOR: f64 = 1e-4;
 
 /// How much the residual scale `s` may understate the noise of `ĵ`: the conflict test
 /// flags `χ² > RESIDUAL_VARIANCE_ALLOWANCE · χ²_{p, 0.999}`. The rows' errors are
@@ -78,6 +80,33 @@ impl PriorFit {
     }
 }
 
+/// The equalities' disagreement with the data, `χ² = Δρ²/s²`: the misfit the fixed
+/// values add over the data's least squares, in units of the data's residual variance
+/// (before the equalities). `None` without equalities or residual degrees of freedom.
+/// Above [`super::audit::CONFLICT_CHI2`] the data contradict the equalities, as they
+/// contradicted an active bound before equalities were eliminated.
+#[must_use]
+pub fn equality_chi2(qr: &RecursiveQr, constraints: &Constraints) -> Option<f64> {
+    let fixed = constraints.fixed();
+    if fixed.iter().all(Option::is_none) || !(qr.residual_dof() > 0.0 && qr.rss > 0.0) {
+        return None;
+    }
+    let e = eliminate_fixed(&qr.r, &qr.z, fixed);
+    Some(e.extra_rss / (qr.rss / qr.residual_dof()))
+}
+
+/// `sigma` with 0 for the elements fixed by equalities (their pinning rows give them a
+/// least-squares σ that stands for nothing).
+#[must_use]
+pub fn zero_fixed(mut sigma: [f64; 6], constraints: &Constraints) -> [f64; 6] {
+    for (s, v) in sigma.iter_mut().zip(constraints.fixed()) {
+        if v.is_some() {
+            *s = 0.0;
+        }
+    }
+    sigma
+}
+
 /// `true` when `constraints` carry an equality or a prior (else [`augment`] is the
 /// identity).
 #[must_use]
@@ -95,7 +124,9 @@ pub fn eliminate(qr: &RecursiveQr, constraints: &Constraints) -> RecursiveQr {
 fn reduce(qr: &RecursiveQr, fixed: &[Option<f64>; 6]) -> (RecursiveQr, f64) {
     let mut out = *qr;
     if fixed.iter().all(Option::is_none) {
-        return (out, 1.0);
+        let norm2: f64 = (0..6).map(|k| qr.r.column(k).norm_squared()).sum();
+        let scale = crate::math::sqrt(norm2 / 6.0);
+        return (out, if scale > 0.0 { scale } else { 1.0 });
     }
     let e = eliminate_fixed(&qr.r, &qr.z, fixed);
     out.r = e.r;

@@ -180,6 +180,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {
         super::uncertainty::noise_sigma(&self.solved, &self.sv, self.svd.v())
+            .map(|s| super::prior::zero_fixed(s, &self.constraints))
     }
 
     /// The least-squares state with the prior knowledge stacked on, at the last solve
@@ -216,9 +217,16 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// Whether the data so far determine J (without solving).
     #[must_use]
     pub fn observability(&self) -> Observability {
-        assess(
-            &super::prior::augment(&self.qr, &self.constraints).0,
-            self.constraints.set().has_bounds(),
+        let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
+        with_prior(
+            assess(
+                &solved,
+                self.constraints.set().has_bounds(),
+                &combined_settings(&self.settings.observability, fit.as_ref()),
+            ),
+            &self.qr,
+            fit.as_ref(),
+            &self.constraints,
             &self.settings.observability,
         )
     }
@@ -286,9 +294,11 @@ pub(crate) fn combined_settings(
     }
 }
 
-/// The status of an answer with a Gaussian prior: withdrawn when the prior and the data
-/// disagree ([`super::prior::PriorFit::conflicts`]); "determined with the prior" when
-/// the data alone (equalities eliminated) would not determine J.
+/// The status of an answer with prior knowledge: leaning on the constraint set when the
+/// data contradict its equalities ([`super::prior::equality_chi2`]); withdrawn when a
+/// Gaussian prior and the data disagree ([`super::prior::PriorFit::conflicts`]);
+/// "determined with the prior knowledge" when the data alone (without equalities or
+/// prior) would not determine J.
 pub(crate) fn with_prior(
     observability: Observability,
     data: &RecursiveQr,
@@ -296,24 +306,30 @@ pub(crate) fn with_prior(
     constraints: &Constraints,
     settings: &ObservabilitySettings,
 ) -> Observability {
-    let Some(fit) = fit else {
-        return observability;
-    };
-    if !observability.has_answer() {
+    // Equalities the data contradict: the answer leans on them (as on a bound).
+    if let (Observability::Determined { .. }, Some(chi2)) = (
+        observability,
+        super::prior::equality_chi2(data, constraints),
+    ) {
+        if chi2 > super::audit::CONFLICT_CHI2 {
+            return Observability::FromPrior(
+                super::observability::Unobservable::ConflictsWithConstraints { chi2 },
+            );
+        }
+    }
+    if !super::prior::applies(constraints) || !observability.has_answer() {
         return observability;
     }
-    if fit.conflicts() {
+    if let Some(fit) = fit.filter(|f| f.conflicts()) {
         return Observability::NotObservable(super::observability::Unobservable::PriorConflict {
             chi2: fit.chi2,
             rows: fit.rows,
         });
     }
+    // "Determined by the data" only if the data alone, without the equalities and the
+    // prior, would be.
     if let Observability::Determined { .. } = observability {
-        let alone = assess(
-            &super::prior::eliminate(data, constraints),
-            constraints.set().has_bounds(),
-            settings,
-        );
+        let alone = assess(data, constraints.set().has_bounds(), settings);
         if let Some(reason) = alone.reason() {
             return Observability::FromPrior(reason);
         }

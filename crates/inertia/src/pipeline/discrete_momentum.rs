@@ -174,13 +174,8 @@ fn discretisation_bias(
 /// its scale, and it does not do so reliably: on a pure spin with a 5 % prior its answers
 /// were 24 % off with a stated σ of 3 % (`tests/prior.rs`; the variational estimator's
 /// are right). Such an answer is withdrawn: known failure, README "Prior knowledge".
-fn scale_from_prior(e: &mut Estimate, constraints: &Constraints) {
-    if constraints.set().prior.is_some()
-        && matches!(
-            e.observability,
-            Observability::FromPrior(Unobservable::NoExcitation)
-        )
-    {
+fn scale_from_prior(e: &mut Estimate, data: &RecursiveQr, constraints: &Constraints) {
+    if constraints.set().prior.is_some() && data.y_energy == 0.0 && e.j().is_some() {
         e.observability = Observability::NotObservable(Unobservable::NoExcitation);
         e.solution = None;
         e.uncertainty = None;
@@ -580,7 +575,7 @@ impl Estimator for DiscreteMomentum {
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
         );
-        scale_from_prior(&mut e, &self.config.constraints);
+        scale_from_prior(&mut e, c.reduced(), &self.config.constraints);
         // The density describes the gyro: its rows are the ones to compare with it (with
         // an attitude better than the gyro, the attitude's rows are quieter).
         // Under forgetting the counts are discounted and the test is not made.
@@ -680,11 +675,10 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         )
         .map_err(wrap)?;
         // With prior knowledge, σ is the least-squares one of the data and the prior
-        // together (the batch jackknife's delete-one solves carry no prior).
+        // together, or the data's own jackknife σ where that is larger (the batch
+        // jackknife's delete-one solves carry no prior: conservative).
         let (solved, _) = prior::augment(&b.qr, &c.constraints);
-        let jackknife = b
-            .jackknife_sigma_kg_m2
-            .filter(|_| !prior::applies(&c.constraints));
+        let jackknife = b.jackknife_sigma_kg_m2;
         let svd = nalgebra::SVD::try_new(
             solved.r,
             false,
@@ -695,7 +689,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         let noise = svd.and_then(|svd| {
             let v_t = svd.v_t?;
             noise_sigma(&solved, &svd.singular_values, &v_t.transpose())
-                .map(|ls| robust_sigma(&ls, jackknife.as_ref()))
+                .map(|ls| robust_sigma(&prior::zero_fixed(ls, &c.constraints), jackknife.as_ref()))
         });
         Ok((e, noise))
     };
@@ -746,7 +740,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
     );
-    scale_from_prior(&mut estimate, &c.constraints);
+    scale_from_prior(&mut estimate, qr, &c.constraints);
     Ok(BatchOutput {
         estimate,
         excitation: Some(diagnose(qr, &c.observability)),
