@@ -234,20 +234,23 @@ enum PriorSigma {
 fn prior_sigma(v: &Bound<'_, PyAny>) -> PyResult<PriorSigma> {
     let bad = |x: f64| value_error(format!("prior_sigma={}: must be finite and > 0", Num(x)));
     if let Ok(s) = v.extract::<String>() {
-        let p = s
-            .trim()
-            .strip_suffix('%')
-            .and_then(|p| p.trim().parse::<f64>().ok())
-            .ok_or_else(|| {
+        // As the CLI's --prior-sigma: "5%" relative, "0.02" kg m² for every element.
+        let t = s.trim();
+        let parse = |x: &str| {
+            x.trim().parse::<f64>().map_err(|_| {
                 value_error(format!(
                     "prior_sigma={s:?}: expected a relative σ such as \"5%\", a number (kg m²) or a 3×3 matrix"
                 ))
-            })?
-            / 100.0;
-        return if p.is_finite() && p > 0.0 {
-            Ok(PriorSigma::Relative(p))
+            })
+        };
+        let (x, out): (f64, fn(f64) -> PriorSigma) = match t.strip_suffix('%') {
+            Some(p) => (parse(p)? / 100.0, PriorSigma::Relative),
+            None => (parse(t)?, |x| PriorSigma::Elements([x; 6])),
+        };
+        return if x.is_finite() && x > 0.0 {
+            Ok(out(x))
         } else {
-            Err(bad(p))
+            Err(bad(x))
         };
     }
     if let Ok(x) = v.extract::<f64>() {

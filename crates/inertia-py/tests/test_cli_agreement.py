@@ -250,3 +250,8 @@ def test_prior_matches_cli(cli, files, tmp_path, products):
     assert differences(expected, by_matrix.to_dict()) <= 1e-9
     with pytest.raises(ValueError, match="prior_sigma"):
         inertia.estimate(str(path), prior=prior)
+    # An absolute σ, as a number or as the CLI's text.
+    absolute = cli_estimate(cli, path, "--prior", str(f), "--prior-sigma", "0.02", "--products", products)
+    for sigma in (0.02, "0.02"):
+        got = inertia.estimate(str(path), prior=prior, prior_sigma=sigma, products=products)
+        assert differences(absolute, got.to_dict()) <= TOL
