@@ -310,13 +310,7 @@ fn read(path: &std::path::Path, options: CsvOptions) -> Result<Telemetry, Failur
         samples,
         lines: Some(lines),
         file: Some(reader.file().to_string()),
-        stats: Stats {
-            rows: st.rows,
-            renormalised: st.renormalised,
-            sign_flips: st.sign_flips,
-            min_step_s: st.min_step_s,
-            max_step_s: st.max_step_s,
-        },
+        stats: st,
         q_columns: reader.quaternion_columns(),
         label: reader.file().to_string(),
     })
@@ -499,6 +493,7 @@ fn restore<'py>(
             sign_flips,
             min_step_s,
             max_step_s,
+            rejected: 0,
         },
         q_columns,
         label,

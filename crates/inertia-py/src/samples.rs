@@ -70,22 +70,14 @@ impl Naming {
     }
 }
 
-/// What the reader counts ([`inertia::telemetry::csv::ReadStats`]).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Stats {
-    pub rows: usize,
-    pub renormalised: usize,
-    pub sign_flips: usize,
-    pub min_step_s: f64,
-    pub max_step_s: f64,
-}
+/// What the reader counts: the CSV reader's counts, for arrays too.
+pub type Stats = inertia::telemetry::csv::ReadStats;
 
 /// The checks that span rows.
 #[derive(Debug, Clone, Default)]
 pub struct Checker {
     pub stats: Stats,
     prev: Option<Sample>,
-    prev_step: Option<f64>,
     period: Option<f64>,
 }
 
@@ -203,16 +195,7 @@ impl Checker {
                     Some(_) => {}
                 }
             }
-            self.stats.min_step_s = if self.prev_step.is_some() {
-                self.stats.min_step_s.min(dt)
-            } else {
-                dt
-            };
-            self.stats.max_step_s = self.stats.max_step_s.max(dt);
-            self.prev_step = Some(dt);
-            if prev.q.v.dot(&q.v) + prev.q.s * q.s < 0.0 {
-                self.stats.sign_flips += 1;
-            }
+            self.stats.step(dt, &prev.q, &q);
         }
         let s = Sample {
             t_s: t,

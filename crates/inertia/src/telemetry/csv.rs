@@ -174,6 +174,28 @@ pub struct ReadStats {
     pub max_step_s: f64,
 }
 
+impl ReadStats {
+    /// Count the step of `dt` s into the next row, whose quaternion `q` follows `prev`
+    /// (before that row is counted in `rows`): the shortest and longest step, and a sign
+    /// opposite to the previous quaternion's.
+    pub fn step(
+        &mut self,
+        dt: f64,
+        prev: &crate::attitude::Quaternion,
+        q: &crate::attitude::Quaternion,
+    ) {
+        self.min_step_s = if self.rows > 1 {
+            self.min_step_s.min(dt)
+        } else {
+            dt
+        };
+        self.max_step_s = self.max_step_s.max(dt);
+        if prev.v.dot(&q.v) + prev.s * q.s < 0.0 {
+            self.sign_flips += 1;
+        }
+    }
+}
+
 /// What is wrong, where.
 #[derive(Debug, thiserror::Error)]
 pub enum TelemetryError {
@@ -357,7 +379,6 @@ pub struct TelemetryReader<R: Read> {
     headers: Vec<String>,
     stats: ReadStats,
     prev: Option<Sample>,
-    prev_step: Option<f64>,
     period: Option<f64>,
     /// For ISO time stamps: the first row's (seconds, nanoseconds) on the clock's scale.
     time_origin: Option<(i64, i64)>,
@@ -441,7 +462,6 @@ impl<R: Read> TelemetryReader<R> {
             headers,
             stats: ReadStats::default(),
             prev: None,
-            prev_step: None,
             period: None,
             time_origin: None,
             clock: Clock::default(),
@@ -678,16 +698,7 @@ impl<R: Read> TelemetryReader<R> {
                     }
                 }
             }
-            self.stats.min_step_s = if self.prev_step.is_some() {
-                self.stats.min_step_s.min(dt)
-            } else {
-                dt
-            };
-            self.stats.max_step_s = self.stats.max_step_s.max(dt);
-            self.prev_step = Some(dt);
-            if prev.q.v.dot(&q.v) + prev.q.s * q.s < 0.0 {
-                self.stats.sign_flips += 1;
-            }
+            self.stats.step(dt, &prev.q, &q);
         }
         Ok(Sample {
             t_s: t,
