@@ -11,6 +11,7 @@ use inertia::estimator::EstimatorError;
 use inertia::pipeline::report::{InputSummary, Report};
 use inertia::pipeline::{self, Pipeline, PipelineConfig, PipelineError};
 use inertia::telemetry::csv::TelemetryReader;
+use inertia::telemetry::read_ahead::ReadAhead;
 use inertia::text::Num;
 use std::collections::VecDeque;
 use std::io::{IsTerminal, Read};
@@ -21,9 +22,9 @@ const RECENT: usize = 8;
 use inertia::pipeline::MAX_RESAMPLE_FACTOR;
 
 /// The telemetry: a file, or standard input for `-`.
-fn open(path: &std::path::Path) -> Result<(Box<dyn Read>, String), CliError> {
+fn open(path: &std::path::Path) -> Result<(Box<dyn Read + Send>, String), CliError> {
     if is_stdio(path) {
-        return Ok((Box::new(std::io::stdin().lock()), "<stdin>".into()));
+        return Ok((Box::new(std::io::stdin()), "<stdin>".into()));
     }
     let f = std::fs::File::open(path).map_err(|e| read_failed(path, e))?;
     Ok((Box::new(f), path.display().to_string()))
@@ -80,7 +81,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
     let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
     let (source, name) = open(&a.file)?;
-    let mut reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
+    let reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
     let file = reader.file().to_string();
     let entry = config.estimator();
     if entry.capabilities.needs_gyro && !reader.has_gyro() {
@@ -90,6 +91,8 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         )));
     }
     let q_columns = reader.quaternion_columns();
+    // Parsing overlaps the estimator.
+    let mut reader = ReadAhead::new(reader);
     // An error of the estimator, tied to the line of the sample that caused it.
     let data_error = |e: PipelineError, line: Option<u64>| {
         let at = line.map_or_else(|| format!("{file}:"), |l| format!("{file}:{l}:"));
@@ -197,7 +200,9 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     if let Some(h) = history {
         h.finish()?;
     }
-    let stats = reader.stats();
+    let stats = reader
+        .finish()
+        .ok_or_else(|| internal("the telemetry reader thread failed"))?;
     let Some(report) = report else {
         let need = if entry.capabilities.needs_gyro && !entry.capabilities.constraints {
             2

@@ -1,18 +1,19 @@
 //! The estimate history file (`-o`): the library's CSV history
-//! ([`inertia::pipeline::history`]) written to a file, put in place only when the run
-//! succeeds ([`crate::output::Pending`]).
+//! ([`inertia::pipeline::history`]) written to a file on its own thread
+//! ([`WriteBehind`]), put in place only when the run succeeds
+//! ([`crate::output::Pending`]).
 
 use crate::error::{write_failed, CliError};
 use crate::output::Pending;
 use inertia::estimator::Estimate;
-use inertia::pipeline::history::HistoryWriter;
+use inertia::pipeline::history::WriteBehind;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
 /// A history file being written.
 pub struct HistoryFile {
-    w: HistoryWriter<BufWriter<File>>,
+    w: WriteBehind<BufWriter<File>>,
     pending: Pending,
 }
 
@@ -20,7 +21,7 @@ impl HistoryFile {
     /// Create the (temporary) file and write the header.
     pub fn create(path: &Path) -> Result<Self, CliError> {
         let (pending, f) = Pending::create(path)?;
-        let w = HistoryWriter::new(f).map_err(|e| write_failed(path, e))?;
+        let w = WriteBehind::new(f).map_err(|e| write_failed(path, e))?;
         Ok(Self { w, pending })
     }
 

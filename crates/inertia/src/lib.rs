@@ -92,6 +92,7 @@ pub mod dynamics;
 mod eigen3;
 pub mod estimator;
 mod givens;
+mod householder;
 mod math;
 #[cfg(feature = "std")]
 pub mod pipeline;

@@ -132,6 +132,9 @@ pub struct ResidualSegments {
     last_rss: f64,
     last_dof: f64,
     latest: Option<Snapshot>,
+    /// [`Self::worst`] of the complete segments, kept up to date as they change (the
+    /// spans change only when a segment completes, while the test runs at every solve).
+    worst: Option<Worst>,
 }
 
 impl Default for ResidualSegments {
@@ -152,6 +155,7 @@ impl ResidualSegments {
             last_rss: 0.0,
             last_dof: 0.0,
             latest: None,
+            worst: None,
         }
     }
 
@@ -187,6 +191,10 @@ impl ResidualSegments {
         self.done[self.len] = self.open;
         self.len += 1;
         self.open = Segment::open();
+        self.worst = self
+            .spans()
+            .map(|s| s.worst)
+            .max_by(|a, b| a.ratio.total_cmp(&b.ratio));
     }
 
     /// Note an answer (determined, or leaning on the prior) and its stated σ per element
@@ -256,9 +264,7 @@ impl ResidualSegments {
     /// The span that stands out most, with at least [`MIN_SEGMENTS`] complete segments.
     #[must_use]
     pub fn worst(&self) -> Option<Worst> {
-        self.spans()
-            .map(|s| s.worst)
-            .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
+        self.worst
     }
 
     /// The most distinct span beyond [`INCONSISTENT_RATIO`] that moved the answer `j` by
@@ -267,6 +273,11 @@ impl ResidualSegments {
     /// honest residuals of unequal size (module docs).
     #[must_use]
     pub fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
+        // No span beyond the ratio: nothing to compare (the common case, without a pass
+        // over the spans at every solve).
+        if !self.worst.is_some_and(|w| w.ratio > INCONSISTENT_RATIO) {
+            return None;
+        }
         self.spans()
             .filter(|s| s.worst.ratio > INCONSISTENT_RATIO)
             .filter(|s| s.reference.is_some_and(|r| shift_z(j, &r) > SHIFT_Z))
@@ -423,5 +434,20 @@ mod tests {
         let r = white(300, 1.0, Some((100, 1e6)));
         assert!(r.segments() < MIN_SEGMENTS);
         assert!(r.worst().is_none());
+    }
+
+    #[test]
+    fn the_kept_worst_span_is_the_worst_of_all_spans() {
+        // Through merges (50,000 rows is beyond 32 segments of 60 dof) and a spike.
+        for spike in [None, Some((20_000, 1e7))] {
+            for n in [400, 3_000, 20_500, 50_000] {
+                let r = white(n, 1.0, spike);
+                let fresh = r
+                    .spans()
+                    .map(|s| s.worst)
+                    .max_by(|a, b| a.ratio.total_cmp(&b.ratio));
+                assert_eq!(r.worst(), fresh, "n {n}, spike {spike:?}");
+            }
+        }
     }
 }

@@ -137,6 +137,97 @@ impl<W: Write> Drop for HistoryWriter<W> {
     }
 }
 
+/// Estimates handed to the writer thread at a time.
+pub const BEHIND_BATCH: usize = 256;
+
+/// A [`HistoryWriter`] on its own thread: formatting the numbers (about a tenth of a
+/// long run) overlaps the estimator. Estimates are handed over in batches of
+/// [`BEHIND_BATCH`] through a bounded channel, so memory stays fixed. The output is the
+/// same byte for byte; a write error stops the thread and is returned by the next
+/// [`Self::write`] or by [`Self::finish`].
+pub struct WriteBehind<W: Write + Send + 'static> {
+    batch: std::vec::Vec<Estimate>,
+    to_writer: Option<std::sync::mpsc::SyncSender<std::vec::Vec<Estimate>>>,
+    thread: Option<std::thread::JoinHandle<Result<W, csv::Error>>>,
+}
+
+impl<W: Write + Send + 'static> WriteBehind<W> {
+    /// Start a writer thread on `out` (the header is written at once).
+    pub fn new(out: W) -> Result<Self, csv::Error> {
+        let mut w = HistoryWriter::new(out)?;
+        let (tx, rx) = std::sync::mpsc::sync_channel::<std::vec::Vec<Estimate>>(8);
+        let thread = std::thread::spawn(move || {
+            for batch in rx {
+                for e in &batch {
+                    w.write(e)?;
+                }
+            }
+            w.finish()
+        });
+        Ok(Self {
+            batch: std::vec::Vec::with_capacity(BEHIND_BATCH),
+            to_writer: Some(tx),
+            thread: Some(thread),
+        })
+    }
+
+    /// Append one estimate.
+    pub fn write(&mut self, e: &Estimate) -> Result<(), csv::Error> {
+        self.batch.push(*e);
+        if self.batch.len() < BEHIND_BATCH {
+            return Ok(());
+        }
+        let full = core::mem::replace(&mut self.batch, std::vec::Vec::with_capacity(BEHIND_BATCH));
+        let sent = self
+            .to_writer
+            .as_ref()
+            .is_some_and(|tx| tx.send(full).is_ok());
+        if sent {
+            Ok(())
+        } else {
+            // The thread stopped at a write error: return it.
+            self.join().map(|_| ())
+        }
+    }
+
+    /// Write what is pending, flush, and return the writer.
+    pub fn finish(mut self) -> Result<W, csv::Error> {
+        if !self.batch.is_empty() {
+            let rest = core::mem::take(&mut self.batch);
+            if let Some(tx) = &self.to_writer {
+                // A closed channel: the thread's error is returned below.
+                let _ = tx.send(rest);
+            }
+        }
+        self.join()
+    }
+
+    /// Close the channel and wait for the thread.
+    fn join(&mut self) -> Result<W, csv::Error> {
+        self.to_writer = None;
+        let gone = || csv::Error::from(std::io::Error::other("history writer already finished"));
+        match self.thread.take().ok_or_else(gone)?.join() {
+            Ok(result) => result,
+            Err(_) => Err(csv::Error::from(std::io::Error::other(
+                "the history writer thread failed",
+            ))),
+        }
+    }
+}
+
+impl<W: Write + Send + 'static> Drop for WriteBehind<W> {
+    /// Hand what is pending to the writer and wait for it (errors are lost: call
+    /// [`Self::finish`] to see them), as [`HistoryWriter`] does when dropped.
+    fn drop(&mut self) {
+        if self.thread.is_some() {
+            if let Some(tx) = &self.to_writer {
+                let _ = tx.send(core::mem::take(&mut self.batch));
+            }
+            let _ = self.join();
+        }
+    }
+}
+
 /// A field as the `csv` crate's default writer forms it: quoted, with quotes doubled,
 /// when it holds a delimiter, a quote or a line break.
 fn push_quoted(line: &mut std::vec::Vec<u8>, field: &[u8]) {
@@ -285,5 +376,60 @@ mod tests {
         push_quoted(&mut line, b"a, b");
         push_quoted(&mut line, b"say \"x\"");
         assert_eq!(line, b"plain: text\"a, b\"\"say \"\"x\"\"\"");
+    }
+
+    /// The thread's output is the same file, across batches and with a partial last one.
+    #[test]
+    fn written_behind_is_the_same_file() {
+        let base = estimates();
+        for n in [0, 1, BEHIND_BATCH, 3 * BEHIND_BATCH + 5] {
+            let all: std::vec::Vec<Estimate> = base.iter().cycle().take(n).copied().collect();
+            let mut w = WriteBehind::new(std::vec::Vec::new()).unwrap();
+            for e in &all {
+                w.write(e).unwrap();
+            }
+            assert_eq!(w.finish().unwrap(), reference(&all), "{n} estimates");
+        }
+    }
+
+    /// A writer that fails after `ok` bytes.
+    #[derive(Debug)]
+    struct Failing {
+        ok: usize,
+    }
+
+    impl Write for Failing {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            if buf.len() > self.ok {
+                return Err(std::io::Error::other("disk full"));
+            }
+            self.ok -= buf.len();
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    /// A write error on the thread reaches the caller, from `write` or from `finish`.
+    #[test]
+    fn a_write_error_behind_is_returned() {
+        let base = estimates();
+        let mut w = WriteBehind::new(Failing { ok: 10 * CHUNK }).unwrap();
+        let mut failed = None;
+        for (k, e) in base.iter().cycle().take(200 * BEHIND_BATCH).enumerate() {
+            if let Err(err) = w.write(e) {
+                failed = Some((k, err));
+                break;
+            }
+        }
+        let (k, err) = failed.expect("the error reaches write");
+        assert!(
+            k < 200 * BEHIND_BATCH && err.to_string().contains("disk full"),
+            "{err}"
+        );
+        let mut w = WriteBehind::new(Failing { ok: 100 }).unwrap();
+        w.write(&base[0]).unwrap();
+        assert!(w.finish().unwrap_err().to_string().contains("disk full"));
     }
 }

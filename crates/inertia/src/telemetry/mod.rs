@@ -10,4 +10,6 @@ pub mod glitch;
 #[cfg(feature = "csv")]
 mod line_cap;
 #[cfg(feature = "csv")]
+pub mod read_ahead;
+#[cfg(feature = "csv")]
 pub mod time_stamp;
