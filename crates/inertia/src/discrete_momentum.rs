@@ -49,6 +49,8 @@ pub struct IntervalMomentum {
     pub a: Matrix3x6<f64>,
     /// `−C N(φ) ρ̄`, N m s.
     pub b: Vector3<f64>,
+    /// `C N(φ)`, the rotor momentum's coefficient ([`Self::rotor`]).
+    pub cn: Matrix3<f64>,
 }
 
 impl IntervalMomentum {
@@ -60,7 +62,14 @@ impl IntervalMomentum {
         Self {
             a: cn * g_matrix(phi) * (2.0 / h_s),
             b: -(cn * rho_bar_nms),
+            cn,
         }
+    }
+
+    /// `b` of the same interval for another rotor momentum `ρ̄` (N m s): `−C N(φ) ρ̄`.
+    #[must_use]
+    pub fn rotor(&self, rho_bar_nms: &Vector3<f64>) -> Vector3<f64> {
+        -(self.cn * rho_bar_nms)
     }
 
     /// `L = a j − b` for a given `j`, N m s.

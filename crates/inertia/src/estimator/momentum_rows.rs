@@ -257,7 +257,8 @@ pub struct AugmentedRow {
 /// A plain row's parts, kept for the Richardson combination.
 #[derive(Debug, Clone, Copy)]
 struct Plain {
-    a: Matrix3x6<f64>,
+    /// The interval's momentum coefficients (`a` the row's in `j`).
+    m: IntervalMomentum,
     /// `b_k + T_k`.
     rhs: Vector3<f64>,
     /// `S_k`.
@@ -449,7 +450,7 @@ impl MomentumRows {
         }
         let m = IntervalMomentum::new(&b.c, &f.v, &(0.5 * (b.rho_nms + node.rho_nms)), h);
         let plain = Plain {
-            a: m.a,
+            m,
             rhs: m.b + self.t,
             s: self.s,
         };
@@ -461,7 +462,7 @@ impl MomentumRows {
         let prev = self.prev.replace(plain);
         if !self.settings.stencil.richardson() {
             return Ok(Some(self.assemble(
-                &plain.a,
+                &plain.m.a,
                 &plain.rhs,
                 &plain.s,
                 ANCHOR0,
@@ -472,7 +473,6 @@ impl MomentumRows {
         let (Some(prev), Some(cm1)) = (prev, self.nodes[0]) else {
             return Ok(None);
         };
-        let prev_phi = f_prev.v;
         let f2 = f_prev.mul(&f).positive_scalar();
         check_phi(&f2.v, cm1.t_s, node.t_s).inspect_err(|_| self.restart(Some(node)))?;
         // Index of c−1 in the chain: count − 3.
@@ -496,7 +496,7 @@ impl MomentumRows {
         };
         let m2 = IntervalMomentum::new(&cm1.c, &f2.v, &rho2, h2);
         let (w, v) = (2.0 / 3.0, 1.0 / 3.0);
-        let a = (prev.a + plain.a) * w - m2.a * v;
+        let a = (prev.m.a + plain.m.a) * w - m2.a * v;
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
@@ -511,11 +511,8 @@ impl MomentumRows {
             let hbar = 0.5 * (h0 + h1);
             let d2 =
                 (node.rho_nms - b.rho_nms) * (hbar / h1) - (b.rho_nms - cm1.rho_nms) * (hbar / h0);
-            let b_of = |c: &Matrix3<f64>, phi: &Vector3<f64>, h: f64| {
-                IntervalMomentum::new(c, phi, &d2, h).b
-            };
-            let col = (b_of(&cm1.c, &prev_phi, h0) + b_of(&b.c, &f.v, h1)) * w
-                - b_of(&cm1.c, &f2.v, h2) * v;
+            // The three intervals' `C N(φ)`, as computed above.
+            let col = (prev.m.rotor(&d2) + plain.m.rotor(&d2)) * w - m2.rotor(&d2) * v;
             for i in 0..3 {
                 row.a[(i, KAPPA)] = -col[i];
             }
