@@ -3,7 +3,9 @@
 //!
 //! The wheel momentum between samples is estimated with `j` by default
 //! ([`Stencil::Adaptive`]). Where the settings leave a choice open (the rotation source
-//! when the telemetry has gyro rates, and the chain length: `--chain` and 4× as long),
+//! when the telemetry has gyro rates, and the chain length: `--chain`, 4× as long, and
+//! the whole record as one chain, whose σ comes from its short sibling's jackknife:
+//! [`short_sibling`]),
 //! every candidate row model folds every sample, and each solve uses the candidate
 //! [`choose`] picks: of those whose residual variance `ρ²/(rows − unknowns)` the data
 //! cannot tell from the smallest, the one with the longest chains (a noisier rotation
@@ -74,9 +76,10 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
         RhoModel::Smooth => &[Stencil::Smooth],
         RhoModel::Auto => &[Stencil::Adaptive],
     };
-    // A short and a long chain: the data choose ([`choose`]).
+    // Short chains, long ones, and the whole record as one chain: the data choose
+    // ([`choose`]).
     let chains: Vec<Option<f64>> = match c.max_chain_s {
-        Some(l) => std::vec![Some(l), Some(LONG_CHAIN_FACTOR * l)],
+        Some(l) => std::vec![Some(l), Some(LONG_CHAIN_FACTOR * l), None],
         None => std::vec![None],
     };
     let mut out = Vec::new();
@@ -97,6 +100,28 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
 
 /// The long chain's length, in short chains.
 pub(crate) const LONG_CHAIN_FACTOR: f64 = 4.0;
+
+/// For a candidate that holds the whole record as one chain, the candidate with the
+/// same rows in short chains. One chain is one jackknife group, so the whole record has
+/// no jackknife σ of its own; its noise σ is element by element the larger of its
+/// least-squares σ and the sibling's jackknife σ ([`DiscreteMomentum::noise_sigma`]),
+/// which sees the correlated errors the least-squares σ does not. The chooser takes the
+/// whole record only where the data cannot tell it from the short chains; the short
+/// chains' estimate has more nuisance unknowns in the same rows, so its σ bounds the
+/// whole record's from above, and the difference of the two answers joins the bias
+/// through the model spread. `None` for a candidate with chains, or without such a
+/// sibling (`--chain 0`: every candidate is one chain, and σ is its own).
+fn short_sibling<'a>(
+    rows: &MomentumRowSettings,
+    all: impl Iterator<Item = &'a MomentumRowSettings>,
+) -> Option<usize> {
+    if rows.max_chain_s.is_some() {
+        return None;
+    }
+    all.into_iter().position(|r| {
+        r.max_chain_s.is_some() && r.rotation == rows.rotation && r.stencil == rows.stencil
+    })
+}
 
 fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorSettings {
     MomentumEstimatorSettings {
@@ -384,6 +409,15 @@ impl DiscreteMomentum {
                 backend,
             )?);
         }
+        // A whole-record candidate's σ comes from its sibling's jackknife: its own chain
+        // groups would hold one chain.
+        let rows: Vec<MomentumRowSettings> =
+            self.candidates.iter().map(|c| *c.row_settings()).collect();
+        for (c, r) in self.candidates.iter_mut().zip(&rows) {
+            if short_sibling(r, rows.iter()).is_some() {
+                c.stop_jackknife();
+            }
+        }
         if self.config.uncertainty {
             if let Some(first) = self.candidates.first() {
                 let mut shadow = DiscreteMomentumEstimator::new(
@@ -445,9 +479,9 @@ impl DiscreteMomentum {
             .candidates
             .get(self.chosen)
             .map_or(f64::INFINITY, |c| c.qr().residual_variance());
-        let others = &mut self.others;
-        others.clear();
-        for (i, (c, check)) in self.candidates.iter_mut().zip(&mut self.checks).enumerate() {
+        self.others.clear();
+        for i in 0..self.candidates.len() {
+            let c = &self.candidates[i];
             if i == self.chosen
                 || !self.standing.live(i)
                 || c.qr().rows() < 6
@@ -455,22 +489,36 @@ impl DiscreteMomentum {
             {
                 continue;
             }
-            let stale = check.is_none_or(|k| k.age >= CROSS_CHECK_EVERY);
+            let stale = self.checks[i].is_none_or(|k| k.age >= CROSS_CHECK_EVERY);
             if stale {
-                let own = c.solve_now(t_s)?;
-                *check = match (own.observability, own.j(), c.robust_noise_sigma()) {
+                let own = self.candidates[i].solve_now(t_s)?;
+                self.checks[i] = match (own.observability, own.j(), self.noise_sigma(i)) {
                     (Observability::Determined { .. }, Some(j), Some(sigma)) => {
                         Some(CrossCheck { j, sigma, age: 0 })
                     }
                     _ => None,
                 };
             }
-            if let Some(k) = check {
-                others.push((k.j, k.sigma));
+            if let Some(k) = self.checks[i] {
+                self.others.push((k.j, k.sigma));
             }
         }
-        reconcile(e, others, self.config.observability.max_relative_sigma);
+        reconcile(
+            e,
+            &self.others,
+            self.config.observability.max_relative_sigma,
+        );
         Ok(())
+    }
+
+    /// Candidate `i`'s noise σ at its last solve: its own, and for the whole record as one
+    /// chain at least its short-chain sibling's jackknife σ ([`short_sibling`]).
+    fn noise_sigma(&mut self, i: usize) -> Option<[f64; 6]> {
+        let rows = *self.candidates.get(i)?.row_settings();
+        let sibling = short_sibling(&rows, self.candidates.iter().map(|c| c.row_settings()));
+        let own = self.candidates[i].robust_noise_sigma()?;
+        let jackknife = sibling.and_then(|k| self.candidates[k].jackknife_sigma());
+        Some(robust_sigma(&own, jackknife.as_ref()))
     }
 }
 
@@ -536,8 +584,8 @@ impl Estimator for DiscreteMomentum {
         }
         self.since_solve = 0;
         let mut e = c.solve_now(s.t_s)?;
-        let noise = c.robust_noise_sigma();
         let best = *c.reduced();
+        let noise = self.noise_sigma(self.chosen);
         if self.config.uncertainty {
             if let (Some(j), Some(noise)) = (e.j(), noise) {
                 let others = self
@@ -663,8 +711,12 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     let qr = &batch.qr;
     let mut backend = registry::build_backend(c.backend);
     let t_s = samples.last().map_or(0.0, |s| s.t_s);
-    // One candidate's own answer and noise σ.
-    let mut own = |b: &BatchReduction| -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+    // One candidate's own answer and noise σ (for the whole record as one chain, at
+    // least its short-chain sibling's jackknife σ: [`short_sibling`]).
+    let mut own = |i: usize| -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+        let (rows, b) = &reduced[i];
+        let sibling = short_sibling(rows, reduced.iter().map(|(r, _)| r))
+            .and_then(|k| reduced[k].1.jackknife_sigma_kg_m2);
         let e = batch::solve_reduced(
             &b.qr,
             t_s,
@@ -679,6 +731,10 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         // jackknife's delete-one solves carry no prior: conservative).
         let (solved, _) = prior::augment(&b.qr, &c.constraints);
         let jackknife = b.jackknife_sigma_kg_m2;
+        let jackknife = match (jackknife, sibling) {
+            (Some(a), Some(b)) => Some(core::array::from_fn(|k| a[k].max(b[k]))),
+            (a, b) => a.or(b),
+        };
         let svd = nalgebra::SVD::try_new(
             solved.r,
             false,
@@ -693,7 +749,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         });
         Ok((e, noise))
     };
-    let (mut estimate, noise) = own(batch)?;
+    let (mut estimate, noise) = own(chosen)?;
     if c.uncertainty {
         if let (Some(j), Some(noise)) = (estimate.j(), noise) {
             let others = reduced
@@ -725,7 +781,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
                 {
                     continue;
                 }
-                if let (e, Some(sigma)) = own(b)? {
+                if let (e, Some(sigma)) = own(i)? {
                     if let (Observability::Determined { .. }, Some(jb)) = (e.observability, e.j()) {
                         others.push((jb, sigma));
                     }
@@ -784,11 +840,112 @@ mod tests {
                 answers += usize::from(a.and_then(|e| e.j()).is_some());
             }
             assert!(answers > 1000);
-            assert_eq!(pruned.candidates.len(), 4);
-            assert!(
-                pruned.standing.live(0) && !pruned.standing.live(1) && !pruned.standing.live(3)
-            );
-            assert!((0..4).all(|i| full.standing.live(i)));
+            // Gyro and attitude rotations, each in short, long and whole-record chains.
+            assert_eq!(pruned.candidates.len(), 6);
+            assert!(pruned.standing.live(0));
+            assert!([1, 3, 5].iter().all(|&i| !pruned.standing.live(i)));
+            assert!((0..6).all(|i| full.standing.live(i)));
+        }
+    }
+
+    #[test]
+    fn a_whole_record_candidate_has_a_short_sibling_and_no_other() {
+        let config = PipelineSettings::default().validate().unwrap();
+        let all = candidates(&config, true);
+        assert_eq!(all.len(), 6);
+        for (i, rows) in all.iter().enumerate() {
+            match short_sibling(rows, all.iter()) {
+                Some(k) => {
+                    assert!(rows.max_chain_s.is_none(), "{i}");
+                    let sibling = all[k];
+                    assert_eq!(sibling.max_chain_s, config.max_chain_s);
+                    assert_eq!(sibling.rotation, rows.rotation);
+                }
+                None => assert!(rows.max_chain_s.is_some(), "{i}"),
+            }
+        }
+        // `--chain 0`: every candidate is one chain, with no sibling.
+        let unchained = PipelineSettings {
+            estimator: "discrete-momentum".into(),
+            max_chain_s: None,
+            ..PipelineSettings::default()
+        }
+        .validate()
+        .unwrap();
+        let all = candidates(&unchained, true);
+        assert_eq!(all.len(), 2);
+        assert!(all.iter().all(|r| short_sibling(r, all.iter()).is_none()));
+    }
+
+    /// Where nothing drifts (true attitude, 1 Hz slew: the short chains' anchors only
+    /// cost information), the whole record is chosen, is closer than the short chains'
+    /// answer, and its σ is at least the short sibling's jackknife σ and covers the
+    /// truth; where the attitude drifts (spin, attitude propagated from a FOG-grade
+    /// gyro), the whole record fits worse and is not chosen.
+    #[test]
+    fn the_whole_record_is_chosen_where_nothing_drifts() {
+        let config = PipelineSettings::default().validate().unwrap();
+        let run_of = |scenario: Scenario, realism: Realism, seed: u64| {
+            let common = Common {
+                seed,
+                realism,
+                ..Common::paper()
+            };
+            scenario.simulate(&common).unwrap()
+        };
+        let one_hz = Realism {
+            attitude: AttitudeSource::Truth,
+            telemetry_every: 10,
+            ..Realism::default()
+        };
+        let mut chosen_whole = 0;
+        for seed in 1..=4 {
+            let run = run_of(Scenario::slew(), one_hz, seed);
+            let mut p = DiscreteMomentum::new(&config).unwrap();
+            let mut last = None;
+            for s in &run.samples {
+                last = p.push(s).unwrap().or(last);
+            }
+            let e = last.expect("an answer");
+            let chosen = *p.candidates[p.chosen].row_settings();
+            if chosen.max_chain_s.is_some() {
+                continue;
+            }
+            chosen_whole += 1;
+            let truth = crate::tensor::j_from_matrix(&run.inertia_kg_m2);
+            let (j, sigma) = (e.j().unwrap(), e.sigma_kg_m2().unwrap());
+            let sibling = short_sibling(&chosen, p.candidates.iter().map(|c| c.row_settings()))
+                .expect("a sibling");
+            let short = p.candidates[sibling].solve_now(e.t_s).unwrap().j().unwrap();
+            let jackknife = p.candidates[sibling].jackknife_sigma().expect("jackknife");
+            assert!((j - truth).norm() < (short - truth).norm(), "seed {seed}");
+            for k in 0..6 {
+                assert!(sigma[k] >= jackknife[k], "seed {seed}, element {k}");
+                assert!(
+                    (j[k] - truth[k]).abs() <= 3.0 * sigma[k],
+                    "seed {seed}, element {k}"
+                );
+            }
+        }
+        assert!(chosen_whole >= 3, "{chosen_whole} of 4 seeds");
+        let fog = Realism {
+            attitude: AttitudeSource::GyroPropagated,
+            ..Realism::default()
+        };
+        for seed in 1..=2 {
+            let mut common = Common {
+                seed,
+                realism: fog,
+                ..Common::paper()
+            };
+            common.gyro_noise_deg_s_rthz = 3.3e-4;
+            let run = Scenario::spin().simulate(&common).unwrap();
+            let mut p = DiscreteMomentum::new(&config).unwrap();
+            for s in &run.samples {
+                p.push(s).unwrap();
+            }
+            let chosen = p.candidates[p.chosen].row_settings();
+            assert!(chosen.max_chain_s.is_some(), "seed {seed}: {chosen:?}");
         }
     }
 }
