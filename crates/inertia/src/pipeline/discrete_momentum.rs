@@ -4,8 +4,8 @@
 //! The wheel momentum between samples is estimated with `j` by default
 //! ([`Stencil::Adaptive`]). Where the settings leave a choice open (the rotation source
 //! when the telemetry has gyro rates, and the chain length: `--chain`, 4× as long, and
-//! the whole record as one chain, whose σ comes from its short sibling's jackknife:
-//! [`short_sibling`]),
+//! the whole record as one chain, whose σ comes from its chained siblings' jackknife:
+//! [`chained_siblings`]),
 //! every candidate row model folds every sample, and each solve uses the candidate
 //! [`choose`] picks: of those whose residual variance `ρ²/(rows − unknowns)` the data
 //! cannot tell from the smallest, the one with the longest chains (a noisier rotation
@@ -101,26 +101,35 @@ fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowSettings> {
 /// The long chain's length, in short chains.
 pub(crate) const LONG_CHAIN_FACTOR: f64 = 4.0;
 
-/// For a candidate that holds the whole record as one chain, the candidate with the
-/// same rows in short chains. One chain is one jackknife group, so the whole record has
-/// no jackknife σ of its own; its noise σ is element by element the larger of its
-/// least-squares σ and the sibling's jackknife σ ([`DiscreteMomentum::noise_sigma`]),
-/// which sees the correlated errors the least-squares σ does not. The chooser takes the
-/// whole record only where the data cannot tell it from the short chains; the short
-/// chains' estimate has more nuisance unknowns in the same rows, so its σ bounds the
-/// whole record's from above, and the difference of the two answers joins the bias
-/// through the model spread. `None` for a candidate with chains, or without such a
-/// sibling (`--chain 0`: every candidate is one chain, and σ is its own).
-fn short_sibling<'a>(
-    rows: &MomentumRowSettings,
-    all: impl Iterator<Item = &'a MomentumRowSettings>,
-) -> Option<usize> {
-    if rows.max_chain_s.is_some() {
-        return None;
-    }
-    all.into_iter().position(|r| {
-        r.max_chain_s.is_some() && r.rotation == rows.rotation && r.stencil == rows.stencil
-    })
+/// For a candidate that holds the whole record as one chain, the candidates with the
+/// same rows in chains (short and long). One chain is one jackknife group, so the whole
+/// record has no jackknife σ of its own; its noise σ is element by element the largest of
+/// its least-squares σ and its chained siblings' jackknife σ ([`sibling_jackknife`]),
+/// which see the correlated errors the least-squares σ does not. The chooser takes the
+/// whole record only where the data cannot tell it from the chains; a chained estimate
+/// has more nuisance unknowns in the same rows, so its σ bounds the whole record's from
+/// above, and the difference of the answers joins the bias through the model spread.
+/// Empty for a candidate with chains, and without chained candidates (`--chain 0`: every
+/// candidate is one chain, and σ is its own).
+fn chained_siblings<'a>(
+    rows: &'a MomentumRowSettings,
+    all: impl Iterator<Item = &'a MomentumRowSettings> + 'a,
+) -> impl Iterator<Item = usize> + 'a {
+    all.enumerate()
+        .filter(move |(_, r)| {
+            rows.max_chain_s.is_none()
+                && r.max_chain_s.is_some()
+                && r.rotation == rows.rotation
+                && r.stencil == rows.stencil
+        })
+        .map(|(k, _)| k)
+}
+
+/// Element by element the largest of the jackknife σ given (`None`: none).
+fn sibling_jackknife(sigmas: impl Iterator<Item = Option<[f64; 6]>>) -> Option<[f64; 6]> {
+    sigmas
+        .flatten()
+        .reduce(|a, b| core::array::from_fn(|k| a[k].max(b[k])))
 }
 
 fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> MomentumEstimatorSettings {
@@ -414,7 +423,7 @@ impl DiscreteMomentum {
         let rows: Vec<MomentumRowSettings> =
             self.candidates.iter().map(|c| *c.row_settings()).collect();
         for (c, r) in self.candidates.iter_mut().zip(&rows) {
-            if short_sibling(r, rows.iter()).is_some() {
+            if chained_siblings(r, rows.iter()).next().is_some() {
                 c.stop_jackknife();
             }
         }
@@ -512,12 +521,17 @@ impl DiscreteMomentum {
     }
 
     /// Candidate `i`'s noise σ at its last solve: its own, and for the whole record as one
-    /// chain at least its short-chain sibling's jackknife σ ([`short_sibling`]).
+    /// chain at least its chained siblings' jackknife σ ([`chained_siblings`]).
     fn noise_sigma(&mut self, i: usize) -> Option<[f64; 6]> {
         let rows = *self.candidates.get(i)?.row_settings();
-        let sibling = short_sibling(&rows, self.candidates.iter().map(|c| c.row_settings()));
+        let siblings: Vec<usize> =
+            chained_siblings(&rows, self.candidates.iter().map(|c| c.row_settings())).collect();
         let own = self.candidates[i].robust_noise_sigma()?;
-        let jackknife = sibling.and_then(|k| self.candidates[k].jackknife_sigma());
+        let jackknife = sibling_jackknife(
+            siblings
+                .iter()
+                .map(|&k| self.candidates[k].jackknife_sigma()),
+        );
         Some(robust_sigma(&own, jackknife.as_ref()))
     }
 }
@@ -712,11 +726,13 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     let mut backend = registry::build_backend(c.backend);
     let t_s = samples.last().map_or(0.0, |s| s.t_s);
     // One candidate's own answer and noise σ (for the whole record as one chain, at
-    // least its short-chain sibling's jackknife σ: [`short_sibling`]).
+    // least its chained siblings' jackknife σ: [`chained_siblings`]).
     let mut own = |i: usize| -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
         let (rows, b) = &reduced[i];
-        let sibling = short_sibling(rows, reduced.iter().map(|(r, _)| r))
-            .and_then(|k| reduced[k].1.jackknife_sigma_kg_m2);
+        let sibling = sibling_jackknife(
+            chained_siblings(rows, reduced.iter().map(|(r, _)| r))
+                .map(|k| reduced[k].1.jackknife_sigma_kg_m2),
+        );
         let e = batch::solve_reduced(
             &b.qr,
             t_s,
@@ -730,11 +746,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         // together, or the data's own jackknife σ where that is larger (the batch
         // jackknife's delete-one solves carry no prior: conservative).
         let (solved, _) = prior::augment(&b.qr, &c.constraints);
-        let jackknife = b.jackknife_sigma_kg_m2;
-        let jackknife = match (jackknife, sibling) {
-            (Some(a), Some(b)) => Some(core::array::from_fn(|k| a[k].max(b[k]))),
-            (a, b) => a.or(b),
-        };
+        let jackknife = sibling_jackknife([b.jackknife_sigma_kg_m2, sibling].into_iter());
         let svd = nalgebra::SVD::try_new(
             solved.r,
             false,
@@ -849,21 +861,32 @@ mod tests {
     }
 
     #[test]
-    fn a_whole_record_candidate_has_a_short_sibling_and_no_other() {
+    fn a_whole_record_candidate_has_two_chained_siblings_and_others_none() {
         let config = PipelineSettings::default().validate().unwrap();
         let all = candidates(&config, true);
         assert_eq!(all.len(), 6);
         for (i, rows) in all.iter().enumerate() {
-            match short_sibling(rows, all.iter()) {
-                Some(k) => {
-                    assert!(rows.max_chain_s.is_none(), "{i}");
-                    let sibling = all[k];
-                    assert_eq!(sibling.max_chain_s, config.max_chain_s);
-                    assert_eq!(sibling.rotation, rows.rotation);
-                }
-                None => assert!(rows.max_chain_s.is_some(), "{i}"),
+            let siblings: std::vec::Vec<usize> = chained_siblings(rows, all.iter()).collect();
+            if rows.max_chain_s.is_some() {
+                assert!(siblings.is_empty(), "{i}");
+                continue;
             }
+            // The short and the long chains of the same rows.
+            let lengths: std::vec::Vec<Option<f64>> =
+                siblings.iter().map(|&k| all[k].max_chain_s).collect();
+            let short = config.max_chain_s;
+            assert_eq!(
+                lengths,
+                [short, short.map(|l| LONG_CHAIN_FACTOR * l)],
+                "{i}"
+            );
+            assert!(siblings.iter().all(|&k| all[k].rotation == rows.rotation));
         }
+        let max = sibling_jackknife(
+            [Some([1.0; 6]), None, Some([0.5, 2.0, 0.5, 2.0, 0.5, 2.0])].into_iter(),
+        );
+        assert_eq!(max, Some([1.0, 2.0, 1.0, 2.0, 1.0, 2.0]));
+        assert_eq!(sibling_jackknife([None, None].into_iter()), None);
         // `--chain 0`: every candidate is one chain, with no sibling.
         let unchained = PipelineSettings {
             estimator: "discrete-momentum".into(),
@@ -874,12 +897,14 @@ mod tests {
         .unwrap();
         let all = candidates(&unchained, true);
         assert_eq!(all.len(), 2);
-        assert!(all.iter().all(|r| short_sibling(r, all.iter()).is_none()));
+        assert!(all
+            .iter()
+            .all(|r| chained_siblings(r, all.iter()).next().is_none()));
     }
 
     /// Where nothing drifts (true attitude, 1 Hz slew: the short chains' anchors only
     /// cost information), the whole record is chosen, is closer than the short chains'
-    /// answer, and its σ is at least the short sibling's jackknife σ and covers the
+    /// answer, and its σ is at least its chained siblings' jackknife σ and covers the
     /// truth; where the attitude drifts (spin, attitude propagated from a FOG-grade
     /// gyro), the whole record fits worse and is not chosen.
     #[test]
@@ -914,10 +939,21 @@ mod tests {
             chosen_whole += 1;
             let truth = crate::tensor::j_from_matrix(&run.inertia_kg_m2);
             let (j, sigma) = (e.j().unwrap(), e.sigma_kg_m2().unwrap());
-            let sibling = short_sibling(&chosen, p.candidates.iter().map(|c| c.row_settings()))
-                .expect("a sibling");
-            let short = p.candidates[sibling].solve_now(e.t_s).unwrap().j().unwrap();
-            let jackknife = p.candidates[sibling].jackknife_sigma().expect("jackknife");
+            let siblings: std::vec::Vec<usize> =
+                chained_siblings(&chosen, p.candidates.iter().map(|c| c.row_settings())).collect();
+            let short = p.candidates[siblings[0]]
+                .solve_now(e.t_s)
+                .unwrap()
+                .j()
+                .unwrap();
+            let jackknife = sibling_jackknife(
+                siblings
+                    .iter()
+                    .map(|&k| p.candidates[k].jackknife_sigma())
+                    .collect::<std::vec::Vec<_>>()
+                    .into_iter(),
+            )
+            .expect("jackknife");
             assert!((j - truth).norm() < (short - truth).norm(), "seed {seed}");
             for k in 0..6 {
                 assert!(sigma[k] >= jackknife[k], "seed {seed}, element {k}");
