@@ -116,13 +116,17 @@ fn chained_siblings<'a>(
     all: impl Iterator<Item = &'a MomentumRowSettings> + 'a,
 ) -> impl Iterator<Item = usize> + 'a {
     all.enumerate()
-        .filter(move |(_, r)| {
-            rows.max_chain_s.is_none()
-                && r.max_chain_s.is_some()
-                && r.rotation == rows.rotation
-                && r.stencil == rows.stencil
-        })
+        .filter(move |(_, r)| is_chained_sibling(rows, r))
         .map(|(k, _)| k)
+}
+
+/// Whether `r` is a chained sibling of the whole-record candidate `rows`
+/// ([`chained_siblings`]).
+fn is_chained_sibling(rows: &MomentumRowSettings, r: &MomentumRowSettings) -> bool {
+    rows.max_chain_s.is_none()
+        && r.max_chain_s.is_some()
+        && r.rotation == rows.rotation
+        && r.stencil == rows.stencil
 }
 
 /// Element by element the largest of the jackknife σ given (`None`: none).
@@ -524,14 +528,14 @@ impl DiscreteMomentum {
     /// chain at least its chained siblings' jackknife σ ([`chained_siblings`]).
     fn noise_sigma(&mut self, i: usize) -> Option<[f64; 6]> {
         let rows = *self.candidates.get(i)?.row_settings();
-        let siblings: Vec<usize> =
-            chained_siblings(&rows, self.candidates.iter().map(|c| c.row_settings())).collect();
         let own = self.candidates[i].robust_noise_sigma()?;
-        let jackknife = sibling_jackknife(
-            siblings
-                .iter()
-                .map(|&k| self.candidates[k].jackknife_sigma()),
-        );
+        // No allocation per solve: the siblings are visited in place.
+        let mut jackknife = None;
+        for c in &mut self.candidates {
+            if is_chained_sibling(&rows, c.row_settings()) {
+                jackknife = sibling_jackknife([jackknife, c.jackknife_sigma()].into_iter());
+            }
+        }
         Some(robust_sigma(&own, jackknife.as_ref()))
     }
 }
