@@ -166,7 +166,7 @@ fn an_attitude_glitch_is_caught_or_ignored() {
 /// The gyro density given with the telemetry: right, the residual variance is what it
 /// implies (the errors-in-variables noise model, `noise_s`, predicts it); three times too
 /// large, the compensation would over-correct, and the answer is withdrawn with a message
-/// that names the option and the units.
+/// that names the option and the units; the same in a batch run.
 #[test]
 fn an_overstated_gyro_density_is_caught() {
     let mems = 2.5e-3;
@@ -202,6 +202,31 @@ fn an_overstated_gyro_density_is_caught() {
                 let reason = e.observability.reason().unwrap().to_string();
                 assert!(reason.contains("--gyro-noise") && reason.contains("60"));
             }
+            // The batch run makes the same test on its reduction of the same rows.
+            let config = PipelineSettings {
+                gyro_noise_deg_s_rthz: Some(factor * mems),
+                constraints: ConstraintSet::positive_definite(),
+                ..estimator(name)
+            }
+            .validate()
+            .unwrap();
+            let out = inertia::pipeline::batch(&s, &config).unwrap();
+            let batch_ratio = out.gyro_density_ratio.expect("batch density ratio");
+            eprintln!(
+                "{name} batch, density x{factor}: ratio {batch_ratio:.3}, {:?}",
+                out.estimate.observability
+            );
+            assert!(
+                (batch_ratio / ratio.unwrap() - 1.0).abs() < 0.05,
+                "batch {batch_ratio} against recursive {ratio:?}"
+            );
+            assert_eq!(
+                matches!(
+                    out.estimate.observability,
+                    Observability::NotObservable(Unobservable::DensityOverstated { .. })
+                ),
+                !expect_ok
+            );
         }
     }
 }

@@ -813,7 +813,19 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         c.observability.max_relative_sigma,
     );
     scale_from_prior(&mut estimate, qr, &c.constraints);
+    // The residuals against the stated gyro density, as in the recursive path: the gyro
+    // rotation's rows are the ones the density describes. (The span test needs the
+    // recursive residuals, which a batch reduction does not form.)
+    let gyro_density_ratio = match (c.gyro_noise_rad_s_rthz, estimate.j()) {
+        (Some(g), Some(j)) => reduced
+            .iter()
+            .find(|(rows, _)| rows.rotation == RotationSource::Gyro)
+            .and_then(|(_, b)| consistency::gyro_density_ratio(&b.qr, &j, g)),
+        _ => None,
+    };
+    consistency::check(&mut estimate, None, gyro_density_ratio);
     Ok(BatchOutput {
+        gyro_density_ratio,
         estimate,
         excitation: Some(diagnose(qr, &c.observability)),
         gaps: batch.gaps,

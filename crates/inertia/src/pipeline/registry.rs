@@ -57,6 +57,9 @@ pub struct BatchOutput {
     pub gaps: usize,
     /// The row model used, for estimators that choose one.
     pub row_model: Option<MomentumRowSettings>,
+    /// The residual variance over the part the stated gyro density alone implies, where
+    /// the estimator makes that test ([`Estimator::gyro_density_ratio`]).
+    pub gyro_density_ratio: Option<f64>,
 }
 
 /// What an estimator uses and needs.

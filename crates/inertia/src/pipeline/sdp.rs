@@ -227,6 +227,7 @@ fn run_batch<S: RowSource + Default>(
         c.observability.max_relative_sigma,
     );
     Ok(BatchOutput {
+        gyro_density_ratio: None,
         estimate,
         excitation: Some(diagnose(&qr, &c.observability)),
         gaps: source.gaps(),
