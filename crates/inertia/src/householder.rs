@@ -93,27 +93,20 @@ mod tests {
     use super::*;
     use crate::givens::fold_row;
 
-    fn rnd(seed: &mut u64) -> f64 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    }
-
     /// Problem: random blocks of 3 rows (some with leading zeros, some with zero
     /// columns), folded into an empty 8×8 state. Reference: the same rows folded one by
     /// one by Givens rotations. Tolerance: 1e-12 relative to the largest entry of `R`
     /// (and of `z`); the leftover's sum of squares to 1e-10 relative.
     #[test]
     fn a_block_by_reflections_is_the_rows_by_rotations() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut rnd = crate::testing::uniform(0x9e37_79b9_7f4a_7c15);
         let (mut rt, mut z) = (SMatrix::<f64, 8, 8>::zeros(), SVector::<f64, 8>::zeros());
         let (mut r_ref, mut z_ref) = (SMatrix::<f64, 8, 8>::zeros(), SVector::<f64, 8>::zeros());
         let (mut rss, mut rss_ref) = (0.0, 0.0);
         for block in 0..40 {
             let mut a: [SVector<f64, 8>; 3] =
-                core::array::from_fn(|_| SVector::from_fn(|_, _| rnd(&mut seed)));
-            let mut beta: [f64; 3] = core::array::from_fn(|_| rnd(&mut seed));
+                core::array::from_fn(|_| SVector::from_fn(|_, _| rnd()));
+            let mut beta: [f64; 3] = core::array::from_fn(|_| rnd());
             // Leading zeros from column `start`; every fifth block leaves column 5 alone.
             let start = block % 3;
             for row in &mut a {

@@ -102,4 +102,6 @@ pub mod sim;
 pub mod solver;
 pub mod telemetry;
 pub mod tensor;
+#[cfg(test)]
+mod testing;
 pub mod text;

@@ -286,13 +286,7 @@ mod tests {
     /// rows; merging a chain's state is folding its rows one by one.
     #[test]
     fn folding_once_and_merging_equal_folding_row_by_row() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = crate::testing::uniform(0x2545_f491_4f6c_dd1d);
         let (mut once, mut dense) = (AugmentedQr::new(4), AugmentedQr::new(4));
         for chain in 0..5 {
             let (mut mine, mut reference) = (AugmentedQr::new(0), AugmentedQr::new(0));

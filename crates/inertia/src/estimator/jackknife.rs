@@ -177,13 +177,7 @@ mod tests {
     /// random rows in the shared unknowns.
     #[test]
     fn prefix_and_suffix_merges_give_the_direct_jackknife() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rnd = crate::testing::uniform(0x2545_f491_4f6c_dd1d);
         let constraints = crate::constraints::ConstraintSet::physical()
             .validate()
             .unwrap();

@@ -1,0 +1,12 @@
+//! Helpers shared by the unit tests.
+
+/// A reproducible stream of uniform numbers in `[-0.5, 0.5)` (xorshift64), for random
+/// test problems without a dependency on `rand` in `no_std` builds.
+pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
