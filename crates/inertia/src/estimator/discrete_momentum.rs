@@ -192,8 +192,13 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// ([`super::jackknife`]), kg m²; `None` with too few chains, with forgetting or
     /// after [`Self::stop_jackknife`].
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
-        let constraints = self.constraints;
-        self.groups.as_mut()?.sigma(&constraints)
+        // Borrowed apart, not copied: the constraint set is large.
+        let Self {
+            groups,
+            constraints,
+            ..
+        } = self;
+        groups.as_mut()?.sigma(constraints)
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
