@@ -422,8 +422,8 @@ impl DiscreteMomentum {
                 backend,
             )?);
         }
-        // A whole-record candidate's σ comes from its sibling's jackknife: its own chain
-        // groups would hold one chain.
+        // A whole-record candidate's σ comes from its chained siblings' jackknife: its own
+        // chain groups would hold one chain.
         let rows: Vec<MomentumRowSettings> =
             self.candidates.iter().map(|c| *c.row_settings()).collect();
         for (c, r) in self.candidates.iter_mut().zip(&rows) {
