@@ -30,7 +30,7 @@
 //! not hold, so the estimator keeps no groups then and the noise σ is the least-squares
 //! one.
 
-use super::augmented_qr::AugmentedQr;
+use super::shared_qr::SharedQr;
 use crate::constraints::Constraints;
 use crate::solver::unconstrained_minimiser;
 use crate::tensor::InertiaVector;
@@ -74,8 +74,8 @@ pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [
 /// compute the jackknife σ at any time without holding the rows.
 #[derive(Debug, Clone)]
 pub struct ChainGroups {
-    chain: AugmentedQr,
-    groups: [AugmentedQr; GROUPS],
+    chain: SharedQr,
+    groups: [SharedQr; GROUPS],
     chains: usize,
     /// `(chains, σ)` at the last computation.
     cached: Option<(usize, Option<[f64; 6]>)>,
@@ -84,8 +84,8 @@ pub struct ChainGroups {
 impl Default for ChainGroups {
     fn default() -> Self {
         Self {
-            chain: AugmentedQr::new(0),
-            groups: [AugmentedQr::new(0); GROUPS],
+            chain: SharedQr::new(0),
+            groups: [SharedQr::new(0); GROUPS],
             chains: 0,
             cached: None,
         }
@@ -94,9 +94,9 @@ impl Default for ChainGroups {
 
 impl ChainGroups {
     /// The state of the chain in progress, to fold its row blocks into along with the
-    /// estimator's ([`AugmentedQr::add`]): it holds the rows of the shared unknowns only,
-    /// the initial momenta being minimised out already.
-    pub fn chain_mut(&mut self) -> &mut AugmentedQr {
+    /// estimator's ([`super::augmented_qr::AugmentedQr::add`]): it holds the rows of the
+    /// shared unknowns only, the initial momenta being minimised out already.
+    pub fn chain_mut(&mut self) -> &mut SharedQr {
         &mut self.chain
     }
 
@@ -109,7 +109,7 @@ impl ChainGroups {
         if let Some(g) = self.groups.get_mut(self.chains % GROUPS) {
             g.merge(&self.chain);
         }
-        self.chain = AugmentedQr::new(0);
+        self.chain = SharedQr::new(0);
         self.chains += 1;
     }
 
@@ -130,7 +130,7 @@ impl ChainGroups {
     }
 
     fn scaled(&self, s: [f64; 6]) -> [f64; 6] {
-        let done: f64 = self.groups.iter().map(AugmentedQr::weight).sum();
+        let done: f64 = self.groups.iter().map(SharedQr::weight).sum();
         let all = done + self.chain.weight();
         let f = if all > 0.0 {
             crate::math::sqrt(done / all)
@@ -145,8 +145,8 @@ impl ChainGroups {
         let groups = &self.groups[..used];
         // The groups before `g` and after it, merged once each way: each delete-one
         // state is then one merge, not `used − 2`.
-        let mut before = [AugmentedQr::new(0); GROUPS];
-        let mut after = [AugmentedQr::new(0); GROUPS];
+        let mut before = [SharedQr::new(0); GROUPS];
+        let mut after = [SharedQr::new(0); GROUPS];
         for g in 1..used {
             before[g] = before[g - 1];
             before[g].merge(&groups[g - 1]);
@@ -169,8 +169,8 @@ impl ChainGroups {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::estimator::momentum_rows::{AugmentedRow, J, UNKNOWNS};
-    use nalgebra::{SMatrix, Vector3};
+    use crate::estimator::shared_qr::SHARED;
+    use nalgebra::SVector;
 
     /// The delete-one states from prefix and suffix merges give the σ of merging every
     /// other group directly (the previous way), to 1e-9 relative, for 4 to 11 chains of
@@ -182,28 +182,19 @@ mod tests {
             .validate()
             .unwrap();
         let mut groups = ChainGroups::default();
-        let mut estimator = AugmentedQr::new(0);
+        let mut estimator = SharedQr::new(0);
         for chain in 0..11 {
             for _ in 0..12 {
-                let mut row = AugmentedRow {
-                    a: SMatrix::<f64, 3, UNKNOWNS>::from_fn(|_, _| rnd()),
-                    b: Vector3::from_fn(|_, _| rnd()),
-                    noise_s: 0.0,
-                };
-                // The chain's own unknowns are the estimator's, minimised out of the
-                // chain's state; rows in the shared unknowns only keep the test simple.
-                for i in 0..3 {
-                    for c in 0..J {
-                        row.a[(i, c)] = 0.0;
-                    }
-                }
-                estimator.add(&row, Some(groups.chain_mut()));
+                let a: [SVector<f64, SHARED>; 3] =
+                    core::array::from_fn(|_| SVector::from_fn(|_, _| rnd()));
+                let y: [f64; 3] = core::array::from_fn(|_| rnd());
+                estimator.add((a, y), &y, 0.0, Some(groups.chain_mut()));
             }
             groups.end_chain();
             let used = groups.chains.min(GROUPS);
             let direct: Option<std::vec::Vec<InertiaVector>> = (0..used)
                 .map(|g| {
-                    let mut rest = AugmentedQr::new(0);
+                    let mut rest = SharedQr::new(0);
                     for (h, group) in groups.groups.iter().enumerate().take(used) {
                         if h != g {
                             rest.merge(group);

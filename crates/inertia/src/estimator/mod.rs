@@ -29,6 +29,7 @@ pub mod qr;
 pub mod recursive;
 pub mod resample;
 pub mod rows;
+pub mod shared_qr;
 pub mod svd_tracker;
 pub mod uncertainty;
 

@@ -1,0 +1,225 @@
+//! The least-squares state in the unknowns every chain of discrete momentum rows shares,
+//! `y = [τ_b; κ; j]` ([`SHARED`] = 10, [`super::momentum_rows`]), the chains' initial
+//! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
+//! folded by Householder reflections, one per pivot for each 3-row block
+//! ([`crate::householder`]; the factor of paper eqs. 60–61 up to rounding).
+//!
+//! Because `j` comes last, the trailing 6×6 block of `R` (and of `z`) is the problem in
+//! `j` with every other unknown minimised out exactly: `min_y ‖R y − z‖²` is
+//! `‖R_jj j − z_j‖² + const` for each `j`. [`SharedQr::reduced`] hands that block to the constrained
+//! solvers and the observability test, which then see the same `(R, z, ρ²)` as for the
+//! paper's rows.
+
+use super::momentum_rows::{J, TORQUE, UNKNOWNS};
+use super::qr::RecursiveQr;
+use crate::givens::{rotate_transposed as rotate, wavefront};
+use crate::householder::{fold_block_transposed as fold_block, reflect_transposed as reflect};
+use crate::math::sqrt;
+use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
+
+/// Number of shared unknowns: `[τ_b (3); κ (1); j (6)]`, the columns
+/// [`TORQUE`]`..`[`UNKNOWNS`] of a row.
+pub const SHARED: usize = UNKNOWNS - TORQUE;
+/// Position of `j` among the shared unknowns.
+pub const J_SHARED: usize = J - TORQUE;
+
+/// A 3-row block in the shared unknowns with its right-hand sides.
+pub type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
+
+/// `(R, z, ρ²)` over the shared unknowns, and counters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SharedQr {
+    /// `Rᵀ`: the rows of `R` contiguous, for the reflections
+    /// (the crate's `householder` module).
+    pub(super) rt: SMatrix<f64, SHARED, SHARED>,
+    pub(super) z: SVector<f64, SHARED>,
+    rss: f64,
+    y_energy: f64,
+    rows: usize,
+    weight: f64,
+    /// Nuisance unknowns introduced so far (degrees of freedom the residual does not have).
+    nuisance: f64,
+    /// Sum of the rows' errors-in-variables coefficients
+    /// ([`super::momentum_rows::AugmentedRow::noise_s`]).
+    noise_s: f64,
+}
+
+impl SharedQr {
+    /// The empty state; `nuisance` unknowns (the disturbance torque) are counted from the
+    /// start.
+    #[must_use]
+    pub fn new(nuisance: usize) -> Self {
+        Self {
+            rt: SMatrix::zeros(),
+            z: SVector::zeros(),
+            rss: 0.0,
+            y_energy: 0.0,
+            rows: 0,
+            weight: 0.0,
+            nuisance: nuisance as f64,
+            noise_s: 0.0,
+        }
+    }
+
+    /// Fold a block (consumed: zero afterwards, its right-hand sides the leftover) into
+    /// this state and, when given, the same block into `other` too, their reflections
+    /// interleaved so that the processor overlaps their `√` and divisions. `y` are the
+    /// rows' right-hand sides as measured (for the energy counter) and `noise_s` their
+    /// errors-in-variables coefficient.
+    pub fn add(
+        &mut self,
+        block: SharedBlock,
+        y: &[f64; 3],
+        noise_s: f64,
+        other: Option<&mut SharedQr>,
+    ) {
+        let (mut a, mut beta) = block;
+        if let Some(o) = other {
+            let (mut a2, mut beta2) = (a, beta);
+            for i in 0..SHARED {
+                reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, i);
+                reflect(&mut o.rt, &mut o.z, &mut a2, &mut beta2, i);
+            }
+            o.count(y, &beta2, noise_s);
+        } else {
+            fold_block(&mut self.rt, &mut self.z, &mut a, &mut beta, 0..SHARED);
+        }
+        self.count(y, &beta, noise_s);
+    }
+
+    /// Count a block of rows that needed no fold (its leftover is zero: the rows fix
+    /// unknowns of their own, such as a chain's first block its initial momenta).
+    pub fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
+        self.count(y, &[0.0; 3], noise_s);
+    }
+
+    fn count(&mut self, y: &[f64; 3], left: &[f64; 3], noise_s: f64) {
+        for (y, left) in y.iter().zip(left) {
+            self.y_energy += y * y;
+            self.rss += left * left;
+            self.rows += 1;
+            self.weight += 1.0;
+        }
+        self.noise_s += noise_s;
+    }
+
+    /// Fold another state's rows into this one: afterwards this is the state of both sets
+    /// of rows (their unknowns identified column by column).
+    pub fn merge(&mut self, other: &SharedQr) {
+        // Its non-zero rows, folded in a wavefront ([`wavefront`]).
+        let mut a = [SVector::<f64, SHARED>::zeros(); SHARED];
+        let mut beta = [0.0; SHARED];
+        let mut n = 0;
+        for i in 0..SHARED {
+            let row = other.rt.column(i);
+            if row.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            a[n] = row.into_owned();
+            beta[n] = other.z[i];
+            n += 1;
+        }
+        wavefront(0..SHARED, n, |m, i| {
+            rotate(&mut self.rt, &mut a[m], &mut self.z, &mut beta[m], i);
+        });
+        for left in &beta[..n] {
+            self.rss += left * left;
+        }
+        self.rss += other.rss;
+        self.y_energy += other.y_energy;
+        self.rows += other.rows;
+        self.weight += other.weight;
+        self.nuisance += other.nuisance;
+        self.noise_s += other.noise_s;
+    }
+
+    /// Count `n` more nuisance unknowns (a new chain's initial momenta).
+    pub fn add_nuisance(&mut self, n: usize) {
+        self.nuisance += n as f64;
+    }
+
+    /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`).
+    pub fn scale(&mut self, lambda: f64) {
+        let s = sqrt(lambda);
+        self.rt *= s;
+        self.z *= s;
+        self.rss *= lambda;
+        self.y_energy *= lambda;
+        self.weight *= lambda;
+        self.nuisance *= lambda;
+        self.noise_s *= lambda;
+    }
+
+    /// Scalar rows folded in.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Row weight folded in (rows, discounted by forgetting).
+    #[must_use]
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// Residual sum of squares `ρ²` (weighted).
+    #[must_use]
+    pub fn rss(&self) -> f64 {
+        self.rss
+    }
+
+    /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
+    #[must_use]
+    pub fn residual_dof(&self) -> f64 {
+        self.weight - 6.0 - self.nuisance
+    }
+
+    /// Residual sum of squares per residual degree of freedom, `∞` without any.
+    #[must_use]
+    pub fn residual_variance(&self) -> f64 {
+        let dof = self.residual_dof();
+        if dof > 0.0 {
+            self.rss / dof
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The reduced problem in `j`: the trailing 6×6 block, with the nuisance unknowns
+    /// counted in [`RecursiveQr::nuisance`].
+    #[must_use]
+    pub fn reduced(&self) -> RecursiveQr {
+        RecursiveQr {
+            r: Matrix6::from_fn(|i, k| self.rt[(J_SHARED + k, J_SHARED + i)]),
+            z: Vector6::from_fn(|i, _| self.z[J_SHARED + i]),
+            rss: self.rss,
+            y_energy: self.y_energy,
+            rows: self.rows,
+            weight: self.weight,
+            noise_s: self.noise_s,
+            nuisance: self.nuisance,
+        }
+    }
+
+    /// `[τ_b; κ]` at a given `j`: back-substitution through the leading rows; zero for
+    /// unknowns the rows never involved.
+    #[must_use]
+    pub fn leading_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J_SHARED> {
+        let mut x = SVector::<f64, J_SHARED>::zeros();
+        for i in (0..J_SHARED).rev() {
+            let d = self.rt[(i, i)];
+            if d == 0.0 {
+                continue;
+            }
+            let mut s = self.z[i];
+            for k in i + 1..J_SHARED {
+                s -= self.rt[(k, i)] * x[k];
+            }
+            for k in 0..6 {
+                s -= self.rt[(J_SHARED + k, i)] * j[k];
+            }
+            x[i] = s / d;
+        }
+        x
+    }
+}
