@@ -2,7 +2,7 @@
 //! `y = [τ_b; κ; j]` ([`SHARED`] = 10, [`super::momentum_rows`]), the chains' initial
 //! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
 //! folded by Householder reflections, one per pivot for each 3-row block
-//! ([`crate::householder`]; the factor of paper eqs. 60–61 up to rounding).
+//! (the crate's `householder` module; the factor of paper eqs. 60–61 up to rounding).
 //!
 //! Because `j` comes last, the trailing 6×6 block of `R` (and of `z`) is the problem in
 //! `j` with every other unknown minimised out exactly: `min_y ‖R y − z‖²` is
