@@ -333,6 +333,124 @@ fn a_gap_starts_a_new_chain() {
     );
 }
 
+/// A chain split by new initial momenta while its sums `S`, `T` run on (what
+/// `ChainClock` does) is the same least-squares problem as the chain restarted there with
+/// its sums from zero (what a gap does): the sums' values at the split are a constant
+/// offset of every later row, which the new initial momenta absorb. Problem: the paper's
+/// slew with paper gyro noise and a known torque (so that `T` is not zero), plain rows
+/// with the attitude's rotation (a restart then loses no row), split at three samples.
+/// Reference: fresh row sources from each split sample. Tolerance: `R`, `z` of the
+/// reduced problem to 1e-9 of their largest entry, `ρ²` to 1e-9 relative; the rows
+/// counted equal.
+#[test]
+fn splitting_a_chain_is_restarting_its_sums() {
+    use inertia::estimator::augmented_qr::AugmentedQr;
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(60.0),
+            ..Common::paper()
+        })
+        .expect("sim");
+    let samples: Vec<Sample> = run
+        .samples
+        .iter()
+        .map(|s| Sample {
+            tau_nm: Vector3::new(1e-3, -2e-3, 5e-4),
+            ..*s
+        })
+        .collect();
+    let rows = MomentumRowSettings::default();
+    let splits = [100, 250, 420];
+    // Split: one source, the initial momenta eliminated after the row ending at a split.
+    let mut split = AugmentedQr::new(rows.shared_nuisance());
+    let mut src = MomentumRows::new(rows);
+    for (k, s) in samples.iter().enumerate() {
+        if let Some(row) = src.push(s).expect("row") {
+            split.add(&row, None);
+        }
+        if splits.contains(&k) {
+            split.eliminate_anchors();
+        }
+    }
+    // Restarted: a fresh source from each split sample on.
+    let mut restarted = AugmentedQr::new(rows.shared_nuisance());
+    let bounds = [0, splits[0], splits[1], splits[2], samples.len() - 1];
+    for w in bounds.windows(2) {
+        let mut src = MomentumRows::new(rows);
+        for s in &samples[w[0]..=w[1]] {
+            if let Some(row) = src.push(s).expect("row") {
+                restarted.add(&row, None);
+            }
+        }
+        restarted.eliminate_anchors();
+    }
+    let (a, b) = (split.reduced(), restarted.reduced());
+    assert_eq!(a.rows, b.rows);
+    assert!(
+        (a.r - b.r).amax() <= 1e-9 * b.r.amax(),
+        "R: {:e}",
+        (a.r - b.r).amax()
+    );
+    assert!(
+        (a.z - b.z).amax() <= 1e-9 * b.z.amax(),
+        "z: {:e}",
+        (a.z - b.z).amax()
+    );
+    assert!((a.rss - b.rss).abs() <= 1e-9 * b.rss, "{} {}", a.rss, b.rss);
+}
+
+/// Candidates that differ only in the longest chain may share one row source
+/// (`fold_shared`): an estimator fed that way holds exactly the state of one that forms its
+/// own rows, for Richardson rows from the gyro with chains of 20 s and the whole record.
+#[test]
+fn a_shared_row_source_gives_the_state_of_an_own_one() {
+    let run = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(120.0),
+            ..Common::paper()
+        })
+        .expect("sim");
+    let base = MomentumRowSettings {
+        rotation: RotationSource::Gyro,
+        stencil: Stencil::Adaptive,
+        ..Default::default()
+    };
+    let mut shared = MomentumRows::new(base);
+    let chains = [Some(20.0), None];
+    let mut own: Vec<_> = chains
+        .iter()
+        .map(|&max_chain_s| {
+            estimator(MomentumRowSettings {
+                max_chain_s,
+                ..base
+            })
+        })
+        .collect();
+    let mut fed: Vec<_> = chains
+        .iter()
+        .map(|&max_chain_s| {
+            estimator(MomentumRowSettings {
+                max_chain_s,
+                ..base
+            })
+        })
+        .collect();
+    for s in &run.samples {
+        for e in &mut own {
+            e.fold(s).expect("fold");
+        }
+        if let Some(row) = shared.push(s).expect("row") {
+            for e in &mut fed {
+                e.fold_shared(&row, &shared, s.t_s);
+            }
+        }
+    }
+    for (a, b) in own.iter().zip(&fed) {
+        assert_eq!(a.qr(), b.qr(), "{:?}", a.row_settings().max_chain_s);
+    }
+    assert!(own[0].qr().residual_dof() < own[1].qr().residual_dof());
+}
+
 #[test]
 fn gyro_rotation_needs_gyro_rates() {
     let run = Scenario::slew()

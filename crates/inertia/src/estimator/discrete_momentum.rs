@@ -10,7 +10,7 @@
 
 use super::augmented_qr::AugmentedQr;
 use super::jackknife::ChainGroups;
-use super::momentum_rows::{AugmentedRow, MomentumRowSettings, MomentumRows};
+use super::momentum_rows::{AugmentedRow, ChainClock, MomentumRowSettings, MomentumRows};
 use super::qr::RecursiveQr;
 use super::recursive::{estimate_from, RecursiveSettings};
 use super::svd_tracker::SvdTracker;
@@ -42,6 +42,8 @@ impl MomentumEstimatorSettings {
 #[derive(Debug, Clone)]
 pub struct DiscreteMomentumEstimator<B: Backend> {
     source: MomentumRows,
+    /// Splits the source's chains at the longest chain ([`ChainClock`]).
+    clock: ChainClock,
     qr: AugmentedQr,
     /// The jackknife's chain groups; `None` with forgetting or after
     /// [`DiscreteMomentumEstimator::stop_jackknife`].
@@ -74,6 +76,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let r = &settings.rows;
         Ok(Self {
             source: MomentumRows::new(*r),
+            clock: ChainClock::new(r.max_chain_s),
             qr: AugmentedQr::new(r.shared_nuisance()),
             // The delete-a-group jackknife weighs its groups equally: with forgetting they
             // are not, and it is not kept ([`super::jackknife`]).
@@ -110,13 +113,34 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let Some(row) = row else {
             return Ok(false);
         };
-        self.fold_row(&row, s.t_s);
+        let epoch = self.clock.epoch(&self.source);
+        self.fold_row(&row, epoch, s.t_s);
         Ok(true)
     }
 
-    fn fold_row(&mut self, row: &AugmentedRow, t_s: f64) {
-        if self.source.epoch() != self.epoch {
-            self.epoch = self.source.epoch();
+    /// Fold a row block that `source` just gave, at time `t_s`, in place of one from this
+    /// estimator's own source: for candidates that differ only in the longest chain and
+    /// so share their rows (module docs of [`super::momentum_rows`], "Chains"). `source`
+    /// must have this estimator's row settings but for `max_chain_s`, and the same source
+    /// must feed it every block from the first on.
+    pub fn fold_shared(&mut self, row: &AugmentedRow, source: &MomentumRows, t_s: f64) {
+        debug_assert_eq!(
+            MomentumRowSettings {
+                max_chain_s: None,
+                ..*source.settings()
+            },
+            MomentumRowSettings {
+                max_chain_s: None,
+                ..self.settings.rows
+            }
+        );
+        let epoch = self.clock.epoch(source);
+        self.fold_row(row, epoch, t_s);
+    }
+
+    fn fold_row(&mut self, row: &AugmentedRow, epoch: u64, t_s: f64) {
+        if epoch != self.epoch {
+            self.epoch = epoch;
             self.qr.eliminate_anchors();
             if let Some(g) = self.groups.as_mut() {
                 g.end_chain();
@@ -298,6 +322,7 @@ pub fn reduce_batch(
         });
     }
     let mut source = MomentumRows::new(*settings);
+    let mut clock = ChainClock::new(settings.max_chain_s);
     use std::{vec, vec::Vec};
     let mut chains: Vec<Vec<AugmentedRow>> = vec![Vec::new()];
     let mut epoch = 0;
@@ -306,8 +331,9 @@ pub fn reduce_batch(
             .push(s)
             .map_err(|source| EstimatorError::Row { sample: i, source })?;
         if let Some(row) = row {
-            if source.epoch() != epoch {
-                epoch = source.epoch();
+            let e = clock.epoch(&source);
+            if e != epoch {
+                epoch = e;
                 chains.push(Vec::new());
             }
             if let Some(c) = chains.last_mut() {

@@ -45,7 +45,14 @@
 //!
 //! A gap ([`crate::sample::is_gap`]) or a step that rotates too far restarts the chain:
 //! the sums restart and the initial momenta become new unknowns; [`MomentumRows::epoch`]
-//! counts the restarts so the estimator can eliminate the old ones.
+//! counts the restarts so the estimator can eliminate the old ones. A chain that only
+//! grows too long ([`MomentumRowSettings::max_chain_s`]) is split by a [`ChainClock`]
+//! instead: its rows go on (no interval lost, the sums running), only the initial
+//! momenta are new unknowns from the split on. The sums' values at the split are then a
+//! constant offset of every later row of the chain (`S τ_b`, `T`), which the new initial
+//! momenta absorb: the same least-squares problem as restarting the sums. Rows therefore
+//! do not depend on the chain length, and candidates that differ only in it can share
+//! one row source.
 
 use crate::attitude::Quaternion;
 use crate::discrete::{check_phi, check_unit, RowError};
@@ -174,10 +181,11 @@ pub struct MomentumRowSettings {
     /// Estimate a constant body-frame disturbance torque `τ_b` (default `true`).
     pub torque_bias: bool,
     /// Longest chain, s (the first [`super::jackknife::MIN_GROUPS`] chains a quarter of
-    /// it): a chain is restarted (its initial momentum becomes a new unknown) once it
-    /// spans this long, so that a slowly drifting attitude error (a
-    /// gyro-propagated attitude's random walk) rotates the momentum by at most the drift
-    /// within one chain. `None`: chains end only at gaps.
+    /// it): a chain is split (its initial momentum becomes a new unknown) once it spans
+    /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
+    /// random walk) rotates the momentum by at most the drift within one chain. `None`:
+    /// chains end only at gaps. The rows themselves do not depend on it: the split is
+    /// [`ChainClock`]'s, downstream of [`MomentumRows`].
     pub max_chain_s: Option<f64>,
 }
 
@@ -276,6 +284,58 @@ struct Node {
     omega_rad_s: Option<Vector3<f64>>,
 }
 
+/// Splits a row source's chains into chains no longer than
+/// [`MomentumRowSettings::max_chain_s`] (module docs, "Chains").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChainClock {
+    max_chain_s: Option<f64>,
+    /// The source's epoch the current chain belongs to (`None` before the first row).
+    source_epoch: Option<u64>,
+    /// Start of the current chain, s.
+    start_s: f64,
+    /// Splits so far.
+    splits: u64,
+}
+
+impl ChainClock {
+    /// A clock for chains of at most `max_chain_s` (`None`: the source's chains whole).
+    #[must_use]
+    pub fn new(max_chain_s: Option<f64>) -> Self {
+        Self {
+            max_chain_s,
+            source_epoch: None,
+            start_s: 0.0,
+            splits: 0,
+        }
+    }
+
+    /// The epoch of the row `source` just gave: the source's restarts plus this clock's
+    /// splits. A split falls at the start of the row's newest interval once the chain
+    /// spans [`MomentumRowSettings::max_chain_s`] there (the first
+    /// [`super::jackknife::MIN_GROUPS`] chains a quarter of it, so that the jackknife over
+    /// chains has its groups early).
+    pub fn epoch(&mut self, source: &MomentumRows) -> u64 {
+        if self.source_epoch != Some(source.epoch()) {
+            self.source_epoch = Some(source.epoch());
+            self.start_s = source.chain_start_s();
+        }
+        let epoch = source.epoch() + self.splits;
+        if let (Some(max), Some(b)) = (self.max_chain_s, source.interval_start_s()) {
+            let early = super::jackknife::MIN_GROUPS as u64;
+            let max = if epoch < early {
+                max / early as f64
+            } else {
+                max
+            };
+            if b - self.start_s >= max {
+                self.splits += 1;
+                self.start_s = b;
+            }
+        }
+        source.epoch() + self.splits
+    }
+}
+
 /// The row source.
 #[derive(Debug, Clone)]
 pub struct MomentumRows {
@@ -346,6 +406,19 @@ impl MomentumRows {
         self.gaps
     }
 
+    /// Time of the chain's first node, s.
+    #[must_use]
+    pub fn chain_start_s(&self) -> f64 {
+        self.chain_start_s
+    }
+
+    /// Start time of the newest interval, s (after a push that gave a row: the interval
+    /// the row ends with).
+    #[must_use]
+    pub fn interval_start_s(&self) -> Option<f64> {
+        self.nodes[1].map(|n| n.t_s)
+    }
+
     /// Start a new chain with `first` (or empty).
     fn restart(&mut self, first: Option<Node>) {
         let had_rows = self.count >= 2;
@@ -403,20 +476,6 @@ impl MomentumRows {
                 self.gaps += 1;
                 self.restart(Some(node));
                 return Ok(None);
-            }
-        }
-        if let Some(max) = self.settings.max_chain_s {
-            // The first chains are shorter, so that the jackknife over chains
-            // ([`super::jackknife`]) has its groups early.
-            let early = super::jackknife::MIN_GROUPS as u64;
-            let max = if self.epoch < early {
-                max / early as f64
-            } else {
-                max
-            };
-            if b.t_s - self.chain_start_s >= max {
-                // A new chain from node b: no interval is lost.
-                self.restart(Some(b));
             }
         }
         let f = match self.settings.rotation {
