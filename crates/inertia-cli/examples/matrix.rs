@@ -62,7 +62,8 @@
 //! discrete momentum estimator given the cell's gyro noise density (`gyro_noise_deg_s_rthz`,
 //! errors-in-variables compensation), as a user with the gyro's datasheet would.
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
-//! (`0`: none) for experiments; unset, the default.
+//! (`0`: none) for experiments; unset, the default. `DIGITS=1` prints the medians with
+//! four significant digits.
 
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::observability::{Observability, Unobservable};
@@ -413,8 +414,13 @@ impl Stats {
     }
 
     fn errors(&self) -> String {
+        let digits = if std::env::var("DIGITS").is_ok() {
+            3
+        } else {
+            1
+        };
         let mut out = format!(
-            "{:.1e} / {:.1e}",
+            "{:.digits$e} / {:.1e}",
             quantile(&self.errors, 0.5),
             quantile(&self.errors, 0.95)
         );

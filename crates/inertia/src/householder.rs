@@ -17,23 +17,10 @@
 use crate::math::sqrt;
 use nalgebra::{SMatrix, SVector};
 
-/// Fold the rows `a` with right-hand sides `beta` into `(Rᵀ, z)` at the pivots `pivots`
-/// (the rows must be zero before `pivots.start`; `Rᵀ` stored, so that each row of `R` is
-/// contiguous). Afterwards `a` is zero in `pivots` and `beta` holds the block's leftover.
-#[inline]
-pub fn fold_block_transposed<const N: usize, const M: usize>(
-    rt: &mut SMatrix<f64, N, N>,
-    z: &mut SVector<f64, N>,
-    a: &mut [SVector<f64, N>; M],
-    beta: &mut [f64; M],
-    pivots: core::ops::Range<usize>,
-) {
-    for i in pivots {
-        reflect_transposed(rt, z, a, beta, i);
-    }
-}
-
-/// The reflection of [`fold_block_transposed`] at pivot `i`. Reflections at one pivot
+/// The reflection at pivot `i` of folding the rows `a` with right-hand sides `beta` into
+/// `(Rᵀ, z)` (`Rᵀ` stored, so that each row of `R` is contiguous): afterwards column `i` of
+/// `a` is zero. Applied at pivots `0..N` in turn (the rows zero before the first), it
+/// folds the block, and `beta` holds the block's leftover. Reflections at one pivot
 /// of independent states may be interleaved, so that the processor overlaps their `√`
 /// and divisions, on which each pivot waits.
 #[inline(always)]
@@ -91,6 +78,22 @@ pub fn reflect_transposed<const N: usize, const M: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Fold the rows `a` with right-hand sides `beta` into `(Rᵀ, z)` at the pivots `pivots`
+    /// (the rows must be zero before `pivots.start`; `Rᵀ` stored, so that each row of `R` is
+    /// contiguous). Afterwards `a` is zero in `pivots` and `beta` holds the block's leftover.
+    pub fn fold_block_transposed<const N: usize, const M: usize>(
+        rt: &mut SMatrix<f64, N, N>,
+        z: &mut SVector<f64, N>,
+        a: &mut [SVector<f64, N>; M],
+        beta: &mut [f64; M],
+        pivots: core::ops::Range<usize>,
+    ) {
+        for i in pivots {
+            reflect_transposed(rt, z, a, beta, i);
+        }
+    }
+
     use crate::givens::fold_row;
 
     /// Problem: random blocks of 3 rows (some with leading zeros, some with zero
