@@ -384,9 +384,9 @@ pub struct EstimateArgs {
     pub no_torque_bias: bool,
     /// Short momentum chain, s (discrete-momentum estimator): the conserved momentum is
     /// re-anchored after this long, which bounds the effect of a drifting attitude
-    /// (gyro-propagated attitude); chains 4x as long and one chain over the whole record
-    /// are folded too, and the data choose (the report's `rows:` line says which). `0`
-    /// for chains that end only at gaps.
+    /// (gyro-propagated attitude); chains a quarter and 4x as long and one chain over the
+    /// whole record are folded too, and the data choose (the report's `rows:` line says
+    /// which). `0` for chains that end only at gaps.
     #[arg(long, value_name = "S", default_value_t = inertia::pipeline::DEFAULT_MAX_CHAIN_S)]
     pub chain: f64,
     /// True inertia (JSON) to report the relative Frobenius error against.

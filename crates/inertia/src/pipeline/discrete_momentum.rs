@@ -3,13 +3,15 @@
 //!
 //! The wheel momentum between samples is estimated with `j` by default
 //! ([`Stencil::Adaptive`]). Where the settings leave a choice open (the rotation source
-//! when the telemetry has gyro rates, and the chain length: `--chain`, 4× as long, and
-//! the whole record as one chain, whose σ comes from its chained siblings' jackknife:
-//! [`chained_siblings`]),
-//! every candidate row model folds every sample, and each solve uses the candidate
-//! [`choose`] picks: of those whose residual variance `ρ²/(rows − unknowns)` the data
-//! cannot tell from the smallest, the one with the longest chains (a noisier rotation
-//! source, or chains long enough for an attitude drift to show, leave larger residuals).
+//! when the telemetry has gyro rates, and the chain length: `--chain`, a quarter and 4×
+//! as long, and the whole record as one chain, whose σ comes from its chained siblings'
+//! jackknife: [`chained_siblings`]), every candidate row model folds every sample (the
+//! candidates that differ only in the chain length from one shared row source), and each
+//! solve uses the candidate [`pick`] picks: first by fit ([`choose`]: of those whose
+//! residual variance `ρ²/(rows − unknowns)` the data cannot tell from the smallest, the
+//! one with the longest chains; a noisier rotation source, or chains long enough for an
+//! attitude drift to show, leave larger residuals), then by steadiness ([`steadier`]: the
+//! same rows in longer chains whose jackknife σ is clearly smaller).
 //! The σ of the answer is assembled here from the chosen candidate's noise σ
 //! ([`crate::estimator::jackknife`]) and three bias terms: the discretisation bias from a
 //! half-rate shadow of the first candidate, the spread of indistinguishable candidates,

@@ -50,8 +50,9 @@ pub struct PipelineSettings {
     /// Short momentum chain, s (discrete momentum estimator): bounds how far a
     /// drifting attitude error can rotate the conserved momentum
     /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
-    /// 4× as long and the whole record as one chain are folded too, and each solve takes
-    /// the longest that fits as well (`pipeline::discrete_momentum`). Default
+    /// a quarter and 4× as long and the whole record as one chain are folded too, and each
+    /// solve takes the longest that fits as well, or a longer one that is clearly
+    /// steadier (`pipeline::discrete_momentum`). Default
     /// [`DEFAULT_MAX_CHAIN_S`]; `None`: chains end only at gaps.
     pub max_chain_s: Option<f64>,
     /// What to do with a step where the attitude jumps against the gyro

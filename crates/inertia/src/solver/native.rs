@@ -1,7 +1,7 @@
 //! The native backend: a log-barrier method on the 6-variable problem.
 //!
 //! First an exact active-set solve of the linear constraints alone
-//! ([`super::active_set`]); when its answer satisfies the LMIs strictly it is optimal
+//! (the `active_set` module); when its answer satisfies the LMIs strictly it is optimal
 //! and is returned. Otherwise the barrier method:
 //! objective `‖R j − z‖²`, passed to the barrier method in least-squares form (the
 //! Newton systems are factored without forming `RᵀR`). The start is the previous
