@@ -68,6 +68,16 @@ fn paper_rows_are_rotated_differences_of_interval_momenta() {
     }
 }
 
+/// The paper's slew for its first `duration_s`, with `common`'s noise.
+fn slew_for(duration_s: f64, common: Common) -> inertia::sim::SimOutput {
+    Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(duration_s),
+            ..common
+        })
+        .expect("sim")
+}
+
 /// Largest drift `‖(A_k j − b_k) − (A_0 j − b_0)‖` over rows of the same anchor: the
 /// conserved quantity's error.
 fn max_drift(samples: &[Sample], settings: MomentumRowSettings) -> f64 {
@@ -249,12 +259,7 @@ fn an_unknown_constant_torque_is_estimated_and_does_not_bias_j() {
 
 #[test]
 fn recursive_and_batch_agree_with_gaps_and_chains() {
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(120.0),
-            ..Common::paper()
-        })
-        .expect("sim");
+    let run = slew_for(120.0, Common::paper());
     // A one-minute gap in the middle.
     let mut samples = run.samples.clone();
     samples.retain(|s| !(50.0..110.0).contains(&s.t_s));
@@ -309,12 +314,7 @@ fn assert_recursive_matches_batch(
 
 #[test]
 fn a_gap_starts_a_new_chain() {
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(20.0),
-            ..Common::noise_free()
-        })
-        .expect("sim");
+    let run = slew_for(20.0, Common::noise_free());
     let mut src = MomentumRows::new(MomentumRowSettings::default());
     let mut rows = 0;
     for s in run.samples.iter().filter(|s| !(8.0..12.0).contains(&s.t_s)) {
@@ -345,12 +345,7 @@ fn a_gap_starts_a_new_chain() {
 #[test]
 fn splitting_a_chain_is_restarting_its_sums() {
     use inertia::estimator::augmented_qr::AugmentedQr;
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(60.0),
-            ..Common::paper()
-        })
-        .expect("sim");
+    let run = slew_for(60.0, Common::paper());
     let samples: Vec<Sample> = run
         .samples
         .iter()
@@ -404,12 +399,7 @@ fn splitting_a_chain_is_restarting_its_sums() {
 /// own rows, for Richardson rows from the gyro with chains of 20 s and the whole record.
 #[test]
 fn a_shared_row_source_gives_the_state_of_an_own_one() {
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(120.0),
-            ..Common::paper()
-        })
-        .expect("sim");
+    let run = slew_for(120.0, Common::paper());
     let base = MomentumRowSettings {
         rotation: RotationSource::Gyro,
         stencil: Stencil::Adaptive,
@@ -417,24 +407,18 @@ fn a_shared_row_source_gives_the_state_of_an_own_one() {
     };
     let mut shared = MomentumRows::new(base);
     let chains = [Some(20.0), None];
-    let mut own: Vec<_> = chains
-        .iter()
-        .map(|&max_chain_s| {
-            estimator(MomentumRowSettings {
-                max_chain_s,
-                ..base
+    let estimators = || -> Vec<_> {
+        chains
+            .iter()
+            .map(|&max_chain_s| {
+                estimator(MomentumRowSettings {
+                    max_chain_s,
+                    ..base
+                })
             })
-        })
-        .collect();
-    let mut fed: Vec<_> = chains
-        .iter()
-        .map(|&max_chain_s| {
-            estimator(MomentumRowSettings {
-                max_chain_s,
-                ..base
-            })
-        })
-        .collect();
+            .collect()
+    };
+    let (mut own, mut fed) = (estimators(), estimators());
     for s in &run.samples {
         for e in &mut own {
             e.fold(s).expect("fold");
@@ -453,12 +437,7 @@ fn a_shared_row_source_gives_the_state_of_an_own_one() {
 
 #[test]
 fn gyro_rotation_needs_gyro_rates() {
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(2.0),
-            ..Common::noise_free()
-        })
-        .expect("sim");
+    let run = slew_for(2.0, Common::noise_free());
     let mut src = MomentumRows::new(MomentumRowSettings {
         rotation: RotationSource::Gyro,
         ..Default::default()
@@ -624,12 +603,7 @@ fn jackknife_of_identical_groups_is_zero_and_of_known_spread_is_exact() {
 fn recursive_and_batch_agree_with_constant_wheel_momentum_and_a_rowless_first_chain() {
     // A constant ρ leaves the adaptive stencil's κ column zero; a first chain of two
     // nodes and a gap give no Richardson row. Both paths must see the same problem.
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(120.0),
-            ..Common::paper()
-        })
-        .expect("sim");
+    let run = slew_for(120.0, Common::paper());
     let rho0 = Vector3::new(0.02, -0.01, 0.015);
     let mut samples: Vec<Sample> = run
         .samples
@@ -655,12 +629,7 @@ fn recursive_and_batch_agree_with_constant_wheel_momentum_and_a_rowless_first_ch
 fn recursive_and_batch_jackknife_agree() {
     // The batch files the last chain too; the recursive one scales its completed chains'
     // σ to the chain in progress. With eleven chains they agree to within a quarter.
-    let run = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(330.0),
-            ..Common::paper()
-        })
-        .expect("sim");
+    let run = slew_for(330.0, Common::paper());
     let rows = MomentumRowSettings {
         stencil: Stencil::Smooth,
         max_chain_s: Some(30.0),

@@ -82,18 +82,13 @@ impl RecursiveQr {
     /// unknowns.
     #[must_use]
     pub fn residual_dof(&self) -> f64 {
-        self.weight - 6.0 - self.nuisance
+        residual_dof(self.weight, self.nuisance)
     }
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
     pub fn residual_variance(&self) -> f64 {
-        let dof = self.residual_dof();
-        if dof > 0.0 {
-            self.rss / dof
-        } else {
-            f64::INFINITY
-        }
+        residual_variance(self.rss, self.residual_dof())
     }
 
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
@@ -105,5 +100,22 @@ impl RecursiveQr {
         self.y_energy *= lambda;
         self.weight *= lambda;
         self.noise_s *= lambda;
+    }
+}
+
+/// Residual degrees of freedom of a least-squares state: its (weighted) rows minus `j`'s
+/// six unknowns and the nuisance unknowns.
+#[must_use]
+pub(crate) fn residual_dof(weight: f64, nuisance: f64) -> f64 {
+    weight - 6.0 - nuisance
+}
+
+/// `ρ²` per residual degree of freedom, `∞` without any.
+#[must_use]
+pub(crate) fn residual_variance(rss: f64, dof: f64) -> f64 {
+    if dof > 0.0 {
+        rss / dof
+    } else {
+        f64::INFINITY
     }
 }

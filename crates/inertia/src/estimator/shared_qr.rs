@@ -182,18 +182,13 @@ impl SharedQr {
     /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
     #[must_use]
     pub fn residual_dof(&self) -> f64 {
-        self.weight - 6.0 - self.nuisance
+        super::qr::residual_dof(self.weight, self.nuisance)
     }
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
     pub fn residual_variance(&self) -> f64 {
-        let dof = self.residual_dof();
-        if dof > 0.0 {
-            self.rss / dof
-        } else {
-            f64::INFINITY
-        }
+        super::qr::residual_variance(self.rss, self.residual_dof())
     }
 
     /// The reduced problem in `j`: the trailing 6×6 block, with the nuisance unknowns

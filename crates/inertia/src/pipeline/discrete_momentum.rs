@@ -1032,6 +1032,28 @@ mod tests {
     use crate::sim::realism::{AttitudeSource, Realism};
     use crate::sim::scenario::{Common, Scenario};
 
+    /// The default settings but J ⪰ εI: the paper's J lies slightly outside Σ ⪰ 0
+    /// (docs/conventions.md §4), so that the truth is in the set and the answer carries
+    /// no constraint bias.
+    fn truth_inside() -> PipelineConfig {
+        PipelineSettings {
+            constraints: crate::constraints::ConstraintSet::positive_definite(),
+            ..PipelineSettings::default()
+        }
+        .validate()
+        .unwrap()
+    }
+
+    /// Every sample through a new estimator: the estimator and its last answer.
+    fn run_to_the_end(config: &PipelineConfig, samples: &[Sample]) -> (DiscreteMomentum, Estimate) {
+        let mut p = DiscreteMomentum::new(config).unwrap();
+        let mut last = None;
+        for s in samples {
+            last = p.push(s).unwrap().or(last);
+        }
+        (p, last.expect("an answer"))
+    }
+
     /// With star-tracker attitudes the attitude candidates fit far worse than the gyro
     /// ones and are ruled out; every answer (ĵ, status, σ) is still exactly that of the
     /// run that folds them to the end.
@@ -1131,12 +1153,7 @@ mod tests {
     /// and a longer chain is chosen.
     #[test]
     fn the_shortest_chains_are_chosen_where_they_are_steadier() {
-        let config = PipelineSettings {
-            constraints: crate::constraints::ConstraintSet::positive_definite(),
-            ..PipelineSettings::default()
-        }
-        .validate()
-        .unwrap();
+        let config = truth_inside();
         let short = config.max_chain_s.unwrap();
         let (mut chosen_sum, mut chain_sum) = (0.0, 0.0);
         for seed in 1..=3 {
@@ -1149,12 +1166,7 @@ mod tests {
                 ..Common::paper()
             };
             let run = Scenario::spin().simulate(&common).unwrap();
-            let mut p = DiscreteMomentum::new(&config).unwrap();
-            let mut last = None;
-            for s in &run.samples {
-                last = p.push(s).unwrap().or(last);
-            }
-            let e = last.expect("an answer");
+            let (mut p, e) = run_to_the_end(&config, &run.samples);
             let chosen = *p.candidates[p.chosen].row_settings();
             assert_eq!(
                 chosen.max_chain_s,
@@ -1265,14 +1277,7 @@ mod tests {
     /// gyro), the whole record fits worse and is not chosen.
     #[test]
     fn the_whole_record_is_chosen_where_nothing_drifts() {
-        // The paper's J lies slightly outside Σ ⪰ 0 (docs/conventions.md §4): J ⪰ εI, so
-        // that the truth is in the set and the answer carries no constraint bias.
-        let config = PipelineSettings {
-            constraints: crate::constraints::ConstraintSet::positive_definite(),
-            ..PipelineSettings::default()
-        }
-        .validate()
-        .unwrap();
+        let config = truth_inside();
         let run_of = |scenario: Scenario, realism: Realism, seed: u64| {
             let common = Common {
                 seed,
@@ -1289,12 +1294,7 @@ mod tests {
         let mut chosen_whole = 0;
         for seed in 1..=4 {
             let run = run_of(Scenario::slew(), one_hz, seed);
-            let mut p = DiscreteMomentum::new(&config).unwrap();
-            let mut last = None;
-            for s in &run.samples {
-                last = p.push(s).unwrap().or(last);
-            }
-            let e = last.expect("an answer");
+            let (mut p, e) = run_to_the_end(&config, &run.samples);
             let chosen = *p.candidates[p.chosen].row_settings();
             if chosen.max_chain_s.is_some() {
                 continue;
