@@ -125,14 +125,8 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// must feed it every block from the first on.
     pub fn fold_shared(&mut self, row: &AugmentedRow, source: &MomentumRows, t_s: f64) {
         debug_assert_eq!(
-            MomentumRowSettings {
-                max_chain_s: None,
-                ..*source.settings()
-            },
-            MomentumRowSettings {
-                max_chain_s: None,
-                ..self.settings.rows
-            }
+            source.settings().rows_only(),
+            self.settings.rows.rows_only()
         );
         let epoch = self.clock.epoch(source);
         self.fold_row(row, epoch, t_s);

@@ -228,6 +228,16 @@ impl core::fmt::Display for MomentumRowSettings {
 }
 
 impl MomentumRowSettings {
+    /// The settings the rows themselves depend on: these but for the chain length, which
+    /// only [`ChainClock`] uses. Candidates with equal rows can share one row source.
+    #[must_use]
+    pub fn rows_only(&self) -> Self {
+        Self {
+            max_chain_s: None,
+            ..*self
+        }
+    }
+
     /// Unknowns besides `j` the rows involve in one chain.
     #[must_use]
     pub fn nuisance_per_chain(&self) -> usize {

@@ -151,8 +151,7 @@ fn chained_siblings<'a>(
 fn is_chained_sibling(rows: &MomentumRowSettings, r: &MomentumRowSettings, from_s: f64) -> bool {
     rows.max_chain_s.is_none()
         && r.max_chain_s.is_some_and(|l| l >= from_s)
-        && r.rotation == rows.rotation
-        && r.stencil == rows.stencil
+        && r.rows_only() == rows.rows_only()
 }
 
 /// Element by element the largest of the jackknife σ given (`None`: none).
@@ -392,7 +391,7 @@ fn steadier(
     let mut best = (fitted, frobenius(&s0) / STEADIER);
     for (i, r) in rows.iter().enumerate() {
         let longer = r.max_chain_s.is_some_and(|l| l > length);
-        if !longer || r.rotation != r0.rotation || r.stencil != r0.stencil {
+        if !longer || r.rows_only() != r0.rows_only() {
             continue;
         }
         if let Some(s) = jackknife(i) {
@@ -452,10 +451,7 @@ struct SharedSource {
 fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSource> {
     let mut out: Vec<SharedSource> = Vec::new();
     for (i, r) in candidates.iter().enumerate() {
-        let key = MomentumRowSettings {
-            max_chain_s: None,
-            ..*r
-        };
+        let key = r.rows_only();
         match out.iter_mut().find(|g| *g.rows.settings() == key) {
             Some(g) => g.members.push(i),
             None => out.push(SharedSource {
