@@ -24,15 +24,32 @@ pub const CONFLICT_CHI2: f64 = 27.86;
 /// Withdraw or qualify the status of `e` (solved from `qr` under a `J ⪰ εI` floor of
 /// `epsilon_kg_m2`) where its own data contradict it.
 pub fn audit(e: &mut Estimate, qr: &RecursiveQr, epsilon_kg_m2: f64, max_relative_sigma: f64) {
+    let moments = e
+        .j()
+        .map(|j| crate::eigen3::symmetric_eigen3(&matrix_from_j(&j)).0);
+    audit_at(e, qr, epsilon_kg_m2, max_relative_sigma, moments.as_ref());
+}
+
+/// [`audit`] given the principal moments of `e`'s `J` (any order), for a caller that has
+/// them already.
+pub fn audit_at(
+    e: &mut Estimate,
+    qr: &RecursiveQr,
+    epsilon_kg_m2: f64,
+    max_relative_sigma: f64,
+    moments: Option<&nalgebra::Vector3<f64>>,
+) {
     if !matches!(
         e.observability,
         Observability::Determined { .. } | Observability::FromPrior(_)
     ) {
         return;
     }
-    let Some(j) = e.j() else { return };
+    let (Some(j), Some(moments)) = (e.j(), moments) else {
+        return;
+    };
     let m = matrix_from_j(&j);
-    let min_moment_kg_m2 = crate::eigen3::symmetric_eigen3(&m).0.min();
+    let min_moment_kg_m2 = moments.min();
     let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
     if min_moment_kg_m2 < 2.0 * epsilon_kg_m2 {
         let unconstrained_negative = unconstrained

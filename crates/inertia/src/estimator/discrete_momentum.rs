@@ -132,7 +132,37 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         self.fold_row(row, epoch, t_s);
     }
 
+    /// [`Self::fold_shared`] for two candidates fed by the same source, their folds
+    /// interleaved ([`AugmentedQr::add_pair`]): the same states as two
+    /// [`Self::fold_shared`], bit for bit, faster.
+    pub fn fold_shared_pair(
+        a: &mut Self,
+        b: &mut Self,
+        row: &AugmentedRow,
+        source: &MomentumRows,
+        t_s: f64,
+    ) {
+        for e in [&*a, &*b] {
+            debug_assert_eq!(source.settings().rows_only(), e.settings.rows.rows_only());
+        }
+        let (ea, eb) = (a.clock.epoch(source), b.clock.epoch(source));
+        a.before_fold(ea, t_s);
+        b.before_fold(eb, t_s);
+        AugmentedQr::add_pair(
+            (&mut a.qr, a.groups.as_mut().map(ChainGroups::chain_mut)),
+            (&mut b.qr, b.groups.as_mut().map(ChainGroups::chain_mut)),
+            row,
+        );
+    }
+
     fn fold_row(&mut self, row: &AugmentedRow, epoch: u64, t_s: f64) {
+        self.before_fold(epoch, t_s);
+        self.qr
+            .add(row, self.groups.as_mut().map(ChainGroups::chain_mut));
+    }
+
+    /// A new chain's bookkeeping and forgetting, before a row block at `t_s` is folded.
+    fn before_fold(&mut self, epoch: u64, t_s: f64) {
         if epoch != self.epoch {
             self.epoch = epoch;
             self.qr.eliminate_anchors();
@@ -152,8 +182,6 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             self.qr.scale(libm::exp(-(t_s - t0) / m));
         }
         self.last_block_t_s = Some(t_s);
-        self.qr
-            .add(row, self.groups.as_mut().map(ChainGroups::chain_mut));
         self.since_solve += 1;
     }
 

@@ -30,6 +30,7 @@
 //! not hold, so the estimator keeps no groups then and the noise σ is the least-squares
 //! one.
 
+use super::normal_equations::NormalEquations;
 use super::shared_qr::SharedQr;
 use crate::constraints::Constraints;
 use crate::solver::unconstrained_minimiser;
@@ -71,10 +72,11 @@ pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [
 }
 
 /// The rows of the chain in progress and of the completed chains, by group: enough to
-/// compute the jackknife σ at any time without holding the rows.
+/// compute the jackknife σ at any time without holding the rows. The chain in progress
+/// is kept as normal equations ([`super::normal_equations`]) and factored when it ends.
 #[derive(Debug, Clone)]
 pub struct ChainGroups {
-    chain: SharedQr,
+    chain: NormalEquations,
     groups: [SharedQr; GROUPS],
     chains: usize,
     /// `(chains, σ)` at the last computation.
@@ -84,7 +86,7 @@ pub struct ChainGroups {
 impl Default for ChainGroups {
     fn default() -> Self {
         Self {
-            chain: SharedQr::new(0),
+            chain: NormalEquations::default(),
             groups: [SharedQr::new(0); GROUPS],
             chains: 0,
             cached: None,
@@ -93,10 +95,10 @@ impl Default for ChainGroups {
 }
 
 impl ChainGroups {
-    /// The state of the chain in progress, to fold its row blocks into along with the
+    /// The state of the chain in progress, to add its row blocks to along with the
     /// estimator's ([`super::augmented_qr::AugmentedQr::add`]): it holds the rows of the
     /// shared unknowns only, the initial momenta being minimised out already.
-    pub fn chain_mut(&mut self) -> &mut SharedQr {
+    pub fn chain_mut(&mut self) -> &mut NormalEquations {
         &mut self.chain
     }
 
@@ -107,9 +109,9 @@ impl ChainGroups {
             return;
         }
         if let Some(g) = self.groups.get_mut(self.chains % GROUPS) {
-            g.merge(&self.chain);
+            g.merge(&self.chain.factor());
         }
-        self.chain = SharedQr::new(0);
+        self.chain = NormalEquations::default();
         self.chains += 1;
     }
 
@@ -188,7 +190,8 @@ mod tests {
                 let a: [SVector<f64, SHARED>; 3] =
                     core::array::from_fn(|_| SVector::from_fn(|_, _| rnd()));
                 let y: [f64; 3] = core::array::from_fn(|_| rnd());
-                estimator.add((a, y), &y, 0.0, Some(groups.chain_mut()));
+                groups.chain_mut().add(&(a, y), &y, 0.0);
+                estimator.add((a, y), &y, 0.0);
             }
             groups.end_chain();
             let used = groups.chains.min(GROUPS);

@@ -23,6 +23,7 @@ pub mod excitation;
 pub mod jackknife;
 pub mod momentum;
 pub mod momentum_rows;
+pub mod normal_equations;
 pub mod observability;
 pub mod prior;
 pub mod qr;

@@ -61,41 +61,48 @@ impl SharedQr {
         }
     }
 
-    /// Fold a block (consumed: zero afterwards, its right-hand sides the leftover) into
-    /// this state and, when given, the same block into `other` too, their reflections
-    /// interleaved so that the processor overlaps their `√` and divisions. `y` are the
-    /// rows' right-hand sides as measured (for the energy counter) and `noise_s` their
-    /// errors-in-variables coefficient.
-    pub fn add(
+    /// Fold a block of `M` rows (consumed: zero afterwards, its right-hand sides the
+    /// leftover) into this state, one reflection per pivot. `y` are the rows' right-hand sides as measured (for the energy
+    /// counter) and `noise_s` their errors-in-variables coefficient.
+    pub fn add<const M: usize>(
         &mut self,
-        block: SharedBlock,
-        y: &[f64; 3],
+        block: ([SVector<f64, SHARED>; M], [f64; M]),
+        y: &[f64; M],
         noise_s: f64,
-        other: Option<&mut SharedQr>,
     ) {
         let (mut a, mut beta) = block;
-        if let Some(o) = other {
-            let (mut a2, mut beta2) = (a, beta);
-            // Unrolled: each reflection's loops get fixed lengths (4 % faster on the
-            // 1M-sample run than the loop over pivots).
-            const _: () = assert!(SHARED == 10, "one literal per pivot below");
-            macro_rules! both {
-                ($($i:literal)*) => {$(
-                    reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, $i);
-                    reflect(&mut o.rt, &mut o.z, &mut a2, &mut beta2, $i);
-                )*};
-            }
-            both!(0 1 2 3 4 5 6 7 8 9);
-            o.count(y, &beta2, noise_s);
-        } else {
-            macro_rules! one {
-                ($($i:literal)*) => {$(
-                    reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, $i);
-                )*};
-            }
-            one!(0 1 2 3 4 5 6 7 8 9);
+        // Unrolled: each reflection's loops get fixed lengths (4 % faster on the
+        // 1M-sample run than the loop over pivots).
+        const _: () = assert!(SHARED == 10, "one literal per pivot below");
+        macro_rules! one {
+            ($($i:literal)*) => {$(
+                reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, $i);
+            )*};
         }
+        one!(0 1 2 3 4 5 6 7 8 9);
         self.count(y, &beta, noise_s);
+    }
+
+    /// [`Self::add`] of a block to each of two states, their reflections interleaved
+    /// pivot by pivot so that the processor overlaps their `√` and divisions, on which
+    /// each pivot waits: the same states as two [`Self::add`], bit for bit. The blocks'
+    /// rows share `y` and `noise_s` (one row block, centred for each state).
+    pub fn add_pair(
+        (s, (mut a, mut beta)): (&mut Self, SharedBlock),
+        (o, (mut a2, mut beta2)): (&mut Self, SharedBlock),
+        y: &[f64; 3],
+        noise_s: f64,
+    ) {
+        const _: () = assert!(SHARED == 10, "one literal per pivot below");
+        macro_rules! both {
+            ($($i:literal)*) => {$(
+                reflect(&mut s.rt, &mut s.z, &mut a, &mut beta, $i);
+                reflect(&mut o.rt, &mut o.z, &mut a2, &mut beta2, $i);
+            )*};
+        }
+        both!(0 1 2 3 4 5 6 7 8 9);
+        s.count(y, &beta, noise_s);
+        o.count(y, &beta2, noise_s);
     }
 
     /// Count a block of rows that needed no fold (its leftover is zero: the rows fix
@@ -104,7 +111,7 @@ impl SharedQr {
         self.count(y, &[0.0; 3], noise_s);
     }
 
-    fn count(&mut self, y: &[f64; 3], left: &[f64; 3], noise_s: f64) {
+    fn count<const M: usize>(&mut self, y: &[f64; M], left: &[f64; M], noise_s: f64) {
         for (y, left) in y.iter().zip(left) {
             self.y_energy += y * y;
             self.rss += left * left;
@@ -142,6 +149,27 @@ impl SharedQr {
         self.weight += other.weight;
         self.nuisance += other.nuisance;
         self.noise_s += other.noise_s;
+    }
+
+    /// A state from its parts: `Rᵀ`, `z`, `ρ²` and the counters `(y energy, rows, row
+    /// weight, errors-in-variables sum)`, no nuisance unknowns counted
+    /// ([`super::normal_equations::NormalEquations::factor`]).
+    pub(super) fn from_parts(
+        rt: SMatrix<f64, SHARED, SHARED>,
+        z: SVector<f64, SHARED>,
+        rss: f64,
+        (y_energy, rows, weight, noise_s): (f64, usize, f64, f64),
+    ) -> Self {
+        Self {
+            rt,
+            z,
+            rss,
+            y_energy,
+            rows,
+            weight,
+            nuisance: 0.0,
+            noise_s,
+        }
     }
 
     /// Count `n` more nuisance unknowns (a new chain's initial momenta).

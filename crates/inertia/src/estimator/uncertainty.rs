@@ -87,10 +87,24 @@ pub fn combine(
 /// propagate to the principal moments of `j`.
 #[must_use]
 pub fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> Uncertainty {
+    with_bias_at(
+        noise,
+        bias,
+        &crate::eigen3::symmetric_eigen3(&matrix_from_j(j_full)),
+    )
+}
+
+/// [`with_bias`] given the eigenpairs of `j` ([`crate::eigen3::symmetric_eigen3`]), for a
+/// caller that has them already.
+#[must_use]
+pub fn with_bias_at(
+    noise: &[f64; 6],
+    bias: &[f64; 6],
+    eig: &(Vector3<f64>, [Vector3<f64>; 3]),
+) -> Uncertainty {
     let bias = *bias;
     let sigma: [f64; 6] =
         core::array::from_fn(|k| crate::math::sqrt(noise[k] * noise[k] + bias[k] * bias[k]));
-    let eig = crate::eigen3::symmetric_eigen3(&matrix_from_j(j_full));
     let principal = core::array::from_fn(|i| {
         let v: Vector3<f64> = eig.1[i];
         let var: f64 = COMPONENT_INDEX

@@ -24,7 +24,8 @@ use super::settings::PipelineConfig;
 use super::standing::{Standing, RULE_OUT_AFTER};
 use super::PipelineError;
 use crate::constraints::Constraints;
-use crate::estimator::audit::audit;
+use crate::eigen3::symmetric_eigen3;
+use crate::estimator::audit::{audit, audit_at};
 use crate::estimator::compensation::compensate;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::discrete_momentum::{
@@ -39,7 +40,7 @@ use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::recursive::RecursiveSettings;
-use crate::estimator::uncertainty::{noise_sigma, with_bias};
+use crate::estimator::uncertainty::{noise_sigma, with_bias, with_bias_at};
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::sample::Sample;
 use crate::solver::{unconstrained_minimiser, Backend};
@@ -484,7 +485,13 @@ pub(crate) const DISAGREE_Z: f64 = 5.0;
 /// either answer may be the right one: the difference joins the bias part of σ, so that
 /// the stated σ covers both. If σ then exceeds `max_relative_sigma · ‖Ĵ‖_F`, the answer
 /// is withdrawn ([`Unobservable::SourcesDisagree`]).
-fn reconcile(e: &mut Estimate, others: &[(InertiaVector, [f64; 6])], max_relative_sigma: f64) {
+/// `eig` are the eigenpairs of `e`'s `J` ([`symmetric_eigen3`]).
+fn reconcile(
+    e: &mut Estimate,
+    eig: &Eigen,
+    others: &[(InertiaVector, [f64; 6])],
+    max_relative_sigma: f64,
+) {
     let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
         return;
     };
@@ -502,7 +509,7 @@ fn reconcile(e: &mut Estimate, others: &[(InertiaVector, [f64; 6])], max_relativ
     if worst == 0.0 {
         return;
     }
-    let u = with_bias(&u.noise_kg_m2, &bias, &j);
+    let u = with_bias_at(&u.noise_kg_m2, &bias, eig);
     let relative = u.frobenius_sigma_kg_m2() / matrix_from_j(&j).norm();
     if relative <= max_relative_sigma {
         e.uncertainty = Some(u);
@@ -524,6 +531,15 @@ fn disagreement(a: &InertiaVector, sa: &[f64; 6], b: &InertiaVector, sb: &[f64; 
         .map(|k| (a[k] - b[k]).abs() / (sa[k] * sa[k] + sb[k] * sb[k]).sqrt())
         .fold(0.0, f64::max)
 }
+
+/// Eigenpairs of a symmetric 3×3 matrix ([`symmetric_eigen3`]).
+type Eigen = (Vector3<f64>, [Vector3<f64>; 3]);
+
+/// Placeholder eigenpairs for an estimate without `J`.
+const NO_EIGEN: Eigen = (
+    Vector3::new(0.0, 0.0, 0.0),
+    [Vector3::new(0.0, 0.0, 0.0); 3],
+);
 
 fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
     Ok(Box::new(DiscreteMomentum::new(c)?))
@@ -628,7 +644,12 @@ impl DiscreteMomentum {
     /// Withdraw a determined answer that another candidate's own answer contradicts
     /// beyond both σ ([`DISAGREE_Z`]); the other candidates' answers are refreshed every
     /// [`CROSS_CHECK_EVERY`] row blocks.
-    fn cross_check(&mut self, e: &mut Estimate, t_s: f64) -> Result<(), EstimatorError> {
+    fn cross_check(
+        &mut self,
+        e: &mut Estimate,
+        eig: &Eigen,
+        t_s: f64,
+    ) -> Result<(), EstimatorError> {
         if self.candidates.len() < 2 || !matches!(e.observability, Observability::Determined { .. })
         {
             return Ok(());
@@ -668,6 +689,7 @@ impl DiscreteMomentum {
         }
         reconcile(
             e,
+            eig,
             &self.others,
             self.config.observability.max_relative_sigma,
         );
@@ -714,10 +736,27 @@ impl Estimator for DiscreteMomentum {
                 continue;
             };
             folded = true;
+            // In pairs, their folds interleaved (`fold_shared_pair`), the odd one alone.
+            let mut waiting: Option<usize> = None;
             for &i in src.members.iter().filter(|i| wanted(i)) {
-                let c = &mut self.candidates[i];
-                c.fold_shared(&row, &src.rows, s.t_s);
-                if record {
+                match waiting.take() {
+                    None => waiting = Some(i),
+                    Some(h) => {
+                        let (low, high) = self.candidates.split_at_mut(i);
+                        if let (Some(a), Some(b)) = (low.get_mut(h), high.first_mut()) {
+                            Candidate::fold_shared_pair(a, b, &row, &src.rows, s.t_s);
+                        }
+                    }
+                }
+            }
+            if let Some(h) = waiting {
+                if let Some(c) = self.candidates.get_mut(h) {
+                    c.fold_shared(&row, &src.rows, s.t_s);
+                }
+            }
+            if record {
+                for &i in src.members.iter().filter(|i| wanted(i)) {
+                    let c = &self.candidates[i];
                     self.residuals[i].record(c.qr().rss(), c.qr().residual_dof(), s.t_s);
                 }
             }
@@ -771,10 +810,15 @@ impl Estimator for DiscreteMomentum {
         }
         self.since_solve = 0;
         let mut e = c.solve_now(s.t_s)?;
+        // The eigenpairs of Ĵ, once for σ's principal moments, the cross-check and the
+        // audit (a withdrawn answer has none, and none of them runs).
+        let eig = e
+            .j()
+            .map_or(NO_EIGEN, |j| symmetric_eigen3(&matrix_from_j(&j)));
         let best = *c.reduced();
         let noise = self.noise_sigma(self.chosen);
         if self.config.uncertainty {
-            if let (Some(j), Some(noise)) = (e.j(), noise) {
+            if let (Some(_), Some(noise)) = (e.j(), noise) {
                 let others = self
                     .candidates
                     .iter()
@@ -801,18 +845,19 @@ impl Estimator for DiscreteMomentum {
                     _ => [0.0; 6],
                 };
                 let bias = quadrature(&spread, &discretisation);
-                e.uncertainty = Some(with_bias(&noise, &bias, &j));
+                e.uncertainty = Some(with_bias_at(&noise, &bias, &eig));
             }
         }
-        self.cross_check(&mut e, s.t_s)?;
+        self.cross_check(&mut e, &eig, s.t_s)?;
         let Some(c) = self.candidates.get(self.chosen) else {
             return Ok(Some(e));
         };
-        audit(
+        audit_at(
             &mut e,
             c.solved(),
             self.config.constraints.set().epsilon_kg_m2,
             self.config.observability.max_relative_sigma,
+            Some(&eig.0),
         );
         scale_from_prior(&mut e, c.reduced(), &self.config.constraints);
         // The density describes the gyro: its rows are the ones to compare with it (with
@@ -991,7 +1036,15 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
                     }
                 }
             }
-            reconcile(&mut estimate, &others, c.observability.max_relative_sigma);
+            if let Some(j) = estimate.j() {
+                let eig = symmetric_eigen3(&matrix_from_j(&j));
+                reconcile(
+                    &mut estimate,
+                    &eig,
+                    &others,
+                    c.observability.max_relative_sigma,
+                );
+            }
         }
     }
     audit(
