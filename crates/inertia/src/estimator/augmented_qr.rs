@@ -398,6 +398,46 @@ mod tests {
         assert_eq!(chain, chain1);
     }
 
+    /// Holding the torque at zero ([`SharedQr::reduced_without_torque`]) is folding the
+    /// same rows with the torque's columns zeroed: the reduced `R` and `z` to 1e-12 of
+    /// their largest entry (up to the signs of rows), `ρ²` to 1e-10 relative, and the
+    /// growth of `ρ²` is the difference of the two states' `ρ²`; three nuisance unknowns
+    /// fewer. Two chains, Richardson-like alternating slots.
+    #[test]
+    fn holding_the_torque_at_zero_is_dropping_its_columns() {
+        let mut rnd = crate::testing::uniform(0xbb67_ae85_84ca_a73b);
+        let (mut with, mut without) = (AugmentedQr::new(3), AugmentedQr::new(0));
+        for k in 0..60 {
+            if k == 25 {
+                with.eliminate_anchors();
+                without.eliminate_anchors();
+            }
+            let row = block(&mut rnd, k % 2);
+            let mut zeroed = row;
+            for m in 0..3 {
+                for t in TORQUE..TORQUE + 3 {
+                    zeroed.a[(m, t)] = 0.0;
+                }
+            }
+            with.add(&row, None);
+            without.add(&zeroed, None);
+        }
+        let (held, growth) = with.shared().reduced_without_torque();
+        let want = without.reduced();
+        let scale = want.r.amax();
+        for i in 0..6 {
+            let sign = held.r[(i, i)].signum() * want.r[(i, i)].signum();
+            for k in 0..6 {
+                assert!((held.r[(i, k)] - sign * want.r[(i, k)]).abs() <= 1e-12 * scale);
+            }
+            assert!((held.z[i] - sign * want.z[i]).abs() <= 1e-12 * want.z.amax());
+        }
+        assert!((held.rss - want.rss).abs() <= 1e-10 * want.rss);
+        assert!((growth - (want.rss - with.rss())).abs() <= 1e-10 * want.rss);
+        assert!(growth > 0.0);
+        assert_eq!(held.nuisance, with.reduced().nuisance - 3.0);
+    }
+
     /// Merging a chain's state (its rows in a wavefront) is folding its rows one by one.
     #[test]
     fn merging_is_folding_the_rows_one_by_one() {

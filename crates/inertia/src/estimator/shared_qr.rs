@@ -235,6 +235,38 @@ impl SharedQr {
         }
     }
 
+    /// The reduced problem in `j` with the disturbance torque `τ_b` held at zero instead of
+    /// minimised out, and the growth of `ρ²` that costs. With `τ_b` first, `‖R y − z‖²`
+    /// at `τ_b = 0` is `‖R_τr r − z_τ‖² + ‖R_rr r − z_r‖²` in the other unknowns `r =
+    /// [κ; j]`: the three rows of `R` that hold `τ_b`, without its columns, folded into the
+    /// trailing factor (Givens rotations). Their leftover is what `τ_b` explained.
+    /// The three torque unknowns are no longer counted as nuisance. Without forgetting
+    /// only (the count of the torque unknowns is not weighted).
+    #[must_use]
+    pub fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
+        const REST: usize = SHARED - 3;
+        let mut r = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(k + 3, i + 3)]);
+        let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + 3]);
+        let mut growth = 0.0;
+        for t in 0..3 {
+            let a = SVector::<f64, REST>::from_fn(|k, _| self.rt[(k + 3, t)]);
+            let left = crate::givens::fold_row(&mut r, &a, Some((&mut z, self.z[t])));
+            growth += left * left;
+        }
+        let off = J_SHARED - 3;
+        let reduced = RecursiveQr {
+            r: Matrix6::from_fn(|i, k| r[(off + i, off + k)]),
+            z: Vector6::from_fn(|i, _| z[off + i]),
+            rss: self.rss + growth,
+            y_energy: self.y_energy,
+            rows: self.rows,
+            weight: self.weight,
+            noise_s: self.noise_s,
+            nuisance: self.nuisance - 3.0,
+        };
+        (reduced, growth)
+    }
+
     /// `[τ_b; κ]` at a given `j`: back-substitution through the leading rows; zero for
     /// unknowns the rows never involved.
     #[must_use]

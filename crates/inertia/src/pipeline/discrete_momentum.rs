@@ -29,7 +29,8 @@ use crate::estimator::audit::{audit, audit_at};
 use crate::estimator::compensation::compensate;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::discrete_momentum::{
-    reduce_batch, BatchReduction, DiscreteMomentumEstimator, MomentumEstimatorSettings,
+    reduce_batch, torque_tested, BatchReduction, DiscreteMomentumEstimator,
+    MomentumEstimatorSettings, TorqueTest,
 };
 use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::jackknife::robust_sigma;
@@ -910,6 +911,10 @@ impl Estimator for DiscreteMomentum {
         self.candidates.get(self.chosen)?.torque_bias_nm()
     }
 
+    fn torque_test(&self) -> Option<TorqueTest> {
+        self.candidates.get(self.chosen)?.torque_test()
+    }
+
     fn residual_consistency(&self) -> Option<Worst> {
         self.residuals.get(self.chosen)?.worst()
     }
@@ -955,6 +960,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         });
     };
     let qr = &batch.qr;
+    let (tested, _) = torque_tested(batch.qr, batch.without_torque);
     let mut backend = registry::build_backend(c.backend);
     let t_s = samples.last().map_or(0.0, |s| s.t_s);
     // One candidate's own answer and noise σ (for the whole record as one chain, at
@@ -969,8 +975,11 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
             )
             .map(|k| reduced[k].1.jackknife_sigma_kg_m2),
         );
+        // As the recursive solve does: the torque held at zero where the data give no
+        // evidence of one.
+        let (tested, _) = torque_tested(b.qr, b.without_torque);
         let e = batch::solve_reduced(
-            &b.qr,
+            &tested,
             t_s,
             &c.constraints,
             &mut *backend,
@@ -981,7 +990,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         // With prior knowledge, σ is the least-squares one of the data and the prior
         // together, or the data's own jackknife σ where that is larger (the batch
         // jackknife's delete-one solves carry no prior: conservative).
-        let (solved, _) = prior::augment(&b.qr, &c.constraints);
+        let (solved, _) = prior::augment(&tested, &c.constraints);
         let jackknife = sibling_jackknife([b.jackknife_sigma_kg_m2, sibling].into_iter());
         let svd = nalgebra::SVD::try_new(
             solved.r,
@@ -1005,7 +1014,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
                 .enumerate()
                 .filter(|&(i, (r, _))| i != chosen && in_running(r, from_s))
                 .map(|(_, (_, b))| b.qr);
-            let spread = model_spread(qr, others, c.gyro_noise_rad_s_rthz, &c.constraints);
+            let spread = model_spread(&tested, others, c.gyro_noise_rad_s_rthz, &c.constraints);
             // As in the recursive path: the first candidate on every other sample.
             let half: Vec<Sample> = samples
                 .chunks_exact(2)
@@ -1049,11 +1058,11 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     }
     audit(
         &mut estimate,
-        &prior::augment(qr, &c.constraints).0,
+        &prior::augment(&tested, &c.constraints).0,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
     );
-    scale_from_prior(&mut estimate, qr, &c.constraints);
+    scale_from_prior(&mut estimate, &tested, &c.constraints);
     // The residuals against the stated gyro density, as in the recursive path: the gyro
     // rotation's rows are the ones the density describes. (The span test needs the
     // recursive residuals, which a batch reduction does not form.)

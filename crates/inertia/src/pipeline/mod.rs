@@ -373,6 +373,13 @@ impl Pipeline {
         self.estimator.torque_bias_nm()
     }
 
+    /// The test for a constant disturbance torque at the last solve, where made: whether
+    /// the torque was held at zero for want of evidence.
+    #[must_use]
+    pub fn torque_test(&self) -> Option<crate::estimator::discrete_momentum::TorqueTest> {
+        self.estimator.torque_test()
+    }
+
     /// The span of the record whose residuals stand out most from the rest, with their
     /// variance ratio ([`crate::estimator::consistency`]; estimators that test their
     /// residuals, without forgetting).

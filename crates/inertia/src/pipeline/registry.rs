@@ -34,6 +34,11 @@ pub trait Estimator: Send {
     fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
         None
     }
+    /// The test for a constant disturbance torque at the last solve, where the estimator
+    /// makes it ([`crate::estimator::discrete_momentum::torque_tested`]).
+    fn torque_test(&self) -> Option<crate::estimator::discrete_momentum::TorqueTest> {
+        None
+    }
     /// The span of the record whose residuals stand out most, where the estimator tests
     /// its residuals ([`crate::estimator::consistency`]).
     fn residual_consistency(&self) -> Option<Worst> {

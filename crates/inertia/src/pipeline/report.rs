@@ -19,6 +19,7 @@
 use super::settings::PipelineConfig;
 use crate::constraints::ActiveBound;
 use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO};
+use crate::estimator::discrete_momentum::TORQUE_CHI2;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
@@ -113,6 +114,9 @@ pub struct Report {
     pub row_model: Option<MomentumRowSettings>,
     /// The estimated constant body-frame disturbance torque, N m.
     pub torque_bias_nm: Option<[f64; 3]>,
+    /// The test for that torque: `chi2`, and whether it was held at zero for want of
+    /// evidence (`held_at_zero`; then `torque_bias_nm` is `null`).
+    pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
     /// The element bounds the answer sits on: they, not the data, hold it there.
     pub active_bounds: std::vec::Vec<ActiveBound>,
     /// How the Gaussian prior sat with the data (`chi2`, `rows`, and per element the
@@ -177,6 +181,7 @@ impl Report {
             excitation: None,
             row_model: None,
             torque_bias_nm: None,
+            torque_test: None,
             active_bounds: estimate
                 .j()
                 .map(|j| config.constraints().set().active_bounds(&j).collect())
@@ -199,6 +204,7 @@ impl Report {
             Self::new(last, p.config(), false, p.estimator_samples(), p.gaps())
                 .with_excitation(p.excitation())
                 .with_row_model(p.row_model(), p.torque_bias_nm())
+                .with_torque_test(p.torque_test())
                 .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
                 .with_glitches(Some(p.glitches())),
         )
@@ -237,6 +243,16 @@ impl Report {
     ) -> Self {
         self.row_model = row_model;
         self.torque_bias_nm = torque_bias_nm.map(|t| [t.x, t.y, t.z]);
+        self
+    }
+
+    /// With the test for a constant disturbance torque, where the estimator makes it.
+    #[must_use]
+    pub fn with_torque_test(
+        mut self,
+        test: Option<crate::estimator::discrete_momentum::TorqueTest>,
+    ) -> Self {
+        self.torque_test = test;
         self
     }
 
@@ -390,10 +406,21 @@ impl fmt::Display for Report {
             )?;
         }
         if let Some(t) = self.torque_bias_nm {
+            let test = self
+                .torque_test
+                .map(|t| format!(" (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2})", t.chi2))
+                .unwrap_or_default();
             writeln!(
                 s,
-                "unknown constant torque (body) [N m]: [{:.3e}, {:.3e}, {:.3e}]",
+                "unknown constant torque (body) [N m]: [{:.3e}, {:.3e}, {:.3e}]{test}",
                 t[0], t[1], t[2]
+            )?;
+        } else if let Some(t) = self.torque_test.filter(|t| t.held_at_zero) {
+            writeln!(
+                s,
+                "unknown constant torque: held at zero, the data give no evidence of one \
+                 (χ²₃ = {:.2} ≤ {TORQUE_CHI2})",
+                t.chi2
             )?;
         }
         if let Some(e) = self.relative_error {
