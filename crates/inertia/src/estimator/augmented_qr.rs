@@ -344,7 +344,7 @@ mod tests {
                 reference.eliminate();
                 // The chain's normal equations, factored ([`NormalEquations::factor`]).
                 assert_shared(&mine.factor(), &reference, &format!("chain {chain}"), 1e-9);
-                assert_eq!(mine.rows(), 3 * (20 + 7 * chain));
+                assert_eq!(mine.counts().rows(), 3 * (20 + 7 * chain));
             }
             // The nuisance unknowns at the least-squares j, against the dense solution.
             // Back-substitution; unknowns no row involved (a slot unused) are zero.

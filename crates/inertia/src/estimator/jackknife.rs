@@ -105,7 +105,7 @@ impl ChainGroups {
     /// The chain in progress ended: file its rows in its group. Nothing happens for a
     /// chain without rows.
     pub fn end_chain(&mut self) {
-        if self.chain.rows() == 0 {
+        if self.chain.counts().rows() == 0 {
             return;
         }
         if let Some(g) = self.groups.get_mut(self.chains % GROUPS) {
@@ -133,7 +133,7 @@ impl ChainGroups {
 
     fn scaled(&self, s: [f64; 6]) -> [f64; 6] {
         let done: f64 = self.groups.iter().map(SharedQr::weight).sum();
-        let all = done + self.chain.weight();
+        let all = done + self.chain.counts().weight();
         let f = if all > 0.0 {
             crate::math::sqrt(done / all)
         } else {

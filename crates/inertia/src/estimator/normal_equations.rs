@@ -25,7 +25,7 @@
 //! from the difference can lose the digits `βᵀβ` has over it; it enters the
 //! delete-one problems only through the weight of a prior ([`super::prior::augment`]).
 
-use super::shared_qr::{SharedBlock, SharedQr, SHARED};
+use super::shared_qr::{RowCounts, SharedBlock, SharedQr, SHARED};
 use crate::math::sqrt;
 use nalgebra::{SMatrix, SVector};
 
@@ -42,10 +42,7 @@ pub struct NormalEquations {
     ata: SMatrix<f64, SHARED, SHARED>,
     atb: SVector<f64, SHARED>,
     btb: f64,
-    y_energy: f64,
-    rows: usize,
-    weight: f64,
-    noise_s: f64,
+    counts: RowCounts,
 }
 
 impl Default for NormalEquations {
@@ -54,10 +51,7 @@ impl Default for NormalEquations {
             ata: SMatrix::zeros(),
             atb: SVector::zeros(),
             btb: 0.0,
-            y_energy: 0.0,
-            rows: 0,
-            weight: 0.0,
-            noise_s: 0.0,
+            counts: RowCounts::default(),
         }
     }
 }
@@ -77,33 +71,18 @@ impl NormalEquations {
             self.atb[k] += a0 * beta[0] + a1 * beta[1] + a2 * beta[2];
         }
         self.btb += beta.iter().map(|b| b * b).sum::<f64>();
-        self.count(y, noise_s);
+        self.counts.count(y, noise_s);
     }
 
     /// Count a block of rows that needed no fold ([`SharedQr::count_absorbed`]).
     pub fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
-        self.count(y, noise_s);
+        self.counts.count(y, noise_s);
     }
 
-    fn count(&mut self, y: &[f64; 3], noise_s: f64) {
-        for v in y {
-            self.y_energy += v * v;
-        }
-        self.rows += 3;
-        self.weight += 3.0;
-        self.noise_s += noise_s;
-    }
-
-    /// Scalar rows added.
+    /// The rows' counters.
     #[must_use]
-    pub fn rows(&self) -> usize {
-        self.rows
-    }
-
-    /// Row weight added.
-    #[must_use]
-    pub fn weight(&self) -> f64 {
-        self.weight
+    pub fn counts(&self) -> &RowCounts {
+        &self.counts
     }
 
     /// The factor of these rows (module docs), with no nuisance unknowns counted.
@@ -127,12 +106,7 @@ impl NormalEquations {
             }
             z[i] = (self.atb[i] - (0..i).map(|k| rt[(i, k)] * z[k]).sum::<f64>()) / r_ii;
         }
-        SharedQr::from_parts(
-            rt,
-            z,
-            (self.btb - z.norm_squared()).max(0.0),
-            (self.y_energy, self.rows, self.weight, self.noise_s),
-        )
+        SharedQr::from_parts(rt, z, (self.btb - z.norm_squared()).max(0.0), self.counts)
     }
 }
 

@@ -26,6 +26,57 @@ pub const J_SHARED: usize = J - TORQUE;
 /// A 3-row block in the shared unknowns with its right-hand sides.
 pub type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
 
+/// The counters every state of rows keeps beside its factor: the energy of the
+/// right-hand sides as measured, the rows and their weight, and the sum of their
+/// errors-in-variables coefficients ([`super::momentum_rows::AugmentedRow::noise_s`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RowCounts {
+    pub(super) y_energy: f64,
+    pub(super) rows: usize,
+    pub(super) weight: f64,
+    pub(super) noise_s: f64,
+}
+
+impl RowCounts {
+    /// Count `M` rows with right-hand sides `y` (as measured) and errors-in-variables
+    /// coefficient `noise_s` in all.
+    pub(super) fn count<const M: usize>(&mut self, y: &[f64; M], noise_s: f64) {
+        for y in y {
+            self.y_energy += y * y;
+        }
+        self.rows += M;
+        self.weight += M as f64;
+        self.noise_s += noise_s;
+    }
+
+    /// The counts of both sets of rows.
+    fn merge(&mut self, other: &RowCounts) {
+        self.y_energy += other.y_energy;
+        self.rows += other.rows;
+        self.weight += other.weight;
+        self.noise_s += other.noise_s;
+    }
+
+    /// Weigh the rows by `λ` (forgetting): every count but the rows themselves.
+    fn scale(&mut self, lambda: f64) {
+        self.y_energy *= lambda;
+        self.weight *= lambda;
+        self.noise_s *= lambda;
+    }
+
+    /// Scalar rows counted.
+    #[must_use]
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Row weight counted (rows, discounted by forgetting).
+    #[must_use]
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+}
+
 /// `(R, z, ρ²)` over the shared unknowns, and counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SharedQr {
@@ -34,14 +85,9 @@ pub struct SharedQr {
     pub(super) rt: SMatrix<f64, SHARED, SHARED>,
     pub(super) z: SVector<f64, SHARED>,
     rss: f64,
-    y_energy: f64,
-    rows: usize,
-    weight: f64,
+    counts: RowCounts,
     /// Nuisance unknowns introduced so far (degrees of freedom the residual does not have).
     nuisance: f64,
-    /// Sum of the rows' errors-in-variables coefficients
-    /// ([`super::momentum_rows::AugmentedRow::noise_s`]).
-    noise_s: f64,
 }
 
 impl SharedQr {
@@ -53,11 +99,8 @@ impl SharedQr {
             rt: SMatrix::zeros(),
             z: SVector::zeros(),
             rss: 0.0,
-            y_energy: 0.0,
-            rows: 0,
-            weight: 0.0,
+            counts: RowCounts::default(),
             nuisance: nuisance as f64,
-            noise_s: 0.0,
         }
     }
 
@@ -112,13 +155,10 @@ impl SharedQr {
     }
 
     fn count<const M: usize>(&mut self, y: &[f64; M], left: &[f64; M], noise_s: f64) {
-        for (y, left) in y.iter().zip(left) {
-            self.y_energy += y * y;
+        for left in left {
             self.rss += left * left;
-            self.rows += 1;
-            self.weight += 1.0;
         }
-        self.noise_s += noise_s;
+        self.counts.count(y, noise_s);
     }
 
     /// Fold another state's rows into this one: afterwards this is the state of both sets
@@ -144,31 +184,24 @@ impl SharedQr {
             self.rss += left * left;
         }
         self.rss += other.rss;
-        self.y_energy += other.y_energy;
-        self.rows += other.rows;
-        self.weight += other.weight;
+        self.counts.merge(&other.counts);
         self.nuisance += other.nuisance;
-        self.noise_s += other.noise_s;
     }
 
-    /// A state from its parts: `Rᵀ`, `z`, `ρ²` and the counters `(y energy, rows, row
-    /// weight, errors-in-variables sum)`, no nuisance unknowns counted
-    /// ([`super::normal_equations::NormalEquations::factor`]).
+    /// A state from its parts: `Rᵀ`, `z`, `ρ²` and the counters, no nuisance unknowns
+    /// counted ([`super::normal_equations::NormalEquations::factor`]).
     pub(super) fn from_parts(
         rt: SMatrix<f64, SHARED, SHARED>,
         z: SVector<f64, SHARED>,
         rss: f64,
-        (y_energy, rows, weight, noise_s): (f64, usize, f64, f64),
+        counts: RowCounts,
     ) -> Self {
         Self {
             rt,
             z,
             rss,
-            y_energy,
-            rows,
-            weight,
+            counts,
             nuisance: 0.0,
-            noise_s,
         }
     }
 
@@ -183,22 +216,26 @@ impl SharedQr {
         self.rt *= s;
         self.z *= s;
         self.rss *= lambda;
-        self.y_energy *= lambda;
-        self.weight *= lambda;
+        self.counts.scale(lambda);
         self.nuisance *= lambda;
-        self.noise_s *= lambda;
+    }
+
+    /// The rows' counters.
+    #[must_use]
+    pub fn counts(&self) -> &RowCounts {
+        &self.counts
     }
 
     /// Scalar rows folded in.
     #[must_use]
     pub fn rows(&self) -> usize {
-        self.rows
+        self.counts.rows
     }
 
     /// Row weight folded in (rows, discounted by forgetting).
     #[must_use]
     pub fn weight(&self) -> f64 {
-        self.weight
+        self.counts.weight
     }
 
     /// Residual sum of squares `ρ²` (weighted).
@@ -210,7 +247,7 @@ impl SharedQr {
     /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
     #[must_use]
     pub fn residual_dof(&self) -> f64 {
-        super::qr::residual_dof(self.weight, self.nuisance)
+        super::qr::residual_dof(self.counts.weight, self.nuisance)
     }
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
@@ -227,10 +264,10 @@ impl SharedQr {
             r: Matrix6::from_fn(|i, k| self.rt[(J_SHARED + k, J_SHARED + i)]),
             z: Vector6::from_fn(|i, _| self.z[J_SHARED + i]),
             rss: self.rss,
-            y_energy: self.y_energy,
-            rows: self.rows,
-            weight: self.weight,
-            noise_s: self.noise_s,
+            y_energy: self.counts.y_energy,
+            rows: self.counts.rows,
+            weight: self.counts.weight,
+            noise_s: self.counts.noise_s,
             nuisance: self.nuisance,
         }
     }
@@ -258,10 +295,10 @@ impl SharedQr {
             r: Matrix6::from_fn(|i, k| r[(off + i, off + k)]),
             z: Vector6::from_fn(|i, _| z[off + i]),
             rss: self.rss + growth,
-            y_energy: self.y_energy,
-            rows: self.rows,
-            weight: self.weight,
-            noise_s: self.noise_s,
+            y_energy: self.counts.y_energy,
+            rows: self.counts.rows,
+            weight: self.counts.weight,
+            noise_s: self.counts.noise_s,
             nuisance: self.nuisance - 3.0,
         };
         (reduced, growth)
