@@ -315,6 +315,51 @@ fn a_constant_torque_is_held_at_zero_only_where_the_data_give_no_evidence_of_one
 }
 
 #[test]
+fn the_torque_test_needs_a_finite_noise_scale() {
+    // (with, without, growth) → the state solved and the test. A residual variance of
+    // 1 (ρ² 10 over 10 degrees of freedom): growth 3 is χ² 3, held at zero; growth 30
+    // is kept. Without residual degrees of freedom, with an exact fit, or with a NaN,
+    // there is no test and the torque stays estimated (the fuzz found a NaN χ² in the
+    // report before this).
+    use inertia::estimator::qr::RecursiveQr;
+    let with = |rss: f64, weight: f64| RecursiveQr {
+        rss,
+        rows: weight as usize,
+        weight,
+        nuisance: 0.0,
+        ..RecursiveQr::new()
+    };
+    let without = |w: &RecursiveQr, growth: f64| {
+        let mut held = *w;
+        held.rss += growth;
+        held.z[0] = 1.0; // tells the two states apart
+        (held, growth)
+    };
+    let w = with(10.0, 16.0); // ν = 16 − 6 = 10
+    let (solved, test) = torque_tested(w, Some(without(&w, 3.0)));
+    let test = test.expect("a noise scale");
+    assert!(test.held_at_zero && (test.chi2 - 3.0).abs() < 1e-12);
+    assert_eq!(solved.z[0], 1.0, "the state without the torque");
+    let (solved, test) = torque_tested(w, Some(without(&w, 30.0)));
+    assert!(!test.expect("tested").held_at_zero);
+    assert_eq!(solved.z[0], 0.0, "the state with the torque");
+    for (w, growth, what) in [
+        (with(10.0, 6.0), 3.0, "no residual degrees of freedom"),
+        (with(0.0, 16.0), 3.0, "an exact fit"),
+        (with(0.0, 16.0), 0.0, "an exact fit both ways"),
+        (with(f64::NAN, 16.0), 3.0, "a NaN"),
+    ] {
+        let (solved, test) = torque_tested(w, Some(without(&w, growth)));
+        assert!(test.is_none(), "{what}: {test:?}");
+        assert_eq!(solved.z[0], 0.0, "{what}: the state with the torque");
+    }
+    assert!(
+        torque_tested(w, None).1.is_none(),
+        "the torque not estimated"
+    );
+}
+
+#[test]
 fn recursive_and_batch_agree_with_gaps_and_chains() {
     let run = slew_for(120.0, Common::paper());
     // A one-minute gap in the middle.

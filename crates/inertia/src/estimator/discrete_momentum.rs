@@ -40,7 +40,9 @@ pub struct TorqueTest {
 /// with the growth of `ρ²` that costs ([`super::shared_qr::SharedQr::reduced_without_torque`]).
 ///
 /// A nested-model test (beyond the paper): with `s² = ρ²/ν` of `with`, `Δρ²/s²` is
-/// χ²-distributed with 3 degrees of freedom when there is no torque. At or below
+/// χ²-distributed with 3 degrees of freedom when there is no torque. There is no test
+/// (`None`, the torque estimated) where that is not a finite number: no residual degrees
+/// of freedom yet, rows fitted exactly, or a non-finite state. At or below
 /// [`TORQUE_CHI2`] the data give no evidence of one and `τ_b` is held at zero: three
 /// unknowns fewer, measured in the README's matrix to lower the error in 51 of 58 cells
 /// (the paper's spin 3.0e-6 → 2.8e-6, the 1 Hz spins by 2–3×). Errors correlated along
@@ -56,7 +58,13 @@ pub fn torque_tested(
     let Some((without, growth)) = without else {
         return (with, None);
     };
-    let chi2 = growth / with.residual_variance();
+    // No test without a noise scale (no residual degrees of freedom, or rows fitted
+    // exactly) or on a non-finite state: the torque stays as set.
+    let s2 = with.residual_variance();
+    let chi2 = growth / s2;
+    if !(s2.is_finite() && s2 > 0.0 && chi2.is_finite() && chi2 >= 0.0) {
+        return (with, None);
+    }
     let held_at_zero = chi2 <= TORQUE_CHI2;
     let test = TorqueTest { chi2, held_at_zero };
     (if held_at_zero { without } else { with }, Some(test))
