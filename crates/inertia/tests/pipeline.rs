@@ -580,3 +580,56 @@ mod status {
         assert!(matches!(o, Observability::Determined { .. }), "{o}");
     }
 }
+
+#[test]
+fn batch_and_recursive_runs_report_the_same_torque_test() {
+    // The discrete momentum estimator on the paper's slew, without a random disturbance (no
+    // torque: held at zero) and with 1e-5 N m hidden from the telemetry (kept): the
+    // recursive pipeline and the batch run make the same decision, with χ² within 1e-3,
+    // and both reports carry it (JSON `torque_test`). The paper's estimator makes no test.
+    for torque in [0.0, 1e-5] {
+        let mut common = Common {
+            disturbance_nm_rthz: 0.0,
+            ..Common::paper()
+        };
+        common.realism.environment.constant_torque_nm = Vector3::new(torque, 0.0, 0.0);
+        let out = Scenario::slew().simulate(&common).unwrap();
+        let settings = PipelineSettings {
+            estimator: "discrete-momentum".into(),
+            ..PipelineSettings::default()
+        };
+        let mut p = Pipeline::new(&settings).unwrap();
+        for s in &out.samples {
+            p.push(s).unwrap();
+        }
+        let recursive = p.torque_test().expect("tested");
+        let config = settings.validate().unwrap();
+        let b = pipeline::batch(&out.samples, &config).unwrap();
+        let batch = b.torque_test.expect("tested");
+        assert_eq!(
+            recursive.held_at_zero,
+            torque == 0.0,
+            "{torque}: {recursive:?}"
+        );
+        assert_eq!(batch.held_at_zero, recursive.held_at_zero, "{torque}");
+        assert!(
+            (batch.chi2 - recursive.chi2).abs() <= 1e-3 * recursive.chi2,
+            "{torque}: {batch:?} against {recursive:?}"
+        );
+        #[cfg(feature = "serde")]
+        {
+            let report =
+                inertia::pipeline::report::Report::of_batch(&b, &config, out.samples.len());
+            assert_eq!(report.torque_test, Some(batch));
+            let text = report.to_string();
+            assert_eq!(text.contains("held at zero"), torque == 0.0, "{text}");
+        }
+    }
+    let paper = PipelineSettings {
+        estimator: "variational".into(),
+        ..PipelineSettings::default()
+    };
+    let out = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let b = pipeline::batch(&out.samples, &paper.validate().unwrap()).unwrap();
+    assert!(b.torque_test.is_none());
+}

@@ -115,7 +115,9 @@ class Estimate:
         samples: samples the estimator saw (after resampling).
         estimator: the estimator's name.
         relative_error: ‖J − J_true‖_F/‖J_true‖_F when ``truth=`` was given.
-        torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,).
+        torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,);
+            ``None`` where it is not estimated or the data gave no evidence of one and it
+            was held at zero (``report["torque_test"]``: ``chi2``, ``held_at_zero``).
         report: the whole report as a dict (the ``inertia estimate --json`` schema).
         text: the readable report (``inertia estimate`` without ``--json``).
 

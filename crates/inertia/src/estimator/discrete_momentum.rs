@@ -44,10 +44,11 @@ pub struct TorqueTest {
 /// (`None`, the torque estimated) where that is not a finite number: no residual degrees
 /// of freedom yet, rows fitted exactly, or a non-finite state. At or below
 /// [`TORQUE_CHI2`] the data give no evidence of one and `τ_b` is held at zero: three
-/// unknowns fewer, measured in the README's matrix to lower the error in 51 of 58 cells
-/// (the paper's spin 3.0e-6 → 2.8e-6, the 1 Hz spins by 2–3×). Errors correlated along
-/// the chain (a propagated attitude's random walk) make `s²` too small and the
-/// statistic too large, so they keep the torque: the safe side. The σ stays that of the
+/// unknowns fewer, measured in the README's matrix to lower the median error in 43 of
+/// 58 cells and raise it in 8, by at most 3 % (the paper's spin 3.0e-6 → 2.8e-6, four
+/// of the 1 Hz spins by 2–3×). Errors correlated along the chain (a propagated
+/// attitude's random walk) can make `s²` too small and the statistic too large, which
+/// errs toward keeping the torque. The σ stays that of the
 /// model with the torque where the jackknife's (which keeps `τ_b` in every delete-one
 /// problem) is the larger, as it mostly is.
 #[must_use]

@@ -743,9 +743,13 @@ impl Estimator for DiscreteMomentum {
                 match waiting.take() {
                     None => waiting = Some(i),
                     Some(h) => {
+                        // Members are in increasing order ([`shared_sources`]).
                         let (low, high) = self.candidates.split_at_mut(i);
-                        if let (Some(a), Some(b)) = (low.get_mut(h), high.first_mut()) {
-                            Candidate::fold_shared_pair(a, b, &row, &src.rows, s.t_s);
+                        match (low.get_mut(h), high.first_mut()) {
+                            (Some(a), Some(b)) => {
+                                Candidate::fold_shared_pair(a, b, &row, &src.rows, s.t_s);
+                            }
+                            _ => unreachable!("members of a source in increasing order"),
                         }
                     }
                 }
@@ -960,7 +964,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         });
     };
     let qr = &batch.qr;
-    let (tested, _) = torque_tested(batch.qr, batch.without_torque);
+    let (tested, torque_test) = torque_tested(batch.qr, batch.without_torque);
     let mut backend = registry::build_backend(c.backend);
     let t_s = samples.last().map_or(0.0, |s| s.t_s);
     // One candidate's own answer and noise σ (for the whole record as one chain, at
@@ -1077,9 +1081,10 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     Ok(BatchOutput {
         gyro_density_ratio,
         estimate,
-        excitation: Some(diagnose(qr, &c.observability)),
+        excitation: Some(diagnose(&tested, &c.observability)),
         gaps: batch.gaps,
         row_model: Some(*rows),
+        torque_test,
     })
 }
 

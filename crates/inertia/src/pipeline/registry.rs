@@ -65,6 +65,9 @@ pub struct BatchOutput {
     /// The residual variance over the part the stated gyro density alone implies, where
     /// the estimator makes that test ([`Estimator::gyro_density_ratio`]).
     pub gyro_density_ratio: Option<f64>,
+    /// The test for a constant disturbance torque, for estimators that make it
+    /// ([`crate::estimator::discrete_momentum::torque_tested`]).
+    pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
 }
 
 /// What an estimator uses and needs.

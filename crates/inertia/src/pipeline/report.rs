@@ -216,6 +216,7 @@ impl Report {
         Self::new(&out.estimate, config, true, samples, out.gaps)
             .with_excitation(out.excitation.clone())
             .with_row_model(out.row_model, None)
+            .with_torque_test(out.torque_test)
             .with_residual_tests(None, out.gyro_density_ratio)
     }
 

@@ -232,5 +232,6 @@ fn run_batch<S: RowSource + Default>(
         excitation: Some(diagnose(&qr, &c.observability)),
         gaps: source.gaps(),
         row_model: None,
+        torque_test: None,
     })
 }
