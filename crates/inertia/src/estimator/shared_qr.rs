@@ -276,23 +276,26 @@ impl SharedQr {
     /// minimised out, and the growth of `ρ²` that costs. With `τ_b` first, `‖R y − z‖²`
     /// at `τ_b = 0` is `‖R_τr r − z_τ‖² + ‖R_rr r − z_r‖²` in the other unknowns `r =
     /// [κ; j]`: the three rows of `R` that hold `τ_b`, without its columns, folded into the
-    /// trailing factor (Givens rotations). Their leftover is what `τ_b` explained.
+    /// trailing factor (one Householder reflection per pivot, the crate's `householder`
+    /// module). Their leftover is what `τ_b` explained.
     /// The three torque unknowns are no longer counted as nuisance. Without forgetting
     /// only (the count of the torque unknowns is not weighted).
     #[must_use]
     pub fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
         const REST: usize = SHARED - 3;
-        let mut r = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(k + 3, i + 3)]);
+        // Rᵀ of the trailing factor, and the torque's rows of R without its columns.
+        let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(i + 3, k + 3)]);
         let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + 3]);
-        let mut growth = 0.0;
-        for t in 0..3 {
-            let a = SVector::<f64, REST>::from_fn(|k, _| self.rt[(k + 3, t)]);
-            let left = crate::givens::fold_row(&mut r, &a, Some((&mut z, self.z[t])));
-            growth += left * left;
+        let mut a: [SVector<f64, REST>; 3] =
+            core::array::from_fn(|t| SVector::from_fn(|k, _| self.rt[(k + 3, t)]));
+        let mut beta: [f64; 3] = core::array::from_fn(|t| self.z[t]);
+        for i in 0..REST {
+            reflect(&mut rt, &mut z, &mut a, &mut beta, i);
         }
+        let growth: f64 = beta.iter().map(|b| b * b).sum();
         let off = J_SHARED - 3;
         let reduced = RecursiveQr {
-            r: Matrix6::from_fn(|i, k| r[(off + i, off + k)]),
+            r: Matrix6::from_fn(|i, k| rt[(off + k, off + i)]),
             z: Vector6::from_fn(|i, _| z[off + i]),
             rss: self.rss + growth,
             y_energy: self.counts.y_energy,
