@@ -1,8 +1,9 @@
 //! The discrete momentum estimator (beyond the paper): the rows of
 //! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; κ; j]`
-//! ([`super::augmented_qr`]), the nuisance unknowns minimised out exactly, and the same
-//! observability test, constraint sets and solvers as Algorithm 1 on the reduced problem
-//! in `j`.
+//! ([`super::augmented_qr`]), the nuisance unknowns minimised out exactly (the torque
+//! `τ_b` held at zero instead where the data give no evidence of one, [`torque_tested`]),
+//! and the same observability test, constraint sets and solvers as Algorithm 1 on the
+//! reduced problem in `j`.
 //!
 //! * [`DiscreteMomentumEstimator`] — recursive, no allocation per sample;
 //! * [`reduce_batch`] — every row stacked, one dense Householder QR per chain and one for
