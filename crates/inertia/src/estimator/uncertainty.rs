@@ -94,8 +94,8 @@ pub fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> U
     )
 }
 
-/// [`with_bias`] given the eigenpairs of `j` (as the crate's 3×3 eigensolver gives them), for a
-/// caller that has them already.
+/// [`with_bias`] given the eigenpairs of `j` (as the crate's 3×3 eigensolver gives
+/// them), for a caller that has them already.
 #[must_use]
 pub fn with_bias_at(
     noise: &[f64; 6],
