@@ -354,9 +354,11 @@ fn messages_are_copied_like_snprintf() {
 #[test]
 fn the_default_settings_are_the_pipelines() {
     // The C defaults, and the row-model values the fixed engine treats as defaults, are
-    // `PipelineSettings::default()`'s, but for the estimator (the CLI's default).
+    // `PipelineSettings::default()`'s, the estimator included.
     let d = inertia::pipeline::PipelineSettings::default();
     let c = inertia_settings_default();
+    assert_eq!(d.estimator, "discrete-momentum");
+    assert_eq!(c.estimator, InertiaEstimatorKind::DiscreteMomentum as u32);
     assert_eq!(d.max_chain_s, Some(c.max_chain_s));
     assert_eq!(
         (d.torque_bias, d.uncertainty),

@@ -53,7 +53,7 @@ use std::vec::Vec;
 /// Registry entry.
 pub(crate) const DISCRETE_MOMENTUM: EstimatorEntry = EstimatorEntry {
     name: "discrete-momentum",
-    summary: "discrete conservation of angular momentum (telescoped paper rows), unknown constant torque, Richardson O(h^4) rows, constrained",
+    summary: "discrete conservation of angular momentum (telescoped paper rows), unknown constant torque, Richardson O(h^4) rows, constrained (default)",
     capabilities: Capabilities {
         needs_gyro: false,
         constraints: true,

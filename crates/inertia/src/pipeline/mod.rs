@@ -24,10 +24,10 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let run = Scenario::slew().simulate(&Common { duration_s: Some(120.0), ..Common::paper() })?;
 //! let mut pipeline = Pipeline::new(&PipelineSettings {
-//!     estimator: "variational".into(),                  // or "finite-difference", "momentum"
+//!     estimator: "discrete-momentum".into(),            // the default; or "variational" (the paper's), "finite-difference", "momentum"
 //!     solver: "native".into(),                          // or "clarabel" (feature)
-//!     constraints: ConstraintSet::physical()            // J ⪰ εI and Σ ⪰ 0
-//!         .with_nominal(Component::J33, 3.0, 0.10),     // J33 within 10 % of 3 kg m²
+//!     constraints: ConstraintSet::positive_definite()   // J ⪰ εI (the default, physical(), adds Σ ⪰ 0,
+//!         .with_nominal(Component::J33, 3.0, 0.10),     // which the paper's J breaks by 2.5e-5); J33 within 10 % of 3 kg m²
 //!     memory_s: Some(600.0),                            // forget with a 600 s time constant
 //!     gyro_noise_deg_s_rthz: Some(1e-5),                // errors-in-variables compensation
 //!     ..PipelineSettings::default()

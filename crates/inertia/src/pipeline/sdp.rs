@@ -19,7 +19,7 @@ use std::boxed::Box;
 /// The paper's discrete variational estimator.
 pub(crate) const VARIATIONAL: EstimatorEntry = EstimatorEntry {
     name: "variational",
-    summary: "discrete variational rows (paper eqs. 53-54), constrained least squares (default)",
+    summary: "discrete variational rows (paper eqs. 53-54), constrained least squares (the paper's Algorithm 1)",
     capabilities: Capabilities {
         needs_gyro: false,
         constraints: true,

@@ -13,7 +13,8 @@ use crate::telemetry::glitch::GlitchPolicy;
 #[derive(Debug, Clone, PartialEq)]
 pub struct PipelineSettings {
     /// Estimator, by its registered name ([`registry::ESTIMATORS`]). Default
-    /// `"variational"`.
+    /// `"discrete-momentum"` (as in the CLI, Python and C); `"variational"` is the
+    /// paper's Algorithm 1.
     pub estimator: String,
     /// Solver backend, by its registered name ([`registry::BACKENDS`]). Default
     /// `"native"`.
@@ -67,7 +68,7 @@ pub const DEFAULT_MAX_CHAIN_S: f64 = 30.0;
 impl Default for PipelineSettings {
     fn default() -> Self {
         Self {
-            estimator: "variational".into(),
+            estimator: "discrete-momentum".into(),
             solver: "native".into(),
             constraints: ConstraintSet::physical(),
             solve_every: 1,
