@@ -184,6 +184,10 @@ typedef struct InertiaSettings {
   double max_chain_s;
   // One of `InertiaGlitchPolicy`. Default stop.
   uint32_t glitches;
+  // Angle random walk of the attitude solution, deg/√h (discrete momentum, with
+  // `gyro_noise_deg_s_rthz`): for an attitude propagated from a gyro, its ARW; the rows
+  // are weighted for the drift. 0 (default) for none (a star tracker or an MEKF).
+  double attitude_drift_deg_rth;
 } InertiaSettings;
 
 // One telemetry sample at time `t_s` (README "Estimating your own telemetry").

@@ -187,6 +187,10 @@ pub struct InertiaSettings {
     pub max_chain_s: f64,
     /// One of `InertiaGlitchPolicy`. Default stop.
     pub glitches: u32,
+    /// Angle random walk of the attitude solution, deg/√h (discrete momentum, with
+    /// `gyro_noise_deg_s_rthz`): for an attitude propagated from a gyro, its ARW; the rows
+    /// are weighted for the drift. 0 (default) for none (a star tracker or an MEKF).
+    pub attitude_drift_deg_rth: f64,
 }
 
 /// One telemetry sample at time `t_s` (README "Estimating your own telemetry").
@@ -314,6 +318,7 @@ struct Plan {
     solve_every: usize,
     memory_s: Option<f64>,
     resample_s: Option<f64>,
+    attitude_drift: Option<f64>,
     gyro_noise: Option<f64>,
     uncertainty: bool,
     torque_bias: bool,
@@ -344,6 +349,7 @@ fn status_of(e: &PipelineError) -> InertiaStatus {
         | PipelineError::SolverUnavailable { .. }
         | PipelineError::InvalidSetting { .. }
         | PipelineError::NotApplicable { .. }
+        | PipelineError::NeedsSetting { .. }
         | PipelineError::NoBatch { .. }
         | PipelineError::Constraints(_) => InertiaStatus::InvalidSetting,
         PipelineError::OutOfRange { .. } => InertiaStatus::OutOfRange,
@@ -469,6 +475,7 @@ impl Plan {
             solve_every: s.solve_every as usize,
             memory_s: optional_positive("memory_s", s.memory_s)?,
             resample_s: optional_positive("resample_s", s.resample_s)?,
+            attitude_drift: optional_positive("attitude_drift_deg_rth", s.attitude_drift_deg_rth)?,
             gyro_noise,
             uncertainty: s.uncertainty != 0,
             torque_bias: s.torque_bias != 0,
@@ -525,6 +532,7 @@ impl Plan {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             max_chain_s: self.max_chain_s,
+            attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,
         }
     }
@@ -562,6 +570,7 @@ impl Plan {
                 self.max_chain_s != Some(inertia::pipeline::DEFAULT_MAX_CHAIN_S),
             ),
             ("gyro_noise_deg_s_rthz", fd && self.gyro_noise.is_some()),
+            ("attitude_drift_deg_rth", self.attitude_drift.is_some()),
         ] {
             if changed {
                 return Err(fail(
@@ -821,6 +830,7 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         rho_model: InertiaRhoModel::Auto as u32,
         max_chain_s: inertia::pipeline::DEFAULT_MAX_CHAIN_S,
         glitches: InertiaGlitchPolicy::Stop as u32,
+        attitude_drift_deg_rth: 0.0,
     }
 }
 

@@ -155,6 +155,31 @@ fn bad_settings_name_the_setting() {
             "torque_bias",
         ),
         (
+            InertiaSettings {
+                attitude_drift_deg_rth: 0.036,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "gyro_noise_deg_s_rthz",
+        ),
+        (
+            InertiaSettings {
+                attitude_drift_deg_rth: -1.0,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "attitude_drift_deg_rth",
+        ),
+        (
+            InertiaSettings {
+                attitude_drift_deg_rth: 0.036,
+                gyro_noise_deg_s_rthz: 6e-4,
+                ..variational()
+            },
+            InertiaStatus::InvalidSetting,
+            "attitude_drift_deg_rth",
+        ),
+        (
             {
                 let mut s = variational();
                 s.bound_lower_kg_m2[2] = 4.0;

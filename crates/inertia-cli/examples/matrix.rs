@@ -269,6 +269,17 @@ impl Cell {
     }
 }
 
+impl Cell {
+    /// The attitude's angle random walk a user states with the densities, deg/√h: that
+    /// of the gyro it is propagated from; none for a truth, star-tracker or MEKF
+    /// attitude (bounded errors). `DRIFT=0` states none anywhere.
+    fn attitude_drift_deg_rth(&self, common: &Common) -> Option<f64> {
+        let propagated = common.realism.attitude == AttitudeSource::GyroPropagated;
+        let off = std::env::var("DRIFT").is_ok_and(|v| v == "0");
+        (propagated && !off).then_some(common.gyro_noise_deg_s_rthz * 60.0)
+    }
+}
+
 fn cells() -> Vec<Cell> {
     let mut cells = Vec::new();
     for craft in [Craft::Slew, Craft::Spin, Craft::SmallSat] {
@@ -320,10 +331,16 @@ struct Outcome {
     density_ratio: Option<f64>,
 }
 
-fn estimate(samples: &[Sample], estimator: &str, gyro_deg_s_rthz: Option<f64>) -> Option<Outcome> {
+fn estimate(
+    samples: &[Sample],
+    estimator: &str,
+    gyro_deg_s_rthz: Option<f64>,
+    attitude_drift_deg_rth: Option<f64>,
+) -> Option<Outcome> {
     let mut p = Pipeline::new(&PipelineSettings {
         estimator: estimator.into(),
         gyro_noise_deg_s_rthz: gyro_deg_s_rthz,
+        attitude_drift_deg_rth,
         // The momentum RLS takes no constraints.
         constraints: if estimator == "momentum" {
             ConstraintSet::physical()
@@ -511,6 +528,9 @@ fn run(cell: &Cell, seed: u64) -> Run {
             &out.samples,
             name,
             density.then_some(common.gyro_noise_deg_s_rthz),
+            density
+                .then(|| cell.attitude_drift_deg_rth(&common))
+                .flatten(),
         );
         seconds[k + 1] = t.elapsed().as_secs_f64();
         e

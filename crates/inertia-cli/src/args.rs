@@ -360,6 +360,13 @@ pub struct EstimateArgs {
     /// of the variational estimator (README). Without it, no compensation.
     #[arg(long, value_name = "DEG_S_RTHZ")]
     pub gyro_noise: Option<f64>,
+    /// Angle random walk of the attitude solution, deg/√h (discrete-momentum estimator,
+    /// with --gyro-noise): for an attitude propagated from a gyro, that gyro's ARW. The
+    /// momentum rows are then weighted for the attitude's drift (generalised least
+    /// squares; README, "Weighting"). Not for a star tracker or an MEKF, whose attitude
+    /// error is bounded.
+    #[arg(long, value_name = "DEG_RTH")]
+    pub attitude_drift: Option<f64>,
     /// Where the incremental rotations come from (discrete-momentum estimator): the
     /// attitude quaternions or the gyro's angle increments. Default: both are tried when
     /// the telemetry has gyro rates, and the rows that fit better are used (the report

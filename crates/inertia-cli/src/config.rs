@@ -286,6 +286,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         memory_s: a.memory,
         resample_s: a.resample,
         gyro_noise_deg_s_rthz: a.gyro_noise,
+        attitude_drift_deg_rth: a.attitude_drift,
         rotation_source: a.rotation_source.map(|r| match r {
             RotationArg::Attitude => RotationSource::Attitude,
             RotationArg::Gyro => RotationSource::Gyro,
@@ -318,6 +319,7 @@ fn option_of(field: &str) -> &str {
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",
         "max_chain_s" => "--chain",
+        "attitude_drift_deg_rth" => "--attitude-drift",
         other => other,
     }
 }
@@ -337,6 +339,15 @@ pub fn settings_error(e: PipelineError) -> CliError {
         PipelineError::NotApplicable { setting, estimator } => input(format!(
             "{} does not apply to the {estimator} estimator",
             option_of(setting)
+        )),
+        PipelineError::NeedsSetting {
+            setting,
+            needs,
+            why,
+        } => input(format!(
+            "{} needs {} > 0: {why}",
+            option_of(setting),
+            option_of(needs)
         )),
         other => input(other),
     }

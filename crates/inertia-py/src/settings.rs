@@ -473,6 +473,7 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         memory_s: kw.f64("memory")?,
         resample_s: kw.f64("resample")?,
         gyro_noise_deg_s_rthz: kw.f64("gyro_noise")?,
+        attitude_drift_deg_rth: kw.f64("attitude_drift")?,
         uncertainty: kw.bool("uncertainty", true)?,
         rotation_source: kw
             .choice("rotation_source", &["attitude", "gyro"])?
@@ -516,6 +517,7 @@ fn argument_of(field: &str) -> &str {
         "memory_s" => "memory",
         "resample_s" => "resample",
         "gyro_noise_deg_s_rthz" => "gyro_noise",
+        "attitude_drift_deg_rth" => "attitude_drift",
         "constraints" => "constraints/bounds/nominal",
         "max_chain_s" => "chain",
         other => other,
@@ -537,6 +539,15 @@ pub fn settings_error(e: PipelineError) -> PyErr {
         PipelineError::NotApplicable { setting, estimator } => value_error(format!(
             "{} does not apply to the {estimator} estimator",
             argument_of(setting)
+        )),
+        PipelineError::NeedsSetting {
+            setting,
+            needs,
+            why,
+        } => value_error(format!(
+            "{} needs {} > 0: {why}",
+            argument_of(setting),
+            argument_of(needs)
         )),
         PipelineError::UnknownEstimator { .. } => value_error(format!("estimator: {e}")),
         PipelineError::UnknownSolver { .. } | PipelineError::SolverUnavailable { .. } => {

@@ -30,6 +30,8 @@ CASES = [
     ("slew", ["--bound", "J12=0.0368:0.0368"], dict(bounds={"J12": (0.0368, 0.0368)})),
     ("smallsat", ["--rotation-source", "gyro", "--chain", "0"],
      dict(rotation_source="gyro", chain=0.0)),
+    ("spin", ["--gyro-noise", "1e-5", "--attitude-drift", "6e-4", "--every", "10"],
+     dict(gyro_noise=1e-5, attitude_drift=6e-4, every=10)),
 ]
 
 

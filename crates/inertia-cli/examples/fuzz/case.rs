@@ -68,6 +68,10 @@ pub fn plan(rng: &mut Rng) -> Plan {
                 RhoModel::Plain,
             ]);
         }
+        // The drift weighting (needs the gyro density; refused in batch runs).
+        if rng.chance(0.2) {
+            s.attitude_drift_deg_rth = Some(*rng.pick(&[6e-4, 0.02, 0.15, 10.0]));
+        }
     }
     if rng.chance(0.1) {
         s.uncertainty = false;

@@ -391,7 +391,7 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
 #: command line's options).
 _SETTINGS = (
     "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
-    "prior_sigma", "products", "gyro_noise", "memory",
+    "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
     "resample", "every", "rotation_source", "rho_model", "torque_bias", "chain", "glitches",
     "solver", "uncertainty",
 )
@@ -428,6 +428,7 @@ def estimate(
     prior_sigma: Any = None,
     products: str = "tensor",
     gyro_noise: Optional[float] = None,
+    attitude_drift: Optional[float] = None,
     memory: Optional[float] = None,
     resample: Optional[float] = None,
     every: int = 1,
@@ -483,6 +484,10 @@ def estimate(
             (+Σ m x y).
         gyro_noise: the gyro's rate-noise density, deg/s/√Hz (errors-in-variables
             compensation).
+        attitude_drift: the attitude's angle random walk, deg/√h, with ``gyro_noise``
+            (``--attitude-drift``): for an attitude propagated from a gyro, its ARW; the
+            momentum rows are weighted for the drift (``report["drift_weighted"]`` says
+            whether the answer came from them). Not for a star tracker or an MEKF.
         memory: forgetting time constant, s. resample: resampling period, s.
         every: solve every N samples. rotation_source: ``"attitude"`` or ``"gyro"``
             (default: chosen from the data). rho_model: ``"auto"``, ``"smooth"``,
@@ -571,6 +576,7 @@ class Estimator:
         prior_sigma: Any = None,
         products: str = "tensor",
         gyro_noise: Optional[float] = None,
+        attitude_drift: Optional[float] = None,
         memory: Optional[float] = None,
         resample: Optional[float] = None,
         every: int = 1,

@@ -16,12 +16,13 @@
 //! initial momenta are minimised out for good: the means are forgotten
 //! ([`AugmentedQr::eliminate_anchors`]).
 
+use super::attitude_drift::{local_level_step, AttitudeDrift};
 use super::momentum_rows::{AugmentedRow, ANCHOR0, ANCHOR1, J, TORQUE};
 use super::normal_equations::NormalEquations;
 use super::qr::RecursiveQr;
 use super::shared_qr::{SharedBlock, SharedQr, J_SHARED, SHARED};
 use crate::math::sqrt;
-use nalgebra::SVector;
+use nalgebra::{Matrix3, SVector};
 
 /// A block's right-hand sides as measured.
 fn row_y(row: &AugmentedRow) -> [f64; 3] {
@@ -37,6 +38,11 @@ struct SlotMean {
     a: [SVector<f64, SHARED>; 3],
     /// Mean right-hand side of each row.
     b: [f64; 3],
+    /// Covariance of the mean in units of the rows' white variance, once an attitude
+    /// drift is modelled ([`super::attitude_drift`]); `None`: `I/weight`.
+    p: Option<Matrix3<f64>>,
+    /// Time of the slot's last block, s.
+    t_s: f64,
 }
 
 impl SlotMean {
@@ -45,6 +51,8 @@ impl SlotMean {
             weight: 0.0,
             a: [SVector::<f64, SHARED>::zeros(); 3],
             b: [0.0; 3],
+            p: None,
+            t_s: 0.0,
         }
     }
 }
@@ -54,6 +62,10 @@ impl SlotMean {
 pub struct AugmentedQr {
     shared: SharedQr,
     slots: [SlotMean; 2],
+    /// The attitude drift the rows are weighted for, if any ([`Self::set_drift`]).
+    drift: Option<AttitudeDrift>,
+    /// Time of the block being folded, s ([`Self::advance_to`]).
+    now_s: f64,
 }
 
 impl AugmentedQr {
@@ -64,7 +76,21 @@ impl AugmentedQr {
         Self {
             shared: SharedQr::new(shared_nuisance),
             slots: [SlotMean::empty(); 2],
+            drift: None,
+            now_s: 0.0,
         }
+    }
+
+    /// Weigh the blocks folded from now on for an attitude that drifts
+    /// ([`super::attitude_drift`]; `None`: centred as without drift, the default). The
+    /// pipeline passes its latest estimate of `J` here after each answer.
+    pub fn set_drift(&mut self, drift: Option<AttitudeDrift>) {
+        self.drift = drift;
+    }
+
+    /// The time of the next block, s (for the drift between a slot's blocks).
+    pub fn advance_to(&mut self, t_s: f64) {
+        self.now_s = t_s;
     }
 
     /// Fold a 3-row block into this state and, when given, into `chain`, the state of the
@@ -121,6 +147,8 @@ impl AugmentedQr {
                 weight: 1.0,
                 a,
                 b: y,
+                p: None,
+                t_s: self.now_s,
             };
             self.shared.count_absorbed(&y, row.noise_s);
             if let Some(c) = chain {
@@ -128,6 +156,24 @@ impl AugmentedQr {
             }
             return None;
         }
+        // Weighted for a drift, or once weighted (the covariance of the mean is then no
+        // longer `I/w`): the local-level filter; otherwise the centring above.
+        if self.drift.is_some() || slot.p.is_some() {
+            let q = self.drift.map_or_else(Matrix3::zeros, |d| {
+                d.process(&a, &y, row.noise_s, self.now_s - slot.t_s)
+            });
+            let mut p = slot.p.unwrap_or_else(|| Matrix3::identity() / w);
+            if let Some(block) = local_level_step(&a, &y, &mut slot.a, &mut slot.b, &mut p, &q) {
+                slot.p = Some(p);
+                slot.weight = w + 1.0;
+                slot.t_s = self.now_s;
+                if let Some(c) = chain {
+                    c.add(&block, &y, row.noise_s);
+                }
+                return Some(block);
+            }
+        }
+        slot.t_s = self.now_s;
         let (f, g) = (sqrt(w / (w + 1.0)), 1.0 / (w + 1.0));
         let mut centred = [SVector::<f64, SHARED>::zeros(); 3];
         let mut beta = [0.0; 3];
@@ -163,6 +209,9 @@ impl AugmentedQr {
         self.shared.scale(lambda);
         for s in &mut self.slots {
             s.weight *= lambda;
+            if let Some(p) = &mut s.p {
+                *p /= lambda;
+            }
         }
     }
 
@@ -307,6 +356,44 @@ mod tests {
             b: Vector3::from_fn(|_, _| rnd()),
             noise_s: rnd().abs(),
         }
+    }
+
+    /// Problem: the chains of [`centring_is_the_dense_fold_with_the_initial_momenta_first`]
+    /// through the drift weighting's local-level filter ([`super::super::attitude_drift`])
+    /// with no growth (`J = 0`, so no momentum to drift), switched on in the middle of
+    /// the first chain. Reference: [`Dense`]. The filter's covariance takes over from the
+    /// centring's `I/w` and follows the forgetting (`P/λ`): the same state, 1e-12.
+    #[test]
+    fn the_drift_filter_without_growth_is_the_centring() {
+        let mut rnd = crate::testing::uniform(0x2545_f491_4f6c_dd1d);
+        let mut qr = AugmentedQr::new(3);
+        let mut dense = Dense::new();
+        let still = AttitudeDrift::new(0.1, 1e-3, crate::tensor::InertiaVector::zeros());
+        let mut t_s = 0.0;
+        for chain in 0..5 {
+            for k in 0..20 + 7 * chain {
+                let p = if chain == 2 { 0 } else { k % 2 };
+                let row = block(&mut rnd, p);
+                if chain == 0 && k == 5 {
+                    qr.set_drift(still);
+                }
+                if chain == 3 && k == 9 {
+                    qr.scale(0.9);
+                    dense.scale(0.9);
+                }
+                t_s += 0.1;
+                qr.advance_to(t_s);
+                qr.add(&row, None);
+                dense.add(&row);
+            }
+            assert_shared(qr.shared(), &dense, &format!("chain {chain}"), 1e-12);
+            qr.eliminate_anchors();
+            dense.eliminate();
+        }
+        assert!(
+            qr.slots.iter().all(|s| s.p.is_none()),
+            "forgotten with the chain"
+        );
     }
 
     /// Problem: five chains of random blocks alternating between the two slots (as

@@ -237,7 +237,14 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             self.qr.scale(libm::exp(-(t_s - t0) / m));
         }
         self.last_block_t_s = Some(t_s);
+        self.qr.advance_to(t_s);
         self.since_solve += 1;
+    }
+
+    /// Weigh the row blocks folded from now on for an attitude that drifts
+    /// ([`super::attitude_drift`]; `None`, the default: unweighted).
+    pub fn set_drift(&mut self, drift: Option<super::attitude_drift::AttitudeDrift>) {
+        self.qr.set_drift(drift);
     }
 
     /// Stop keeping the jackknife's chain groups (their folding is a third of the cost

@@ -11,6 +11,7 @@
 //!
 //! Every estimate says whether the data determine J ([`observability`]).
 
+pub mod attitude_drift;
 pub mod audit;
 pub mod augmented_qr;
 #[cfg(feature = "std")]

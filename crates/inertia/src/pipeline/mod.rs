@@ -106,6 +106,16 @@ pub enum PipelineError {
         /// What it must be.
         expected: &'static str,
     },
+    /// A setting that needs another one.
+    #[error("setting `{setting}` needs `{needs}` > 0: {why}")]
+    NeedsSetting {
+        /// The setting.
+        setting: &'static str,
+        /// The setting it needs.
+        needs: &'static str,
+        /// Why.
+        why: &'static str,
+    },
     /// A setting the chosen estimator does not use (rather than ignore it silently).
     #[error("setting `{setting}` does not apply to the {estimator} estimator")]
     NotApplicable {
@@ -395,6 +405,13 @@ impl Pipeline {
     #[must_use]
     pub fn gyro_density_ratio(&self) -> Option<f64> {
         self.estimator.gyro_density_ratio()
+    }
+
+    /// With an attitude drift stated: whether the last answer came from the rows weighted
+    /// for it ([`registry::Estimator::drift_weighted`]).
+    #[must_use]
+    pub fn drift_weighted(&self) -> Option<bool> {
+        self.estimator.drift_weighted()
     }
 
     /// The excitation report of the data so far (estimators with a least-squares state).

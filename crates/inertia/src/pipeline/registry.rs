@@ -49,6 +49,13 @@ pub trait Estimator: Send {
     fn gyro_density_ratio(&self) -> Option<f64> {
         None
     }
+    /// With an attitude drift stated ([`super::PipelineSettings::attitude_drift_deg_rth`]):
+    /// whether the answer of the last solve came from the rows weighted for it
+    /// (`false`: from the unweighted rows, whose σ was the smaller, or no answer yet to
+    /// weight with). `None` without a drift stated.
+    fn drift_weighted(&self) -> Option<bool> {
+        None
+    }
 }
 
 /// The answer of a batch run.

@@ -130,6 +130,10 @@ pub struct Report {
     pub residual_consistency: Option<Worst>,
     /// The residual variance over the part the stated gyro density alone implies.
     pub gyro_density_ratio: Option<f64>,
+    /// With an attitude drift stated (`attitude_drift_deg_rth`): whether the answer came
+    /// from the rows weighted for it (`false`: the unweighted rows', whose bias outweighed
+    /// their noise, or no answer yet to weight with); `null` without one.
+    pub drift_weighted: Option<bool>,
     #[serde(skip)]
     observability: Observability,
 }
@@ -190,6 +194,7 @@ impl Report {
             glitches: None,
             residual_consistency: None,
             gyro_density_ratio: None,
+            drift_weighted: None,
             observability: estimate.observability,
         }
     }
@@ -205,6 +210,7 @@ impl Report {
                 .with_excitation(p.excitation())
                 .with_row_model(p.row_model(), p.torque_bias_nm())
                 .with_torque_test(p.torque_test())
+                .with_drift_weighted(p.drift_weighted())
                 .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
                 .with_glitches(Some(p.glitches())),
         )
@@ -254,6 +260,13 @@ impl Report {
         test: Option<crate::estimator::discrete_momentum::TorqueTest>,
     ) -> Self {
         self.torque_test = test;
+        self
+    }
+
+    /// With whether the answer came from the rows weighted for a stated attitude drift.
+    #[must_use]
+    pub fn with_drift_weighted(mut self, weighted: Option<bool>) -> Self {
+        self.drift_weighted = weighted;
         self
     }
 
@@ -423,6 +436,17 @@ impl fmt::Display for Report {
                  (χ²₃ = {:.2} ≤ {TORQUE_CHI2})",
                 t.chi2
             )?;
+        }
+        match self.drift_weighted {
+            Some(true) => writeln!(
+                s,
+                "attitude drift: the rows are weighted for it (generalised least squares)"
+            )?,
+            Some(false) => writeln!(
+                s,
+                "attitude drift: the unweighted rows' answer (their bias outweighs their noise, or no answer yet to weight with)"
+            )?,
+            None => {}
         }
         if let Some(e) = self.relative_error {
             writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;

@@ -56,6 +56,16 @@ pub struct PipelineSettings {
     /// steadier (`pipeline::discrete_momentum`). Default
     /// [`DEFAULT_MAX_CHAIN_S`]; `None`: chains end only at gaps.
     pub max_chain_s: Option<f64>,
+    /// Angle random walk of the attitude solution, deg/√h (discrete momentum estimator):
+    /// for an attitude propagated from a gyro, that gyro's ARW. Given with
+    /// `gyro_noise_deg_s_rthz`, the momentum rows are weighted for the attitude's drift
+    /// (generalised least squares, [`crate::estimator::attitude_drift`]) from the first
+    /// answer on, refolded from the first sample (up to an hour at 10 Hz is kept for
+    /// that), beside the same rows unweighted; each answer is the weighted one unless
+    /// the unweighted one's bias σ exceeds its noise σ ([`super::Pipeline::drift_weighted`]
+    /// says which). Twice the work per sample. `None` (default): unweighted, right for a
+    /// star tracker or an MEKF, whose attitude error is bounded.
+    pub attitude_drift_deg_rth: Option<f64>,
     /// What to do with a step where the attitude jumps against the gyro
     /// ([`crate::telemetry::glitch`]; telemetry with gyro rates). Default
     /// [`GlitchPolicy::Stop`].
@@ -81,6 +91,7 @@ impl Default for PipelineSettings {
             rho_model: RhoModel::Auto,
             torque_bias: true,
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
+            attitude_drift_deg_rth: None,
             glitches: GlitchPolicy::Stop,
         }
     }
@@ -102,6 +113,7 @@ pub struct PipelineConfig {
     pub(crate) rho_model: RhoModel,
     pub(crate) torque_bias: bool,
     pub(crate) max_chain_s: Option<f64>,
+    pub(crate) attitude_drift_deg_rth: Option<f64>,
     pub(crate) glitches: GlitchPolicy,
 }
 
@@ -132,6 +144,20 @@ impl PipelineSettings {
         positive("memory_s", self.memory_s, "a finite memory > 0 s")?;
         positive("resample_s", self.resample_s, "a finite period > 0 s")?;
         positive("max_chain_s", self.max_chain_s, "a finite duration > 0 s")?;
+        positive(
+            "attitude_drift_deg_rth",
+            self.attitude_drift_deg_rth,
+            "a finite angle random walk > 0 deg/√h",
+        )?;
+        if self.attitude_drift_deg_rth.is_some()
+            && !self.gyro_noise_deg_s_rthz.is_some_and(|g| g > 0.0)
+        {
+            return Err(PipelineError::NeedsSetting {
+                setting: "attitude_drift_deg_rth",
+                needs: "gyro_noise_deg_s_rthz",
+                why: "the drift is weighed against the gyro's noise",
+            });
+        }
         if let Some(g) = self.gyro_noise_deg_s_rthz {
             if !(g.is_finite() && g >= 0.0) {
                 return Err(PipelineError::InvalidSetting {
@@ -163,6 +189,10 @@ impl PipelineSettings {
                 ("rho_model", self.rho_model != defaults.rho_model),
                 ("torque_bias", self.torque_bias != defaults.torque_bias),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
+                (
+                    "attitude_drift_deg_rth",
+                    self.attitude_drift_deg_rth != defaults.attitude_drift_deg_rth,
+                ),
             ] {
                 if changed {
                     return Err(PipelineError::NotApplicable {
@@ -203,6 +233,7 @@ impl PipelineSettings {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             max_chain_s: self.max_chain_s,
+            attitude_drift_deg_rth: self.attitude_drift_deg_rth,
             glitches: self.glitches,
         })
     }
@@ -280,6 +311,12 @@ impl PipelineConfig {
     #[must_use]
     pub fn max_chain_s(&self) -> Option<f64> {
         self.max_chain_s
+    }
+
+    /// Angle random walk of the attitude solution, deg/√h (the drift weighting).
+    #[must_use]
+    pub fn attitude_drift_deg_rth(&self) -> Option<f64> {
+        self.attitude_drift_deg_rth
     }
 
     /// Observability thresholds.
