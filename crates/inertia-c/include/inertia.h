@@ -186,7 +186,8 @@ typedef struct InertiaSettings {
   uint32_t glitches;
   // Angle random walk of the attitude solution, deg/√h (discrete momentum, with
   // `gyro_noise_deg_s_rthz`): for an attitude propagated from a gyro, its ARW; the rows
-  // are weighted for the drift. 0 (default) for none (a star tracker or an MEKF).
+  // are weighted for the drift (needs `uncertainty`). 0 (default) for none (a star
+  // tracker or an MEKF).
   double attitude_drift_deg_rth;
 } InertiaSettings;
 

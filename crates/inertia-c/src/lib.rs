@@ -189,7 +189,8 @@ pub struct InertiaSettings {
     pub glitches: u32,
     /// Angle random walk of the attitude solution, deg/√h (discrete momentum, with
     /// `gyro_noise_deg_s_rthz`): for an attitude propagated from a gyro, its ARW; the rows
-    /// are weighted for the drift. 0 (default) for none (a star tracker or an MEKF).
+    /// are weighted for the drift (needs `uncertainty`). 0 (default) for none (a star
+    /// tracker or an MEKF).
     pub attitude_drift_deg_rth: f64,
 }
 

@@ -164,6 +164,16 @@ fn bad_settings_name_the_setting() {
         ),
         (
             InertiaSettings {
+                attitude_drift_deg_rth: 0.036,
+                gyro_noise_deg_s_rthz: 6e-4,
+                uncertainty: 0,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "uncertainty",
+        ),
+        (
+            InertiaSettings {
                 attitude_drift_deg_rth: -1.0,
                 ..inertia_settings_default()
             },

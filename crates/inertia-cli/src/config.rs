@@ -343,9 +343,10 @@ pub fn settings_error(e: PipelineError) -> CliError {
         PipelineError::NeedsSetting {
             setting,
             needs,
+            requirement,
             why,
         } => input(format!(
-            "{} needs {} > 0: {why}",
+            "{} needs {} {requirement}: {why}",
             option_of(setting),
             option_of(needs)
         )),

@@ -543,9 +543,10 @@ pub fn settings_error(e: PipelineError) -> PyErr {
         PipelineError::NeedsSetting {
             setting,
             needs,
+            requirement,
             why,
         } => value_error(format!(
-            "{} needs {} > 0: {why}",
+            "{} needs {} {requirement}: {why}",
             argument_of(setting),
             argument_of(needs)
         )),

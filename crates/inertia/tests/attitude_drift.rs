@@ -93,8 +93,9 @@ fn weighting_for_the_drift_leaves_a_momentum_free_slew_alone() {
     assert!(r.iter().all(|x| x.2), "{r:?}");
 }
 
-/// Misuse: a drift without the gyro's density to weigh it against, a negative one, one
-/// for the paper's estimator, and a batch run are refused with the setting named.
+/// Misuse: a drift without the gyro's density to weigh it against, or without σ (which
+/// chooses between the weighted and the unweighted rows), a negative one, one for the
+/// paper's estimator, and a batch run are refused with the setting named.
 #[test]
 fn the_drift_setting_is_refused_where_it_cannot_be_used() {
     let needs = PipelineSettings {
@@ -106,6 +107,18 @@ fn the_drift_setting_is_refused_where_it_cannot_be_used() {
         Err(PipelineError::NeedsSetting {
             setting: "attitude_drift_deg_rth",
             needs: "gyro_noise_deg_s_rthz",
+            ..
+        })
+    ));
+    let no_sigma = PipelineSettings {
+        uncertainty: false,
+        ..settings(true)
+    };
+    assert!(matches!(
+        no_sigma.validate(),
+        Err(PipelineError::NeedsSetting {
+            setting: "attitude_drift_deg_rth",
+            needs: "uncertainty",
             ..
         })
     ));

@@ -107,12 +107,14 @@ pub enum PipelineError {
         expected: &'static str,
     },
     /// A setting that needs another one.
-    #[error("setting `{setting}` needs `{needs}` > 0: {why}")]
+    #[error("setting `{setting}` needs `{needs}` {requirement}: {why}")]
     NeedsSetting {
         /// The setting.
         setting: &'static str,
         /// The setting it needs.
         needs: &'static str,
+        /// What that one must be (`"> 0"`, `"on"`).
+        requirement: &'static str,
         /// Why.
         why: &'static str,
     },

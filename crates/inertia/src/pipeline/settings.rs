@@ -63,8 +63,9 @@ pub struct PipelineSettings {
     /// answer on, refolded from the first sample (up to an hour at 10 Hz is kept for
     /// that), beside the same rows unweighted; each answer is the weighted one unless
     /// the unweighted one's bias σ exceeds its noise σ ([`super::Pipeline::drift_weighted`]
-    /// says which). Twice the work per sample. `None` (default): unweighted, right for a
-    /// star tracker or an MEKF, whose attitude error is bounded.
+    /// says which; so it needs `uncertainty`). Twice the work per sample. `None`
+    /// (default): unweighted, right for a star tracker or an MEKF, whose attitude error
+    /// is bounded.
     pub attitude_drift_deg_rth: Option<f64>,
     /// What to do with a step where the attitude jumps against the gyro
     /// ([`crate::telemetry::glitch`]; telemetry with gyro rates). Default
@@ -155,7 +156,16 @@ impl PipelineSettings {
             return Err(PipelineError::NeedsSetting {
                 setting: "attitude_drift_deg_rth",
                 needs: "gyro_noise_deg_s_rthz",
+                requirement: "> 0",
                 why: "the drift is weighed against the gyro's noise",
+            });
+        }
+        if self.attitude_drift_deg_rth.is_some() && !self.uncertainty {
+            return Err(PipelineError::NeedsSetting {
+                setting: "attitude_drift_deg_rth",
+                needs: "uncertainty",
+                requirement: "on",
+                why: "the weighted rows' answer is given unless the unweighted rows' bias σ exceeds their noise σ",
             });
         }
         if let Some(g) = self.gyro_noise_deg_s_rthz {
