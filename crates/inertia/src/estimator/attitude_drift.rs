@@ -17,15 +17,21 @@
 //!   by `Q = σ_a² Δt [Π×][Π×]ᵀ = σ_a² Δt (|Π|² I − Π Πᵀ)`; along `Π` nothing drifts.
 //!
 //! So within a chain `X_p` is a random walk seen through white noise: the local-level
-//! model. Its Kalman filter, in units of `r`, gives the innovations of `a` and `b`, which,
+//! model, filtered for each initial-momentum slot on its own (the two slots of the
+//! Richardson rows share one attitude walk; their correlation is not modelled, so the
+//! rows are GLS per slot). Its Kalman filter, in units of `r`, gives the innovations of `a` and `b`, which,
 //! whitened by the innovation covariance `F = P + I` (Cholesky `F = L Lᵀ`, rows `L⁻¹ v`),
 //! are independent with unit variance: the GLS rows of the chain (de Jong's augmented
 //! filter: the gains do not depend on the data, so the same filter whitens the
 //! regressors and the right-hand side). With `Q = 0` it is the centring of
 //! [`super::augmented_qr`]: `P = I/w`, rows scaled by `√(w/(w+1))`, gain `1/(w+1)`.
 //!
-//! `Π` and `s` need a first estimate of `J` (the pipeline passes its latest answer; until
-//! there is one the rows are centred as without drift), and the ratio `σ_a²/σ_g²` needs
+//! The errors-in-variables compensation ([`super::compensation`]) still counts each
+//! whitened block's full `noise_s`, while whitening by `F = P + Q + I` leaves it less of
+//! the white noise: with a large drift it over-corrects a little.
+//!
+//! `Π` and `s` need a first estimate of `J` (the pipeline refolds the run from its first
+//! sample at its first answer, [`crate::pipeline`]), and the ratio `σ_a²/σ_g²` needs
 //! both densities from the user: with a star tracker or an MEKF the attitude error is
 //! bounded and there is no drift to model. Measured on the README's matrix, the weighting
 //! matters where the momentum is large (a spin); where the wheels hold the total momentum
@@ -38,8 +44,8 @@ use nalgebra::{Matrix3, SVector, Vector3};
 /// the estimate of `J` that sets `Π` and `s` (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AttitudeDrift {
-    /// `σ_a²/σ_g²`, s: the attitude's angle random walk (rad/√s) squared over the
-    /// rotation source's rate-noise density (rad/s/√Hz) squared.
+    /// `σ_a²/σ_g²` (dimensionless): the attitude's angle random walk (rad/√s) squared
+    /// over the rotation source's rate-noise density (rad/s/√Hz) squared.
     pub ratio_s: f64,
     /// The estimate of `j` the weights are formed with.
     pub j: InertiaVector,
@@ -59,8 +65,10 @@ impl AttitudeDrift {
     }
 
     /// The growth `Q` of the mean's covariance, in units of the block's white variance,
-    /// over `dt_s` since the slot's previous block, for a block with coefficients `a` in
-    /// the shared unknowns (`j` last), right-hand side `b` and coefficient `noise_s`.
+    /// over `dt_s` since the slot's previous block, for a slot whose running means are
+    /// `a` (coefficients in the shared unknowns, `j` last) and `b` (right-hand side), and
+    /// a block of coefficient `noise_s`. `Π` comes from the means, not from the block
+    /// being whitened, so that the weights do not depend on that block's noise.
     #[must_use]
     pub fn process<const N: usize>(
         &self,
@@ -74,7 +82,7 @@ impl AttitudeDrift {
         if !(s > 0.0 && noise_s > 0.0 && dt_s > 0.0) {
             return Matrix3::zeros();
         }
-        // Π ≈ X = a·y − b at y = [0; …; 0; j] (the torque and curvature are small).
+        // Π ≈ X̄ = ā·y − b̄ at y = [0; …; 0; j] (the torque and curvature are small).
         let pi = Vector3::from_fn(|m, _| {
             (0..6).map(|k| a[m][N - 6 + k] * self.j[k]).sum::<f64>() - b[m]
         });

@@ -160,7 +160,7 @@ impl AugmentedQr {
         // longer `I/w`): the local-level filter; otherwise the centring above.
         if self.drift.is_some() || slot.p.is_some() {
             let q = self.drift.map_or_else(Matrix3::zeros, |d| {
-                d.process(&a, &y, row.noise_s, self.now_s - slot.t_s)
+                d.process(&slot.a, &slot.b, row.noise_s, self.now_s - slot.t_s)
             });
             let mut p = slot.p.unwrap_or_else(|| Matrix3::identity() / w);
             if let Some(block) = local_level_step(&a, &y, &mut slot.a, &mut slot.b, &mut p, &q) {
@@ -172,6 +172,8 @@ impl AugmentedQr {
                 }
                 return Some(block);
             }
+            // A non-finite covariance: centred as without drift from here on.
+            slot.p = None;
         }
         slot.t_s = self.now_s;
         let (f, g) = (sqrt(w / (w + 1.0)), 1.0 / (w + 1.0));

@@ -450,7 +450,8 @@ struct DiscreteMomentum {
     replay: Option<Vec<Sample>>,
     /// Once the rows are weighted for a drift: the same run unweighted, kept beside it
     /// (weighting a drift that the rows' discretisation bias outweighs costs accuracy),
-    /// and whether its answer, the one of smaller σ, was the one given at the last solve.
+    /// and whether its answer was the one given at the last solve
+    /// ([`unweighted_is_better`]).
     unweighted: Option<(Box<DiscreteMomentum>, bool)>,
 }
 
@@ -462,13 +463,15 @@ struct DiscreteMomentum {
 /// densities given, the weighted rows lower the error of every 10 Hz spin by 20–24 %
 /// and raise it 1.6–2.9× at 1 Hz (paper and FOG gyro), where this test keeps the
 /// unweighted answer; the σ of the two answers ranks them the wrong way round in both.
+/// Without a σ to tell (none at this solve), the unweighted answer.
 fn unweighted_is_better(e: &Estimate) -> bool {
     e.uncertainty
-        .is_some_and(|u| frobenius(&u.bias_kg_m2) > frobenius(&u.noise_kg_m2))
+        .is_none_or(|u| frobenius(&u.bias_kg_m2) > frobenius(&u.noise_kg_m2))
 }
 
-/// Most samples kept for the drift weighting's replay (an hour at 10 Hz, 4.3 MB): past
-/// it, the rows before the first answer stay unweighted.
+/// Most samples kept for the drift weighting's replay (an hour at 10 Hz, 4.3 MB): with
+/// no answer by then, the rows are not weighted at all (weighting only the rows after
+/// the first answer is worse than none).
 pub(crate) const REPLAY_CAP: usize = 36_000;
 
 /// One row source and the candidates it feeds.
@@ -992,24 +995,32 @@ impl Estimator for DiscreteMomentum {
             Some((t, _)) => t.push_sample(s)?,
             None => None,
         };
-        // The first answer: weigh the rows for the attitude's drift, from the first
-        // sample on where the samples were kept; the run so far goes on unweighted beside.
         let (mut e, mut twin) = (e, twin);
-        if let (Some(a), Some(g), Some(j)) = (
+        let drift = match (
             self.config.attitude_drift_deg_rth,
             self.config.gyro_noise_rad_s_rthz,
             e.as_ref().and_then(Estimate::j),
         ) {
-            let drift = AttitudeDrift::new(a, g.to_degrees(), j);
-            match (self.replay.take(), drift) {
-                (Some(samples), Some(d)) => {
-                    let (fresh, last) = self.replayed(&samples, d)?;
+            (Some(a), Some(g), Some(j)) => AttitudeDrift::new(a, g.to_degrees(), j),
+            _ => None,
+        };
+        if let Some(d) = drift {
+            if self.unweighted.is_some() {
+                // Weighted already: the latest answer's Ĵ for the rows to come.
+                self.set_drift(Some(d));
+            } else if let Some(samples) = self.replay.take() {
+                // The first answer: the run refolded from its first sample with the
+                // rows weighted, the run so far going on unweighted beside it. Should
+                // the refold fail where the unweighted run did not, the run stays
+                // unweighted.
+                if let Ok((fresh, last)) = self.replayed(&samples, d) {
                     let old = core::mem::replace(self, fresh);
                     self.unweighted = Some((Box::new(old), false));
                     (e, twin) = (last, e);
                 }
-                _ => self.set_drift(drift),
             }
+            // Past [`REPLAY_CAP`] samples before the first answer the rows stay
+            // unweighted: weighting only the rows to come is worse than none.
         }
         // The unweighted answer where its discretisation and model bias outweigh its
         // noise ([`unweighted_is_better`]).
@@ -1060,7 +1071,7 @@ impl Estimator for DiscreteMomentum {
     fn drift_weighted(&self) -> Option<bool> {
         self.config
             .attitude_drift_deg_rth
-            .map(|_| self.drift.is_some() && !matches!(self.unweighted, Some((_, true))))
+            .map(|_| matches!(self.unweighted, Some((_, false))))
     }
 }
 

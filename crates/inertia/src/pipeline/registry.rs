@@ -51,8 +51,9 @@ pub trait Estimator: Send {
     }
     /// With an attitude drift stated ([`super::PipelineSettings::attitude_drift_deg_rth`]):
     /// whether the answer of the last solve came from the rows weighted for it
-    /// (`false`: from the unweighted rows, whose σ was the smaller, or no answer yet to
-    /// weight with). `None` without a drift stated.
+    /// (`false`: from the unweighted rows, whose bias σ exceeded their noise σ; or no
+    /// answer yet to weight with, or none within the samples kept to refold). `None`
+    /// without a drift stated.
     fn drift_weighted(&self) -> Option<bool> {
         None
     }

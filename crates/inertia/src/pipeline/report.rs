@@ -444,7 +444,7 @@ impl fmt::Display for Report {
             )?,
             Some(false) => writeln!(
                 s,
-                "attitude drift: the unweighted rows' answer (their bias outweighs their noise, or no answer yet to weight with)"
+                "attitude drift: the unweighted rows' answer (their bias outweighs their noise, or no first answer to weight with within the samples kept)"
             )?,
             None => {}
         }
