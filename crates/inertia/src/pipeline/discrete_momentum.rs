@@ -617,7 +617,7 @@ impl DiscreteMomentum {
     }
 
     /// The state whose answer was given at the last solve (the unweighted twin's where
-    /// its σ was the smaller), for the diagnostics of the report.
+    /// [`unweighted_is_better`]), for the diagnostics of the report.
     fn given(&self) -> &Self {
         match &self.unweighted {
             Some((twin, true)) => twin,
