@@ -497,16 +497,26 @@ fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSource> {
     out
 }
 
-/// A candidate's own answer, for the cross-check.
+/// A candidate's own answer, for the cross-check: `(ĵ, noise σ)` when it was determined
+/// at the last refresh, `age` row blocks ago.
 #[derive(Clone, Copy)]
 struct CrossCheck {
-    j: InertiaVector,
-    sigma: [f64; 6],
+    answer: Option<(InertiaVector, [f64; 6])>,
     age: usize,
 }
 
-/// Row blocks between refreshes of a candidate's own answer for the cross-check.
+/// Row blocks between refreshes of a candidate's own answer for the cross-check, at
+/// least; later in a record, [`CROSS_CHECK_SHARE`] of the blocks so far.
 const CROSS_CHECK_EVERY: usize = 50;
+
+/// The cross-check's answers are refreshed once the blocks since the last refresh are
+/// this share of the record so far (or [`CROSS_CHECK_EVERY`], whichever is more). An
+/// answer from `n` blocks moves by about `σ √(Δn/n)` over `Δn` more (a random walk of
+/// the estimate, `σ ∝ 1/√n`), so an answer refreshed every `n/20` blocks is at most about
+/// `0.2 σ` old, against the [`DISAGREE_Z`] `= 5 σ` the check looks for; and the refreshes
+/// of a record of `N` blocks are `O(log N)`, not `N/50`, each a full solve of a candidate
+/// whose warm starts are that old.
+const CROSS_CHECK_SHARE: usize = 20;
 
 /// `|ĵ_a − ĵ_b| / √(σ_a² + σ_b²)` (noise σ, without the model spread) beyond which two
 /// candidates disagree: far in the tail of any honest σ, so that only an inconsistency
@@ -911,7 +921,8 @@ impl DiscreteMomentum {
 impl DiscreteMomentum {
     /// Withdraw a determined answer that another candidate's own answer contradicts
     /// beyond both σ ([`DISAGREE_Z`]); the other candidates' answers are refreshed every
-    /// [`CROSS_CHECK_EVERY`] row blocks.
+    /// [`CROSS_CHECK_EVERY`] row blocks, or every [`CROSS_CHECK_SHARE`]th of the record so
+    /// far if that is more.
     fn cross_check(
         &mut self,
         e: &mut Estimate,
@@ -941,18 +952,20 @@ impl DiscreteMomentum {
             {
                 continue;
             }
-            let stale = self.checks[i].is_none_or(|k| k.age >= CROSS_CHECK_EVERY);
+            let every = CROSS_CHECK_EVERY.max(self.samples / CROSS_CHECK_SHARE);
+            let stale = self.checks[i].is_none_or(|k| k.age >= every);
             if stale {
                 let own = self.candidates[i].solve_now(t_s)?;
-                self.checks[i] = match (own.observability, own.j(), self.noise_sigma(i)) {
-                    (Observability::Determined { .. }, Some(j), Some(sigma)) => {
-                        Some(CrossCheck { j, sigma, age: 0 })
-                    }
+                // An answer that is not determined is not compared, and is refreshed no
+                // more often than one that is.
+                let answer = match (own.observability, own.j(), self.noise_sigma(i)) {
+                    (Observability::Determined { .. }, Some(j), Some(sigma)) => Some((j, sigma)),
                     _ => None,
                 };
+                self.checks[i] = Some(CrossCheck { answer, age: 0 });
             }
-            if let Some(k) = self.checks[i] {
-                self.others.push((k.j, k.sigma));
+            if let Some(answer) = self.checks[i].and_then(|k| k.answer) {
+                self.others.push(answer);
             }
         }
         reconcile(
