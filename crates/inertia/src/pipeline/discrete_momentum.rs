@@ -541,8 +541,10 @@ fn reconcile(
     let mut bias = u.bias_kg_m2;
     let mut worst: f64 = 0.0;
     for (jb, sigma) in others {
-        let z = disagreement(&j, &u.noise_kg_m2, jb, sigma);
-        if z > DISAGREE_Z {
+        let Some(z) = disagreement_beyond(&j, &u.noise_kg_m2, jb, sigma, DISAGREE_Z) else {
+            continue;
+        };
+        {
             worst = worst.max(z);
             for (b, (x, y)) in bias.iter_mut().zip(j.iter().zip(jb.iter())) {
                 *b = b.max((x - y).abs());
@@ -573,6 +575,29 @@ fn disagreement(a: &InertiaVector, sa: &[f64; 6], b: &InertiaVector, sb: &[f64; 
     (0..6)
         .map(|k| (a[k] - b[k]).abs() / (sa[k] * sa[k] + sb[k] * sb[k]).sqrt())
         .fold(0.0, f64::max)
+}
+
+/// [`disagreement`] where it exceeds `z`, `None` otherwise: the same verdict, but the
+/// usual case, every element well inside `z` (at every solve, for each candidate), is
+/// told by squares, without a `√` and a division per element. The squares' test lets
+/// through everything within a relative `1e-9` of `z`, whose exact value then decides.
+fn disagreement_beyond(
+    a: &InertiaVector,
+    sa: &[f64; 6],
+    b: &InertiaVector,
+    sb: &[f64; 6],
+    z: f64,
+) -> Option<f64> {
+    let near = z * z * (1.0 - 1e-9);
+    let candidate = (0..6).any(|k| {
+        let d = a[k] - b[k];
+        // Also true where the variance is 0 (or NaN) but the answers differ.
+        !(d * d <= near * (sa[k] * sa[k] + sb[k] * sb[k]))
+    });
+    if !candidate {
+        return None;
+    }
+    Some(disagreement(a, sa, b, sb)).filter(|d| *d > z)
 }
 
 /// Eigenpairs of a symmetric 3×3 matrix ([`symmetric_eigen3`]).
@@ -1273,6 +1298,56 @@ mod tests {
         }
         .validate()
         .unwrap()
+    }
+
+    /// Problem: pairs of answers and σ drawn around the threshold (differences of 0–8 σ
+    /// per element, in a third of the cases one of them within 1e-12 of exactly
+    /// `DISAGREE_Z` σ), plus zero,
+    /// infinite and NaN differences and variances. Reference: the exact `disagreement`
+    /// compared with the threshold. The squares' shortcut must give the same verdict and
+    /// the same value, every time.
+    #[test]
+    fn disagreement_beyond_is_the_exact_verdict() {
+        let mut rnd = crate::testing::uniform(0x5eed_d15a_9ee0_0001);
+        let z = DISAGREE_Z;
+        let mut cases = Vec::new();
+        for n in 0..20_000 {
+            let sa: [f64; 6] = core::array::from_fn(|_| (rnd() + 0.5) * 1e-3);
+            let sb: [f64; 6] = core::array::from_fn(|_| (rnd() + 0.5) * 1e-3);
+            let a = InertiaVector::from_fn(|_, _| 1.0 + rnd());
+            // The largest difference of this case, in σ.
+            let level = 8.0 * (rnd() + 0.5);
+            let b = InertiaVector::from_fn(|k, _| {
+                let s = (sa[k] * sa[k] + sb[k] * sb[k]).sqrt();
+                let t = if n % 3 == 0 && k == n % 6 {
+                    z * (1.0 + 1e-12 * rnd())
+                } else {
+                    level * (rnd() + 0.5)
+                };
+                a[k] + t * s * if rnd() < 0.0 { -1.0 } else { 1.0 }
+            });
+            cases.push((a, sa, b, sb));
+        }
+        let a = InertiaVector::repeat(1.0);
+        for special in [0.0, f64::INFINITY, f64::NAN] {
+            cases.push((a, [special; 6], a, [special; 6]));
+            cases.push((a, [special; 6], a.add_scalar(1e-6), [special; 6]));
+            cases.push((a, [1e-3; 6], a.add_scalar(special), [1e-3; 6]));
+        }
+        let mut beyond = 0;
+        for (a, sa, b, sb) in &cases {
+            let exact = disagreement(a, sa, b, sb);
+            let want = (exact > z).then_some(exact);
+            let got = disagreement_beyond(a, sa, b, sb, z);
+            assert_eq!(
+                got.map(f64::to_bits),
+                want.map(f64::to_bits),
+                "{a:?} {sa:?} {b:?} {sb:?}"
+            );
+            beyond += usize::from(got.is_some());
+        }
+        // Both verdicts occur, near the threshold too.
+        assert!(beyond > 1000 && beyond < cases.len() - 1000, "{beyond}");
     }
 
     /// Every sample through a new estimator: the estimator and its last answer.
