@@ -1,0 +1,151 @@
+#!/usr/bin/env python3
+"""Why the momentum RLS leads the discrete momentum rows in a few cells of the matrix
+(README, "The Monte Carlo matrix", "Against the momentum RLS"): every row form as one
+batch least-squares problem in numpy, on the same simulated files, seed by seed.
+
+    cargo build --release -p inertia-cli
+    python3 scripts/rls_vs_rows.py mems 30        # the MEMS slew, seeds 1..30
+    python3 scripts/rls_vs_rows.py small-sat 30   # the small satellite with a FOG
+
+Needs numpy. Simulates into a temporary directory with target/release/inertia, then
+prints, per row form, the median relative Frobenius error, its median ratio to the RLS's
+and the mean error per element (relative to ‖J‖; the attenuation of errors-in-variables
+shows there), plus each form's error on noise-free telemetry of the same case.
+
+Row forms (all with one initial momentum for the whole record, no torque unknown):
+  rls            C_k G(ω_k) j − h = −C_k ρ_k, ω_k the mean of the two adjacent intervals'
+                 rates (estimator::momentum, batch instead of recursive)
+  rls, ρ matched the same with ρ averaged over the span its rate averages,
+                 (ρ_{k−1} + 2ρ_k + ρ_{k+1})/4: exact on noise-free data
+  plain          the discrete momentum rows of one interval, (2/h) C N(φ) G(φ) j − L = −C N(φ) ρ̄
+  averaged       the plain rows of two neighbouring intervals averaged (the first-order
+                 noise of the Richardson rows)
+  averaged, comp the same, errors-in-variables compensated with the gyro's density
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIN = os.path.join(ROOT, "target", "release", "inertia")
+
+NO_BIAS = ["--gyro-bias-deg-h", "0:0:0", "--gyro-bias-instability-deg-h", "0"]
+CLEAN = ["--attitude", "truth", "--gyro-noise", "0", "--disturbance", "0",
+         "--wheel-quantization-nms", "0"]
+CASES = {
+    # name: (craft and commands, the sensors of the noisy runs, gyro density deg/s/√Hz)
+    "mems": (["--scenario", "slew", "--controller-hz", "10"],
+             ["--attitude", "gyro", "--gyro-noise", "0.0025"], 0.0025),
+    "small-sat": (["--preset", "small-sat", "--controller-hz", "10", *NO_BIAS],
+                  ["--attitude", "gyro", "--gyro-arw-deg-rthr", "0.02"], 0.02 / 60),
+}
+
+
+def rotation(q):
+    x, y, z, w = q.T
+    r = np.empty((len(q), 3, 3))
+    r[:, 0] = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], 1)
+    r[:, 1] = np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], 1)
+    r[:, 2] = np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], 1)
+    return r
+
+
+def g(p):
+    """G(p) with G(p) j = J p (j = J11 J22 J33 J12 J13 J23)."""
+    a, b, c = p[..., 0], p[..., 1], p[..., 2]
+    o = np.zeros_like(a)
+    return np.stack([np.stack([a, o, o, b, c, o], -1),
+                     np.stack([o, b, o, a, o, c], -1),
+                     np.stack([o, o, c, o, a, b], -1)], -2)
+
+
+def n_matrix(p):
+    a, b, c = p[..., 0], p[..., 1], p[..., 2]
+    o = np.zeros_like(a)
+    skew = np.stack([np.stack([o, -c, b], -1), np.stack([c, o, -a], -1),
+                     np.stack([-b, a, o], -1)], -2)
+    s = np.sqrt(1 - (p * p).sum(-1))
+    return s[..., None, None] * np.eye(3) + skew
+
+
+D = np.diag([1.0, 1, 1, 2, 2, 2])
+
+
+def solve(a, b, eiv=0.0):
+    """min Σ‖a_k j − L − b_k‖² over j and one L; `eiv` the rows' expected noise Gram
+    per row block (σ² noise_s), removed from the normal equations."""
+    n = len(a)
+    m = np.zeros((3 * n, 9))
+    m[:, :6] = a.reshape(3 * n, 6)
+    for i in range(3):
+        m[np.arange(n) * 3 + i, 6 + i] = -1
+    normal = m.T @ m
+    normal[:6, :6] -= n * eiv * D
+    j = np.linalg.solve(normal, m.T @ b.reshape(-1))[:6]
+    return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
+
+
+def forms(path, density_deg):
+    d = np.genfromtxt(path, delimiter=",", names=True)
+    t = d["t"]
+    q = np.stack([d["q_x"], d["q_y"], d["q_z"], d["q_w"]], 1)
+    rho = np.stack([d["rho_x"], d["rho_y"], d["rho_z"]], 1)
+    w = np.stack([d["w_x"], d["w_y"], d["w_z"]], 1)
+    truth = np.array(json.load(open(path.replace(".csv", ".truth.json")))["inertia_kg_m2"])
+    h = t[1] - t[0]
+    c = rotation(q)
+    node = c[1:-1]
+    a_rls = node @ g((w[:-2] + w[1:-1]) / 2)
+    out = {
+        "rls": solve(a_rls, -(node @ rho[1:-1][..., None])[..., 0]),
+        "rls, ρ matched": solve(
+            a_rls, -(node @ ((rho[:-2] + 2 * rho[1:-1] + rho[2:]) / 4)[..., None])[..., 0]),
+    }
+    theta = w[:-1] * h
+    angle = np.linalg.norm(theta, axis=1, keepdims=True)
+    phi = np.sin(angle / 2) * theta / np.where(angle > 0, angle, 1)
+    cn = c[:-1] @ n_matrix(phi)
+    a = cn @ g(phi) * (2 / h)
+    b = -(cn @ ((rho[:-1] + rho[1:]) / 2)[..., None])[..., 0]
+    out["plain"] = solve(a, b)
+    a2, b2 = (a[:-1] + a[1:]) / 2, (b[:-1] + b[1:]) / 2
+    out["averaged"] = solve(a2, b2)
+    sigma = np.radians(density_deg)
+    out["averaged, comp"] = solve(a2, b2, sigma**2 / (2 * h))
+    scale = np.linalg.norm(truth)
+    return {k: (v - truth) / scale for k, v in out.items()}
+
+
+def main():
+    case = sys.argv[1] if len(sys.argv) > 1 else "mems"
+    seeds = int(sys.argv[2]) if len(sys.argv) > 2 else 30
+    options, sensors, density = CASES[case]
+    with tempfile.TemporaryDirectory() as tmp:
+        def simulate(name, extra):
+            path = os.path.join(tmp, name + ".csv")
+            subprocess.run([BIN, "simulate", *options, *extra, "-o", path],
+                           check=True, capture_output=True)
+            return path
+
+        runs = [forms(simulate(f"s{s}", [*sensors, "--seed", str(s)]), density)
+                for s in range(1, seeds + 1)]
+        # No gyro noise in it, so none to compensate.
+        clean = forms(simulate("clean", CLEAN), 0.0)
+    rls = np.array([np.linalg.norm(r["rls"]) for r in runs])
+    print(f"{case}, {seeds} seeds: error relative to ‖J‖ (Frobenius)")
+    print(f"{'form':16s} {'median':>9s} {'/RLS':>6s} {'noise-free':>10s}   mean error "
+          "J11 J22 J33 J12 J13 J23")
+    for k in runs[0]:
+        e = np.array([np.linalg.norm(r[k]) for r in runs])
+        mean = np.mean([r[k] for r in runs], axis=0)
+        elems = [mean[0, 0], mean[1, 1], mean[2, 2], mean[0, 1], mean[0, 2], mean[1, 2]]
+        print(f"{k:16s} {np.median(e):9.3e} {np.median(e / rls):6.3f} "
+              f"{np.linalg.norm(clean[k]):10.1e}   " + " ".join(f"{x:+.1e}" for x in elems))
+
+
+if __name__ == "__main__":
+    main()
