@@ -21,6 +21,13 @@ Row forms (all with one initial momentum for the whole record, no torque unknown
   averaged       the plain rows of two neighbouring intervals averaged (the first-order
                  noise of the Richardson rows)
   averaged, comp the same, errors-in-variables compensated with the gyro's density
+  averaged, GLS  the same weighted by its noise's covariance as the gyro's alone would
+                 make it: each block by Ĵ⁻¹ (C N)ᵀ, Ĵ the averaged rows' answer (the gyro's
+                 noise enters the momentum as C J δω); tried, not adopted (README)
+  averaged, GLS, comp  both
+
+"spread" is the root of the summed variances of the six elements over the seeds, the
+noise part of the error; the mean error per element is its bias part.
 """
 import json
 import os
@@ -72,20 +79,23 @@ def n_matrix(p):
     return s[..., None, None] * np.eye(3) + skew
 
 
-D = np.diag([1.0, 1, 1, 2, 2, 2])
+G_AXES = [g(np.eye(3)[i]) for i in range(3)]
 
 
-def solve(a, b, eiv=0.0):
-    """min Σ‖a_k j − L − b_k‖² over j and one L; `eiv` the rows' expected noise Gram
-    per row block (σ² noise_s), removed from the normal equations."""
+def solve(a, b, eiv=0.0, whiten=None, j_white=None):
+    """min Σ‖W_k (a_k j − L − b_k)‖² over j and one L (W_k = I unless `whiten`);
+    `eiv` the rows' expected noise Gram per row block (σ² noise_s), removed from the
+    normal equations: `σ² noise_s D` unweighted, `Σ_i G(e_i)ᵀ J⁻² G(e_i)` times it when
+    whitened by `J⁻¹ (C N)ᵀ` (`j_white` that J)."""
     n = len(a)
+    w = np.broadcast_to(np.eye(3), (n, 3, 3)) if whiten is None else whiten
     m = np.zeros((3 * n, 9))
-    m[:, :6] = a.reshape(3 * n, 6)
-    for i in range(3):
-        m[np.arange(n) * 3 + i, 6 + i] = -1
+    m[:, :6] = (w @ a).reshape(3 * n, 6)
+    m[:, 6:] = (-w).reshape(3 * n, 3)
     normal = m.T @ m
-    normal[:6, :6] -= n * eiv * D
-    j = np.linalg.solve(normal, m.T @ b.reshape(-1))[:6]
+    j_inv = np.eye(3) if j_white is None else np.linalg.inv(j_white)
+    normal[:6, :6] -= n * eiv * sum(x.T @ j_inv @ j_inv @ x for x in G_AXES)
+    j = np.linalg.solve(normal, m.T @ (w @ b[..., None]).reshape(-1))[:6]
     return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
 
 
@@ -114,8 +124,12 @@ def forms(path, density_deg):
     out["plain"] = solve(a, b)
     a2, b2 = (a[:-1] + a[1:]) / 2, (b[:-1] + b[1:]) / 2
     out["averaged"] = solve(a2, b2)
-    sigma = np.radians(density_deg)
-    out["averaged, comp"] = solve(a2, b2, sigma**2 / (2 * h))
+    eiv = np.radians(density_deg) ** 2 / (2 * h)
+    out["averaged, comp"] = solve(a2, b2, eiv)
+    first = out["averaged"]
+    whiten = np.linalg.inv(first) @ np.transpose((cn[:-1] + cn[1:]) / 2, (0, 2, 1))
+    out["averaged, GLS"] = solve(a2, b2, whiten=whiten)
+    out["averaged, GLS, comp"] = solve(a2, b2, eiv, whiten, first)
     scale = np.linalg.norm(truth)
     return {k: (v - truth) / scale for k, v in out.items()}
 
@@ -137,14 +151,16 @@ def main():
         clean = forms(simulate("clean", CLEAN), 0.0)
     rls = np.array([np.linalg.norm(r["rls"]) for r in runs])
     print(f"{case}, {seeds} seeds: error relative to ‖J‖ (Frobenius)")
-    print(f"{'form':16s} {'median':>9s} {'/RLS':>6s} {'noise-free':>10s}   mean error "
-          "J11 J22 J33 J12 J13 J23")
+    print(f"{'form':20s} {'median':>9s} {'/RLS':>6s} {'spread':>9s} {'noise-free':>10s}"
+          "   mean error J11 J22 J33 J12 J13 J23")
+    upper = np.triu_indices(3)
     for k in runs[0]:
         e = np.array([np.linalg.norm(r[k]) for r in runs])
-        mean = np.mean([r[k] for r in runs], axis=0)
-        elems = [mean[0, 0], mean[1, 1], mean[2, 2], mean[0, 1], mean[0, 2], mean[1, 2]]
-        print(f"{k:16s} {np.median(e):9.3e} {np.median(e / rls):6.3f} "
-              f"{np.linalg.norm(clean[k]):10.1e}   " + " ".join(f"{x:+.1e}" for x in elems))
+        elems = np.array([r[k][upper] for r in runs])
+        spread = np.sqrt(elems.var(axis=0).sum())
+        mean = elems.mean(axis=0)[[0, 3, 5, 1, 2, 4]]
+        print(f"{k:20s} {np.median(e):9.3e} {np.median(e / rls):6.3f} {spread:9.3e} "
+              f"{np.linalg.norm(clean[k]):10.1e}   " + " ".join(f"{x:+.1e}" for x in mean))
 
 
 if __name__ == "__main__":

@@ -436,6 +436,8 @@ struct DiscreteMomentum {
     density_ratio: Option<f64>,
     /// Input samples so far.
     samples: usize,
+    /// Samples that completed a row block (the cross-check's clock).
+    blocks: usize,
     /// The even sample waiting for its successor (the shadow's next sample).
     held: Option<Sample>,
     /// The other candidates' answers for [`reconcile`], kept between solves so that a
@@ -503,10 +505,14 @@ fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSource> {
 struct CrossCheck {
     answer: Option<(InertiaVector, [f64; 6])>,
     age: usize,
+    /// At the last solve the answer was within reach of the check: beyond half its
+    /// threshold ([`cross_check_every`]).
+    near: bool,
 }
 
 /// Row blocks between refreshes of a candidate's own answer for the cross-check, at
-/// least; later in a record, [`CROSS_CHECK_SHARE`] of the blocks so far.
+/// least; later in a record, a [`CROSS_CHECK_SHARE`]th of the blocks so far (not under
+/// forgetting, [`cross_check_every`]).
 const CROSS_CHECK_EVERY: usize = 50;
 
 /// The cross-check's answers are refreshed once the blocks since the last refresh are
@@ -515,8 +521,26 @@ const CROSS_CHECK_EVERY: usize = 50;
 /// the estimate, `σ ∝ 1/√n`), so an answer refreshed every `n/20` blocks is at most about
 /// `0.2 σ` old, against the [`DISAGREE_Z`] `= 5 σ` the check looks for; and the refreshes
 /// of a record of `N` blocks are `O(log N)`, not `N/50`, each a full solve of a candidate
-/// whose warm starts are that old.
+/// whose warm starts are that old. The price: a candidate whose answer becomes determined
+/// just after a refresh joins the check up to a twentieth of the record later (it was
+/// re-solved at every block while undetermined).
 const CROSS_CHECK_SHARE: usize = 20;
+
+/// Row blocks between refreshes of a candidate's answer for the cross-check after
+/// `blocks` row blocks ([`CROSS_CHECK_SHARE`]). Every [`CROSS_CHECK_EVERY`] blocks, as
+/// before the share, where its age matters: for an answer that differs from the chosen
+/// one by more than half the threshold (`near`: its verdict may flip, and once beyond,
+/// its difference joins σ, which should not be stale), for one that was not determined
+/// (so that it joins the check soon once it is), and under forgetting, where the answers
+/// rest on the last memory's blocks however long the record.
+fn cross_check_every(blocks: usize, forgetting: bool, check: Option<&CrossCheck>) -> usize {
+    let settled = check.is_some_and(|k| k.answer.is_some() && !k.near);
+    if forgetting || !settled {
+        CROSS_CHECK_EVERY
+    } else {
+        CROSS_CHECK_EVERY.max(blocks / CROSS_CHECK_SHARE)
+    }
+}
 
 /// `|ĵ_a − ĵ_b| / √(σ_a² + σ_b²)` (noise σ, without the model spread) beyond which two
 /// candidates disagree: far in the tail of any honest σ, so that only an inconsistency
@@ -544,11 +568,9 @@ fn reconcile(
         let Some(z) = disagreement_beyond(&j, &u.noise_kg_m2, jb, sigma, DISAGREE_Z) else {
             continue;
         };
-        {
-            worst = worst.max(z);
-            for (b, (x, y)) in bias.iter_mut().zip(j.iter().zip(jb.iter())) {
-                *b = b.max((x - y).abs());
-            }
+        worst = worst.max(z);
+        for (b, (x, y)) in bias.iter_mut().zip(j.iter().zip(jb.iter())) {
+            *b = b.max((x - y).abs());
         }
     }
     if worst == 0.0 {
@@ -591,8 +613,12 @@ fn disagreement_beyond(
     let near = z * z * (1.0 - 1e-9);
     let candidate = (0..6).any(|k| {
         let d = a[k] - b[k];
-        // Also true where the variance is 0 (or NaN) but the answers differ.
-        !(d * d <= near * (sa[k] * sa[k] + sb[k] * sb[k]))
+        let s2 = sa[k] * sa[k] + sb[k] * sb[k];
+        // Squares decide only where neither they nor `near · s2` can underflow or
+        // overflow to a wrong verdict (a `|d|` whose square underflows is then within
+        // 1e-8 σ); elsewhere, a zero, infinite or NaN variance or difference included,
+        // the exact value does.
+        !((1e-290..=1e290).contains(&s2) && d * d <= near * s2)
     });
     if !candidate {
         return None;
@@ -643,6 +669,7 @@ impl DiscreteMomentum {
             residuals: Vec::new(),
             density_ratio: None,
             samples: 0,
+            blocks: 0,
             held: None,
             others: Vec::new(),
             drift: None,
@@ -791,6 +818,7 @@ impl DiscreteMomentum {
             return Ok(None);
         }
         self.rule_out();
+        self.blocks += 1;
         for k in self.checks.iter_mut().flatten() {
             k.age += 1;
         }
@@ -947,7 +975,7 @@ impl DiscreteMomentum {
     /// Withdraw a determined answer that another candidate's own answer contradicts
     /// beyond both σ ([`DISAGREE_Z`]); the other candidates' answers are refreshed every
     /// [`CROSS_CHECK_EVERY`] row blocks, or every [`CROSS_CHECK_SHARE`]th of the record so
-    /// far if that is more.
+    /// far if that is more and there is no forgetting ([`cross_check_every`]).
     fn cross_check(
         &mut self,
         e: &mut Estimate,
@@ -977,20 +1005,32 @@ impl DiscreteMomentum {
             {
                 continue;
             }
-            let every = CROSS_CHECK_EVERY.max(self.samples / CROSS_CHECK_SHARE);
+            let every = cross_check_every(
+                self.blocks,
+                self.config.memory_s.is_some(),
+                self.checks[i].as_ref(),
+            );
             let stale = self.checks[i].is_none_or(|k| k.age >= every);
             if stale {
                 let own = self.candidates[i].solve_now(t_s)?;
                 // An answer that is not determined is not compared, and is refreshed no
-                // more often than one that is.
+                // more often than every `CROSS_CHECK_EVERY` blocks.
                 let answer = match (own.observability, own.j(), self.noise_sigma(i)) {
                     (Observability::Determined { .. }, Some(j), Some(sigma)) => Some((j, sigma)),
                     _ => None,
                 };
-                self.checks[i] = Some(CrossCheck { answer, age: 0 });
+                self.checks[i] = Some(CrossCheck {
+                    answer,
+                    age: 0,
+                    near: false,
+                });
             }
-            if let Some(answer) = self.checks[i].and_then(|k| k.answer) {
-                self.others.push(answer);
+            if let Some(k) = self.checks[i].as_mut() {
+                if let (Some((jb, sigma)), Some(j), Some(u)) = (k.answer, e.j(), e.uncertainty) {
+                    k.near = disagreement_beyond(&j, &u.noise_kg_m2, &jb, &sigma, DISAGREE_Z / 2.0)
+                        .is_some();
+                    self.others.push((jb, sigma));
+                }
             }
         }
         reconcile(
@@ -1300,9 +1340,44 @@ mod tests {
         .unwrap()
     }
 
+    /// The refresh interval: 50 blocks early on, a twentieth of the record later, and 50
+    /// whatever the record's length under forgetting, for an answer within reach of the
+    /// threshold, for one not determined and for a candidate never checked.
+    #[test]
+    fn cross_check_refreshes_grow_with_the_record_where_the_verdict_is_settled() {
+        let answer = Some((InertiaVector::zeros(), [1.0; 6]));
+        let settled = CrossCheck {
+            answer,
+            age: 0,
+            near: false,
+        };
+        let near = CrossCheck {
+            near: true,
+            ..settled
+        };
+        let undetermined = CrossCheck {
+            answer: None,
+            ..settled
+        };
+        let every = |blocks, forgetting, check| cross_check_every(blocks, forgetting, check);
+        assert_eq!(every(0, false, Some(&settled)), CROSS_CHECK_EVERY);
+        assert_eq!(every(999, false, Some(&settled)), CROSS_CHECK_EVERY);
+        assert_eq!(every(10_000, false, Some(&settled)), 500);
+        assert_eq!(every(1_000_000, false, Some(&settled)), 50_000);
+        for (forgetting, check) in [
+            (true, Some(&settled)),
+            (false, Some(&near)),
+            (false, Some(&undetermined)),
+            (false, None),
+        ] {
+            assert_eq!(every(1_000_000, forgetting, check), CROSS_CHECK_EVERY);
+        }
+    }
+
     /// Problem: pairs of answers and σ drawn around the threshold (differences of 0–8 σ
     /// per element, in a third of the cases one of them within 1e-12 of exactly
-    /// `DISAGREE_Z` σ), plus zero,
+    /// `DISAGREE_Z` σ), differences within a few units of rounding of the threshold,
+    /// squares that underflow or overflow, plus zero,
     /// infinite and NaN differences and variances. Reference: the exact `disagreement`
     /// compared with the threshold. The squares' shortcut must give the same verdict and
     /// the same value, every time.
@@ -1333,6 +1408,29 @@ mod tests {
             cases.push((a, [special; 6], a, [special; 6]));
             cases.push((a, [special; 6], a.add_scalar(1e-6), [special; 6]));
             cases.push((a, [1e-3; 6], a.add_scalar(special), [1e-3; 6]));
+        }
+        // Differences of exactly `t σ`, `t` a few units of rounding either side of the
+        // threshold: where a test by squares without its margin decides differently.
+        for n in 0..20_000 {
+            let sa: [f64; 6] = core::array::from_fn(|_| (rnd() + 0.5) * 1e-3);
+            let sb: [f64; 6] = core::array::from_fn(|_| (rnd() + 0.5) * 1e-3);
+            let k = n % 6;
+            let ulps = (rnd() * 16.0).round();
+            let s = (sa[k] * sa[k] + sb[k] * sb[k]).sqrt();
+            let mut b = InertiaVector::zeros();
+            b[k] = z * (1.0 + ulps * f64::EPSILON) * s;
+            cases.push((InertiaVector::zeros(), sa, b, sb));
+        }
+        // Squares that underflow (both to zero: 1e-170 against σ 1e-175 is far beyond)
+        // or overflow.
+        let zero = InertiaVector::zeros();
+        for (d, s) in [
+            (1e-170, 1e-175),
+            (1e-170, 1e-160),
+            (1e154, 3e152),
+            (1e154, 1e153),
+        ] {
+            cases.push((zero, [s; 6], InertiaVector::repeat(d), [s; 6]));
         }
         let mut beyond = 0;
         for (a, sa, b, sb) in &cases {
