@@ -505,9 +505,9 @@ fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSource> {
 struct CrossCheck {
     answer: Option<(InertiaVector, [f64; 6])>,
     age: usize,
-    /// At the last solve the answer was within reach of the check: beyond half its
-    /// threshold ([`cross_check_every`]).
-    near: bool,
+    /// The answer was beyond the check's threshold when it was solved: a disagreement
+    /// found with a fresh answer.
+    beyond: bool,
 }
 
 /// Row blocks between refreshes of a candidate's own answer for the cross-check, at
@@ -526,16 +526,19 @@ const CROSS_CHECK_EVERY: usize = 50;
 /// re-solved at every block while undetermined).
 const CROSS_CHECK_SHARE: usize = 20;
 
-/// Row blocks between refreshes of a candidate's answer for the cross-check after
-/// `blocks` row blocks ([`CROSS_CHECK_SHARE`]). Every [`CROSS_CHECK_EVERY`] blocks, as
-/// before the share, where its age matters: for an answer that differs from the chosen
-/// one by more than half the threshold (`near`: its verdict may flip, and once beyond,
-/// its difference joins σ, which should not be stale), for one that was not determined
-/// (so that it joins the check soon once it is), and under forgetting, where the answers
-/// rest on the last memory's blocks however long the record.
-fn cross_check_every(blocks: usize, forgetting: bool, check: Option<&CrossCheck>) -> usize {
-    let settled = check.is_some_and(|k| k.answer.is_some() && !k.near);
-    if forgetting || !settled {
+/// Row blocks between refreshes of a determined answer for the cross-check after
+/// `blocks` row blocks ([`CROSS_CHECK_SHARE`]): [`CROSS_CHECK_EVERY`] where its age
+/// matters, that is where it is `near` the check (it differs from the present answer by
+/// more than half the threshold, so that its verdict may flip, and once beyond, its
+/// difference joins σ) and under forgetting (the answers rest on the last memory's blocks
+/// however long the record). So an answer older than [`CROSS_CHECK_EVERY`] blocks is only
+/// used while it is within half the threshold, where it changes neither σ nor the
+/// verdict; one that comes near is refreshed at once if it is that old. Nor does an
+/// answer that has aged past the threshold tell a disagreement: it is solved again first,
+/// and kept while beyond only if it was beyond when solved. (An answer not determined is
+/// solved again at every block, so that it joins the check as soon as it is.)
+fn cross_check_every(blocks: usize, forgetting: bool, near: bool) -> usize {
+    if forgetting || near {
         CROSS_CHECK_EVERY
     } else {
         CROSS_CHECK_EVERY.max(blocks / CROSS_CHECK_SHARE)
@@ -1005,32 +1008,42 @@ impl DiscreteMomentum {
             {
                 continue;
             }
-            let every = cross_check_every(
-                self.blocks,
-                self.config.memory_s.is_some(),
-                self.checks[i].as_ref(),
-            );
-            let stale = self.checks[i].is_none_or(|k| k.age >= every);
+            let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
+                return Ok(());
+            };
+            // How far the kept answer is from the present one: within reach of the
+            // check (`cross_check_every`), or beyond it.
+            let z = self.checks[i].and_then(|k| k.answer).and_then(|(jb, sb)| {
+                disagreement_beyond(&j, &u.noise_kg_m2, &jb, &sb, DISAGREE_Z / 2.0)
+            });
+            let beyond = z.is_some_and(|z| z > DISAGREE_Z);
+            let forgetting = self.config.memory_s.is_some();
+            let stale = self.checks[i].is_none_or(|k| {
+                k.answer.is_none()
+                    || k.age >= cross_check_every(self.blocks, forgetting, z.is_some())
+                    // A disagreement is never told by an answer older than this solve
+                    // unless that answer disagreed when it was fresh.
+                    || (beyond && !k.beyond && k.age > 0)
+            });
             if stale {
                 let own = self.candidates[i].solve_now(t_s)?;
-                // An answer that is not determined is not compared, and is refreshed no
-                // more often than every `CROSS_CHECK_EVERY` blocks.
+                // An answer that is not determined is not compared, and is solved again
+                // at the next block.
                 let answer = match (own.observability, own.j(), self.noise_sigma(i)) {
                     (Observability::Determined { .. }, Some(j), Some(sigma)) => Some((j, sigma)),
                     _ => None,
                 };
+                let beyond = answer.is_some_and(|(jb, sb)| {
+                    disagreement_beyond(&j, &u.noise_kg_m2, &jb, &sb, DISAGREE_Z).is_some()
+                });
                 self.checks[i] = Some(CrossCheck {
                     answer,
                     age: 0,
-                    near: false,
+                    beyond,
                 });
             }
-            if let Some(k) = self.checks[i].as_mut() {
-                if let (Some((jb, sigma)), Some(j), Some(u)) = (k.answer, e.j(), e.uncertainty) {
-                    k.near = disagreement_beyond(&j, &u.noise_kg_m2, &jb, &sigma, DISAGREE_Z / 2.0)
-                        .is_some();
-                    self.others.push((jb, sigma));
-                }
+            if let Some(answer) = self.checks[i].and_then(|k| k.answer) {
+                self.others.push(answer);
             }
         }
         reconcile(
@@ -1340,37 +1353,20 @@ mod tests {
         .unwrap()
     }
 
-    /// The refresh interval: 50 blocks early on, a twentieth of the record later, and 50
-    /// whatever the record's length under forgetting, for an answer within reach of the
-    /// threshold, for one not determined and for a candidate never checked.
+    /// The refresh interval of a determined answer: 50 blocks early on, a twentieth of
+    /// the record later, and 50 whatever the record's length under forgetting and for an
+    /// answer within reach of the threshold.
     #[test]
     fn cross_check_refreshes_grow_with_the_record_where_the_verdict_is_settled() {
-        let answer = Some((InertiaVector::zeros(), [1.0; 6]));
-        let settled = CrossCheck {
-            answer,
-            age: 0,
-            near: false,
-        };
-        let near = CrossCheck {
-            near: true,
-            ..settled
-        };
-        let undetermined = CrossCheck {
-            answer: None,
-            ..settled
-        };
-        let every = |blocks, forgetting, check| cross_check_every(blocks, forgetting, check);
-        assert_eq!(every(0, false, Some(&settled)), CROSS_CHECK_EVERY);
-        assert_eq!(every(999, false, Some(&settled)), CROSS_CHECK_EVERY);
-        assert_eq!(every(10_000, false, Some(&settled)), 500);
-        assert_eq!(every(1_000_000, false, Some(&settled)), 50_000);
-        for (forgetting, check) in [
-            (true, Some(&settled)),
-            (false, Some(&near)),
-            (false, Some(&undetermined)),
-            (false, None),
-        ] {
-            assert_eq!(every(1_000_000, forgetting, check), CROSS_CHECK_EVERY);
+        assert_eq!(cross_check_every(0, false, false), CROSS_CHECK_EVERY);
+        assert_eq!(cross_check_every(999, false, false), CROSS_CHECK_EVERY);
+        assert_eq!(cross_check_every(10_000, false, false), 500);
+        assert_eq!(cross_check_every(1_000_000, false, false), 50_000);
+        for (forgetting, near) in [(true, false), (false, true), (true, true)] {
+            assert_eq!(
+                cross_check_every(1_000_000, forgetting, near),
+                CROSS_CHECK_EVERY
+            );
         }
     }
 
