@@ -521,9 +521,7 @@ const CROSS_CHECK_EVERY: usize = 50;
 /// the estimate, `σ ∝ 1/√n`), so an answer refreshed every `n/20` blocks is at most about
 /// `0.2 σ` old, against the [`DISAGREE_Z`] `= 5 σ` the check looks for; and the refreshes
 /// of a record of `N` blocks are `O(log N)`, not `N/50`, each a full solve of a candidate
-/// whose warm starts are that old. The price: a candidate whose answer becomes determined
-/// just after a refresh joins the check up to a twentieth of the record later (it was
-/// re-solved at every block while undetermined).
+/// whose warm starts are that old.
 const CROSS_CHECK_SHARE: usize = 20;
 
 /// Row blocks between refreshes of a determined answer for the cross-check after
@@ -989,9 +987,9 @@ impl DiscreteMomentum {
         {
             return Ok(());
         }
-        if e.uncertainty.is_none() {
+        let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
             return Ok(());
-        }
+        };
         self.checks.resize(self.candidates.len(), None);
         let best_variance = self
             .candidates
@@ -1008,9 +1006,6 @@ impl DiscreteMomentum {
             {
                 continue;
             }
-            let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
-                return Ok(());
-            };
             // How far the kept answer is from the present one: within reach of the
             // check (`cross_check_every`), or beyond it.
             let z = self.checks[i].and_then(|k| k.answer).and_then(|(jb, sb)| {
