@@ -508,12 +508,70 @@ fn quantile(v: &[f64], q: f64) -> f64 {
     s[((s.len() - 1) as f64 * q).round() as usize]
 }
 
+/// The default against the momentum RLS seed by seed, over the seeds where both answer:
+/// how often the default's error is the smaller, and the two-sided sign test's p-value
+/// for "neither is better" (whether a ratio of medians near 1 says anything).
+#[derive(Default)]
+struct Paired {
+    better: u64,
+    both: u64,
+}
+
+impl Paired {
+    fn record(&mut self, dm: Option<f64>, rls: Option<f64>) {
+        if let (Some(a), Some(b)) = (dm, rls) {
+            self.both += 1;
+            self.better += u64::from(a < b);
+        }
+    }
+
+    /// `P(|wins − n/2| ≥ |observed − n/2|)` for `n` fair coin flips.
+    fn sign_test_p(&self) -> f64 {
+        let n = self.both;
+        let d = (2.0 * self.better as f64 - n as f64).abs();
+        // ln C(n, k) by sums of logs: n is at most a few hundred seeds.
+        let ln_choose = |k: u64| -> f64 {
+            (1..=k)
+                .map(|i| ((n - k + i) as f64).ln() - (i as f64).ln())
+                .sum()
+        };
+        (0..=n)
+            .filter(|&k| (2.0 * k as f64 - n as f64).abs() >= d)
+            .map(|k| (ln_choose(k) - n as f64 * core::f64::consts::LN_2).exp())
+            .sum::<f64>()
+            .min(1.0)
+    }
+}
+
+impl std::fmt::Display for Paired {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.both == 0 {
+            return write!(f, "(no pairs)");
+        }
+        write!(
+            f,
+            "({}/{}, p {:.2})",
+            self.better,
+            self.both,
+            self.sign_test_p()
+        )
+    }
+}
+
 /// One run: the simulator's J, the three estimates and the time of the simulation and of
 /// each estimator, s.
 struct Run {
     truth: Matrix3<f64>,
     estimates: [Option<Outcome>; 4],
     seconds: [f64; 5],
+}
+
+impl Run {
+    /// Estimator `k`'s final relative Frobenius error, if it answered.
+    fn error(&self, k: usize) -> Option<f64> {
+        let j = self.estimates[k].as_ref()?.estimate.as_ref()?.inertia()?;
+        Some(relative_frobenius_error(&j, &self.truth))
+    }
 }
 
 fn run(cell: &Cell, seed: u64) -> Run {
@@ -626,11 +684,12 @@ fn main() {
     let wall = start.elapsed();
 
     println!(
-        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ | DM residual ratio: median / max (withdrawn) | variational residual ratio: median / max (withdrawn) | DM given the density: residual / density variance, median / min (withdrawn) |"
+        "| scenario | attitude | telemetry | discrete momentum (default): median / 95 % | variational: median / 95 % | momentum RLS: median / 95 % | DM/RLS (DM better in / seeds, sign test p) | DM 3σ coverage (worst element) | DM σ_F / error (median) | DM determined beyond 3σ | variational determined beyond 3σ | DM given the gyro density: median / 95 % | its 3σ coverage | its determined beyond 3σ | DM residual ratio: median / max (withdrawn) | variational residual ratio: median / max (withdrawn) | DM given the density: residual / density variance, median / min (withdrawn) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (c, cell) in cells.iter().enumerate() {
         let mut stats = vec![Stats::default(); 4];
+        let mut paired = Paired::default();
         for r in runs
             .iter()
             .zip(&jobs)
@@ -640,9 +699,10 @@ fn main() {
             for (s, e) in stats.iter_mut().zip(&r.estimates) {
                 s.record(e.as_ref(), &r.truth);
             }
+            paired.record(r.error(0), r.error(2));
         }
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) |",
+            "| {} | {} | {} | {} | {} | {} | {:.2} {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} ({}) |",
             cell.craft.name(),
             cell.attitude.name(cell.craft),
             cell.telemetry(),
@@ -650,6 +710,7 @@ fn main() {
             stats[1].errors(),
             stats[2].errors(),
             quantile(&stats[0].errors, 0.5) / quantile(&stats[2].errors, 0.5),
+            paired,
             stats[0].coverage(),
             stats[0].sigma_ratio(),
             stats[0].determined_beyond(),

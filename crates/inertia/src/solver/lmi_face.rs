@@ -185,7 +185,11 @@ mod tests {
         let folded = |r: &Matrix6<f64>| {
             let mut u = Matrix6::zeros();
             for i in 0..6 {
-                fold_row(&mut u, &(r.row(i).transpose() * core::f64::consts::SQRT_2), None);
+                fold_row(
+                    &mut u,
+                    &(r.row(i).transpose() * core::f64::consts::SQRT_2),
+                    None,
+                );
             }
             u
         };
