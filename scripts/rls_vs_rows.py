@@ -26,6 +26,15 @@ Row forms (all with one initial momentum for the whole record, no torque unknown
                  noise enters the momentum as C J δω); tried, not adopted (README)
   averaged, GLS, comp  both
 
+Then two tests of whether the data can tell when the GLS weighting pays. The residuals'
+shape: the unweighted rows' residuals rotated back to the body, (C N)ᵀ r, fitted by
+maximum likelihood with covariance s Ĵ² (the gyro's noise) or s I (the wheels'); the
+statistic tr(J̃⁻² S)/tr(S), J̃ = Ĵ/det(Ĵ)^⅓, is below 1 where Ĵ² fits better. And a
+second table: the record
+cut into 8 chains (each with its own initial momentum, as the estimator's chain groups),
+the averaged rows unweighted and GLS-weighted, and per seed the one whose delete-a-chain
+jackknife σ (Frobenius) is the smaller.
+
 "spread" is the root of the summed variances of the six elements over the seeds, the
 noise part of the error; the mean error per element is its bias part.
 """
@@ -99,6 +108,35 @@ def solve(a, b, eiv=0.0, whiten=None, j_white=None):
     return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
 
 
+def solve_chains(a, b, w, chain):
+    """min Σ‖W_k (a_k j − L_chain(k) − b_k)‖² over j and one L per chain: j."""
+    n, chains = len(a), chain.max() + 1
+    m = np.zeros((3 * n, 6 + 3 * chains))
+    m[:, :6] = (w @ a).reshape(3 * n, 6)
+    for i in range(chains):
+        rows = np.where(chain == i)[0]
+        for k in range(3):
+            m[3 * rows + k, 6 + 3 * i:9 + 3 * i] = -w[rows][:, k, :]
+    return np.linalg.lstsq(m, (w @ b[..., None]).reshape(-1), rcond=None)[0][:6]
+
+
+def jackknife(a, b, w, chains=8):
+    """j over `chains` chains and its delete-a-chain jackknife σ (Frobenius)."""
+    n = len(a)
+    chain = np.minimum(np.arange(n) * chains // n, chains - 1)
+    full = solve_chains(a, b, w, chain)
+    deleted = np.array([
+        solve_chains(a[chain != i], b[chain != i], w[chain != i],
+                     np.unique(chain[chain != i], return_inverse=True)[1])
+        for i in range(chains)])
+    var = (chains - 1) / chains * ((deleted - deleted.mean(0)) ** 2).sum(0)
+    return full, np.sqrt(var[:3].sum() + 2 * var[3:].sum())
+
+
+def to_matrix(j):
+    return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
+
+
 def forms(path, density_deg):
     d = np.genfromtxt(path, delimiter=",", names=True)
     t = d["t"]
@@ -131,7 +169,26 @@ def forms(path, density_deg):
     out["averaged, GLS"] = solve(a2, b2, whiten=whiten)
     out["averaged, GLS, comp"] = solve(a2, b2, eiv, whiten, first)
     scale = np.linalg.norm(truth)
-    return {k: (v - truth) / scale for k, v in out.items()}
+    # Chains, unweighted and GLS-weighted (by the unweighted chains' answer), and the
+    # one with the smaller jackknife σ.
+    eye = np.broadcast_to(np.eye(3), a2.shape[:1] + (3, 3))
+    j_u, s_u = jackknife(a2, b2, eye)
+    white = np.linalg.inv(to_matrix(j_u)) @ np.transpose((cn[:-1] + cn[1:]) / 2, (0, 2, 1))
+    j_g, s_g = jackknife(a2, b2, white)
+    # Which covariance shape the unweighted rows' residuals, rotated back to the body,
+    # fit better by maximum likelihood (each with a free scale): Ĵ² (the gyro's noise,
+    # C J δω) where this is below 1, I (the wheels') above.
+    jv = np.array([first[0, 0], first[1, 1], first[2, 2], first[0, 1], first[0, 2],
+                   first[1, 2]])
+    fit = a2 @ jv - b2
+    body = (np.transpose((cn[:-1] + cn[1:]) / 2, (0, 2, 1)) @ (fit - fit.mean(0))[..., None])
+    spread = body[..., 0].T @ body[..., 0]
+    shape = np.linalg.inv(first / np.cbrt(np.linalg.det(first)))
+    likelihood = np.trace(shape @ shape @ spread) / np.trace(spread)
+    chained = {"chains": to_matrix(j_u), "chains, GLS": to_matrix(j_g),
+               "chains, by jackknife": to_matrix(j_g if s_g < s_u else j_u)}
+    return ({k: (v - truth) / scale for k, v in out.items()},
+            {k: (v - truth) / scale for k, v in chained.items()}, s_g < s_u, likelihood)
 
 
 def main():
@@ -145,10 +202,11 @@ def main():
                            check=True, capture_output=True)
             return path
 
-        runs = [forms(simulate(f"s{s}", [*sensors, "--seed", str(s)]), density)
+        both = [forms(simulate(f"s{s}", [*sensors, "--seed", str(s)]), density)
                 for s in range(1, seeds + 1)]
+        runs = [r[0] for r in both]
         # No gyro noise in it, so none to compensate.
-        clean = forms(simulate("clean", CLEAN), 0.0)
+        clean = forms(simulate("clean", CLEAN), 0.0)[0]
     rls = np.array([np.linalg.norm(r["rls"]) for r in runs])
     print(f"{case}, {seeds} seeds: error relative to ‖J‖ (Frobenius)")
     print(f"{'form':20s} {'median':>9s} {'/RLS':>6s} {'spread':>9s} {'noise-free':>10s}"
@@ -161,6 +219,18 @@ def main():
         mean = elems.mean(axis=0)[[0, 3, 5, 1, 2, 4]]
         print(f"{k:20s} {np.median(e):9.3e} {np.median(e / rls):6.3f} {spread:9.3e} "
               f"{np.linalg.norm(clean[k]):10.1e}   " + " ".join(f"{x:+.1e}" for x in mean))
+    chained = [r[1] for r in both]
+    gls = np.array([r[2] for r in both])
+    shapes = np.array([r[3] for r in both])
+    print(f"\nresiduals' shape, tr(J̃⁻² S)/tr(S) (below 1: the gyro's, GLS): "
+          f"{shapes.min():.3f}–{shapes.max():.3f}")
+    e_u = np.array([np.linalg.norm(r["chains"]) for r in chained])
+    e_g = np.array([np.linalg.norm(r["chains, GLS"]) for r in chained])
+    print(f"\n8 chains; the jackknife chose GLS in {gls.sum()} of {seeds} seeds, "
+          f"the one with the smaller error in {(gls == (e_g < e_u)).sum()}")
+    for k in chained[0]:
+        e = np.array([np.linalg.norm(r[k]) for r in chained])
+        print(f"{k:20s} {np.median(e):9.3e} {np.median(e / rls):6.3f}")
 
 
 if __name__ == "__main__":
