@@ -133,9 +133,14 @@ fn hessian_factor(r: &Matrix6<f64>) -> Matrix6<f64> {
     if triangular {
         return r * s2;
     }
+    folded_rows(r, s2)
+}
+
+/// The rows `s R` folded one by one into an empty factor.
+fn folded_rows(r: &Matrix6<f64>, s: f64) -> Matrix6<f64> {
     let mut u = Matrix6::zeros();
     for i in 0..6 {
-        fold_row(&mut u, &(r.row(i).transpose() * s2), None);
+        fold_row(&mut u, &(r.row(i).transpose() * s), None);
     }
     u
 }
@@ -182,17 +187,7 @@ mod tests {
     #[test]
     fn the_hessian_factor_of_a_triangular_r_is_its_folded_rows() {
         let mut rnd = crate::testing::uniform(0x51_7cc1_b727_220a);
-        let folded = |r: &Matrix6<f64>| {
-            let mut u = Matrix6::zeros();
-            for i in 0..6 {
-                fold_row(
-                    &mut u,
-                    &(r.row(i).transpose() * core::f64::consts::SQRT_2),
-                    None,
-                );
-            }
-            u
-        };
+        let folded = |r: &Matrix6<f64>| folded_rows(r, core::f64::consts::SQRT_2);
         for case in 0..200 {
             let scale = 10f64.powi(case % 13 - 6);
             let mut r = Matrix6::from_fn(|i, k| {
