@@ -22,6 +22,7 @@
 use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
 use super::settings::PipelineConfig;
 use super::standing::{Standing, RULE_OUT_AFTER};
+use super::twins::{self, Twins};
 use super::PipelineError;
 use crate::constraints::Constraints;
 use crate::eigen3::symmetric_eigen3;
@@ -424,6 +425,8 @@ struct DiscreteMomentum {
     standing: Standing,
     /// Row blocks beyond the limit that rule a candidate out ([`super::standing`]).
     rule_out_after: usize,
+    /// Whether the attitude is the gyro's integral ([`super::twins`]).
+    twins: Twins,
     chosen: usize,
     since_solve: usize,
     /// Per candidate: its last own estimate and noise σ, and the row blocks since.
@@ -663,6 +666,7 @@ impl DiscreteMomentum {
             from_s: 0.0,
             standing: Standing::default(),
             rule_out_after: RULE_OUT_AFTER,
+            twins: Twins::default(),
             chosen: 0,
             since_solve: 0,
             checks: Vec::new(),
@@ -820,6 +824,9 @@ impl DiscreteMomentum {
         }
         self.rule_out();
         self.blocks += 1;
+        if self.twins.due(self.blocks) {
+            self.check_twins();
+        }
         for k in self.checks.iter_mut().flatten() {
             k.age += 1;
         }
@@ -956,6 +963,56 @@ impl DiscreteMomentum {
         for (i, c) in self.candidates.iter_mut().enumerate() {
             if !self.standing.live(i) {
                 c.stop_jackknife();
+            }
+        }
+    }
+
+    /// Compare the candidates that differ only in the rotation source ([`super::twins`]);
+    /// once they are found to be one measurement, rule out the attitude's.
+    fn check_twins(&mut self) {
+        let gyro = self.config.gyro_noise_rad_s_rthz;
+        let constraints = &self.config.constraints;
+        let answer = |c: &Candidate| {
+            let qr = c.qr().reduced();
+            Some((
+                own_solution(&qr, gyro, constraints)?,
+                twins::least_squares_sigma(&qr)?,
+            ))
+        };
+        let mut worst: Option<f64> = Some(0.0);
+        let mut pairs = 0;
+        for (a, ra) in self.rows.iter().enumerate() {
+            if ra.rotation != RotationSource::Attitude || !self.standing.live(a) {
+                continue;
+            }
+            let twin = self.rows.iter().position(|r| {
+                r.rotation == RotationSource::Gyro
+                    && MomentumRowSettings {
+                        rotation: RotationSource::Attitude,
+                        ..*r
+                    } == *ra
+            });
+            let Some(g) = twin.filter(|&g| g == 0 || self.standing.live(g)) else {
+                continue;
+            };
+            pairs += 1;
+            let z = match (answer(&self.candidates[g]), answer(&self.candidates[a])) {
+                (Some((jg, sg)), Some((ja, sa))) => twins::ratio(&jg, &sg, &ja, &sa),
+                _ => None,
+            };
+            worst = worst.zip(z).map(|(w, z)| w.max(z));
+        }
+        if pairs == 0 {
+            self.twins = Twins::Independent;
+            return;
+        }
+        self.twins = self.twins.after(worst, self.blocks, self.rule_out_after);
+        if self.twins == Twins::Same {
+            for (i, c) in self.candidates.iter_mut().enumerate() {
+                if self.rows[i].rotation == RotationSource::Attitude {
+                    self.standing.rule_out(i);
+                    c.stop_jackknife();
+                }
             }
         }
     }
@@ -1483,7 +1540,61 @@ mod tests {
             assert!(pruned.standing.live(0));
             assert!([1, 3, 5, 7].iter().all(|&i| !pruned.standing.live(i)));
             assert!((0..8).all(|i| full.standing.live(i)));
+            // The star tracker's rotations are not the gyro's: both sources are kept
+            // until the fit rules one out.
+            assert_eq!(pruned.twins, Twins::Independent);
         }
+    }
+
+    /// The paper's gyro-propagated attitude is the gyro's own integral: once its
+    /// candidates' answers have matched the gyro's twins within [`twins::TWIN_Z`] of
+    /// their σ through [`RULE_OUT_AFTER`] row blocks, they are ruled out (4 folds instead
+    /// of 8), and every later answer is the one of the run that folds all 8 to within a
+    /// tenth of its σ, with the same status (its figures, such as a χ², move with the
+    /// answer); the rotation source reported is the gyro.
+    #[test]
+    fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
+        let common = Common {
+            duration_s: Some(400.0),
+            ..Common::paper()
+        };
+        let config = PipelineSettings::default().validate().unwrap();
+        let run = Scenario::slew().simulate(&common).unwrap();
+        let mut pruned = DiscreteMomentum::new(&config).unwrap();
+        let mut full = DiscreteMomentum {
+            rule_out_after: usize::MAX,
+            ..DiscreteMomentum::new(&config).unwrap()
+        };
+        let (mut compared, mut worst) = (0, 0.0f64);
+        for s in &run.samples {
+            let (a, b) = (pruned.push(s).unwrap(), full.push(s).unwrap());
+            let (Some(a), Some(b)) = (a, b) else {
+                assert_eq!(a.is_some(), b.is_some(), "t = {}", s.t_s);
+                continue;
+            };
+            assert_eq!(
+                core::mem::discriminant(&a.observability),
+                core::mem::discriminant(&b.observability),
+                "t = {}",
+                s.t_s
+            );
+            if let (Some(ja), Some(jb), Some(sb)) = (a.j(), b.j(), b.sigma_kg_m2()) {
+                for k in 0..6 {
+                    worst = worst.max((ja[k] - jb[k]).abs() / sb[k]);
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared > 3500, "{compared}");
+        assert!(worst <= twins::TWIN_Z, "{worst}");
+        assert_eq!(pruned.twins, Twins::Same);
+        assert_eq!(full.twins, Twins::Undecided);
+        assert!([0, 2, 4, 6].iter().all(|&i| pruned.standing.live(i)));
+        assert!([1, 3, 5, 7].iter().all(|&i| !pruned.standing.live(i)));
+        assert_eq!(
+            pruned.row_model().map(|r| r.rotation),
+            Some(RotationSource::Gyro)
+        );
     }
 
     /// [`pick`] on made-up fits: the shortest chain fits best; a longer chain of the

@@ -51,6 +51,7 @@ pub mod registry;
 mod sdp;
 mod settings;
 mod standing;
+mod twins;
 
 #[cfg(feature = "csv")]
 pub mod history;

@@ -42,6 +42,13 @@ impl Standing {
         self.beyond.get(i).is_some_and(Option::is_some)
     }
 
+    /// Rule candidate `i` out for good, whatever its fit ([`super::twins`]).
+    pub(crate) fn rule_out(&mut self, i: usize) {
+        if let Some(b) = self.beyond.get_mut(i) {
+            *b = None;
+        }
+    }
+
     /// Count a row block, given each candidate's `(residual variance, residual degrees of
     /// freedom)` (those of ruled-out ones are ignored).
     pub(crate) fn update(&mut self, fits: impl Iterator<Item = (f64, f64)> + Clone) {
