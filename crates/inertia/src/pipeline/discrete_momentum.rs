@@ -1003,7 +1003,7 @@ impl DiscreteMomentum {
             worst = worst.zip(z).map(|(w, z)| w.max(z));
         }
         if pairs == 0 {
-            self.twins = Twins::Independent;
+            self.twins = Twins::NoPairs;
             return;
         }
         self.twins = self.twins.after(worst, self.blocks, self.rule_out_after);
@@ -1209,6 +1209,14 @@ impl Estimator for DiscreteMomentum {
 
     fn gyro_density_ratio(&self) -> Option<f64> {
         self.given().density_ratio
+    }
+
+    fn attitude_is_gyro_integral(&self) -> Option<bool> {
+        match self.given().twins {
+            Twins::Undecided | Twins::NoPairs => None,
+            Twins::Same => Some(true),
+            Twins::Independent => Some(false),
+        }
     }
 
     fn drift_weighted(&self) -> Option<bool> {
@@ -1543,6 +1551,7 @@ mod tests {
             // The star tracker's rotations are not the gyro's: both sources are kept
             // until the fit rules one out.
             assert_eq!(pruned.twins, Twins::Independent);
+            assert_eq!(pruned.attitude_is_gyro_integral(), Some(false));
         }
     }
 
@@ -1589,6 +1598,8 @@ mod tests {
         assert!(worst <= twins::TWIN_Z, "{worst}");
         assert_eq!(pruned.twins, Twins::Same);
         assert_eq!(full.twins, Twins::Undecided);
+        assert_eq!(pruned.attitude_is_gyro_integral(), Some(true));
+        assert_eq!(full.attitude_is_gyro_integral(), None);
         assert!([0, 2, 4, 6].iter().all(|&i| pruned.standing.live(i)));
         assert!([1, 3, 5, 7].iter().all(|&i| !pruned.standing.live(i)));
         assert_eq!(

@@ -417,6 +417,15 @@ impl Pipeline {
         self.estimator.drift_weighted()
     }
 
+    /// With both rotation sources in play (gyro rates in the telemetry, no
+    /// `rotation_source` set): whether the attitude was found to be the gyro's own
+    /// integral, whose rows are then not folded twice
+    /// ([`registry::Estimator::attitude_is_gyro_integral`]); `None` until decided.
+    #[must_use]
+    pub fn attitude_is_gyro_integral(&self) -> Option<bool> {
+        self.estimator.attitude_is_gyro_integral()
+    }
+
     /// The excitation report of the data so far (estimators with a least-squares state).
     #[must_use]
     pub fn excitation(&self) -> Option<Excitation> {

@@ -134,6 +134,11 @@ pub struct Report {
     /// from the rows weighted for it (`false`: the unweighted rows', whose bias outweighed
     /// their noise, or no answer yet to weight with); `null` without one.
     pub drift_weighted: Option<bool>,
+    /// With both rotation sources in play: whether the attitude was found to be the
+    /// gyro's own integral (its rows then the gyro's, folded once: the rotation source
+    /// is the gyro); `null` until the test has decided (3000 row blocks) or without both
+    /// sources.
+    pub attitude_is_gyro_integral: Option<bool>,
     #[serde(skip)]
     observability: Observability,
 }
@@ -195,6 +200,7 @@ impl Report {
             residual_consistency: None,
             gyro_density_ratio: None,
             drift_weighted: None,
+            attitude_is_gyro_integral: None,
             observability: estimate.observability,
         }
     }
@@ -211,6 +217,7 @@ impl Report {
                 .with_row_model(p.row_model(), p.torque_bias_nm())
                 .with_torque_test(p.torque_test())
                 .with_drift_weighted(p.drift_weighted())
+                .with_attitude_is_gyro_integral(p.attitude_is_gyro_integral())
                 .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
                 .with_glitches(Some(p.glitches())),
         )
@@ -260,6 +267,13 @@ impl Report {
         test: Option<crate::estimator::discrete_momentum::TorqueTest>,
     ) -> Self {
         self.torque_test = test;
+        self
+    }
+
+    /// With whether the attitude was found to be the gyro's own integral.
+    #[must_use]
+    pub fn with_attitude_is_gyro_integral(mut self, same: Option<bool>) -> Self {
+        self.attitude_is_gyro_integral = same;
         self
     }
 
@@ -332,6 +346,13 @@ impl fmt::Display for Report {
         )?;
         if let Some(m) = &self.row_model {
             writeln!(s, "rows: {m}")?;
+        }
+        if self.attitude_is_gyro_integral == Some(true) {
+            writeln!(
+                s,
+                "rotation: the attitude is the gyro's own integral (their answers agree within {} σ), so its rows are the gyro's and are folded once",
+                super::twins::TWIN_Z
+            )?;
         }
         writeln!(s, "status: {}", self.observability)?;
         let (Some(m), Some(j)) = (self.inertia, self.j) else {

@@ -42,6 +42,9 @@ pub(crate) enum Twins {
     /// Every check within [`TWIN_Z`] through the ruling-out horizon: the
     /// attitude's candidates are ruled out.
     Same,
+    /// No pair to compare (one rotation source, or the other's candidates ruled out by
+    /// their fit): no test.
+    NoPairs,
 }
 
 impl Twins {
