@@ -3,7 +3,11 @@
 //! A file is written to a temporary file beside its destination (`.NAME.PID.tmp`) and
 //! renamed over the destination only when the run succeeds ([`Pending::commit`]): a
 //! failed run leaves no partial output, and an unwritable destination is found when the
-//! temporary file is created, before any work.
+//! temporary file is created, before any work. A destination that is a symbolic link is
+//! followed: the file it names is replaced, and the link stays. A destination that
+//! exists and is not a regular file (`/dev/null`, a named pipe, a terminal) is written
+//! directly, as a shell redirection would: renaming over it would replace the device
+//! with a file (as root) or fail (otherwise), and it cannot hold a partial file anyway.
 
 use crate::error::{write_failed, CliError};
 use std::ffi::OsString;
@@ -16,33 +20,65 @@ pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// Whether `path` exists and is not a regular file or directory (its symbolic links
+/// followed): a device such as `/dev/null`, a named pipe or a socket, written directly
+/// ([`Pending`]) and with nothing written beside it.
+pub fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 /// An output file not yet in place: removed on drop unless committed.
 pub struct Pending {
-    tmp: PathBuf,
+    /// The temporary file, `None` when the destination is written directly.
+    tmp: Option<PathBuf>,
+    /// Where the file goes: the destination with its symbolic links followed.
+    target: PathBuf,
+    /// The destination as the user named it, for messages.
     dest: PathBuf,
     committed: bool,
 }
 
 impl Pending {
-    /// Create the temporary file for `dest`.
+    /// Create the temporary file for `dest` (or open `dest` itself where it exists and is
+    /// not a regular file).
     pub fn create(dest: &Path) -> Result<(Self, BufWriter<File>), CliError> {
         if dest.is_dir() {
             return Err(write_failed(dest, "is a directory"));
         }
-        let name = dest
+        if is_special(dest) {
+            let file = File::options()
+                .write(true)
+                .open(dest)
+                .map_err(|e| write_failed(dest, e))?;
+            let pending = Self {
+                tmp: None,
+                target: dest.to_path_buf(),
+                dest: dest.to_path_buf(),
+                committed: false,
+            };
+            return Ok((pending, BufWriter::new(file)));
+        }
+        // A symbolic link is followed: the file it names is replaced.
+        let target = if dest.exists() {
+            std::fs::canonicalize(dest).map_err(|e| write_failed(dest, e))?
+        } else {
+            dest.to_path_buf()
+        };
+        let name = target
             .file_name()
             .ok_or_else(|| write_failed(dest, "not a file name"))?;
         let mut tmp_name = OsString::from(".");
         tmp_name.push(name);
         tmp_name.push(format!(".{}.tmp", std::process::id()));
-        let tmp = dest.with_file_name(tmp_name);
+        let tmp = target.with_file_name(tmp_name);
         let file = File::options()
             .write(true)
             .create_new(true)
             .open(&tmp)
             .map_err(|e| write_failed(dest, e))?;
         let pending = Self {
-            tmp,
+            tmp: Some(tmp),
+            target,
             dest: dest.to_path_buf(),
             committed: false,
         };
@@ -59,9 +95,11 @@ impl Pending {
         let file = w
             .into_inner()
             .map_err(|e| write_failed(&self.dest, e.error()))?;
-        file.sync_all().map_err(|e| write_failed(&self.dest, e))?;
-        drop(file);
-        std::fs::rename(&self.tmp, &self.dest).map_err(|e| write_failed(&self.dest, e))?;
+        if let Some(tmp) = &self.tmp {
+            file.sync_all().map_err(|e| write_failed(&self.dest, e))?;
+            drop(file);
+            std::fs::rename(tmp, &self.target).map_err(|e| write_failed(&self.dest, e))?;
+        }
         self.committed = true;
         Ok(())
     }
@@ -69,8 +107,8 @@ impl Pending {
 
 impl Drop for Pending {
     fn drop(&mut self) {
-        if !self.committed {
-            let _ = std::fs::remove_file(&self.tmp);
+        if let (false, Some(tmp)) = (self.committed, &self.tmp) {
+            let _ = std::fs::remove_file(tmp);
         }
     }
 }

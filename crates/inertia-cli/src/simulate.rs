@@ -13,7 +13,7 @@
 use crate::args::{AttitudeArg, PresetArg, ScenarioArg, SimulateArgs};
 use crate::config::InertiaFile;
 use crate::error::{input, write_failed, CliError};
-use crate::output::{is_stdio, to_stdout, Pending};
+use crate::output::{is_special, is_stdio, to_stdout, Pending};
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
@@ -247,7 +247,9 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     // Create both files first: an unwritable destination fails before the simulation.
     let csv = (!stdout).then(|| Pending::create(&a.output)).transpose()?;
     let truth_file = truth_path(&a.output);
-    let truth = (!stdout)
+    // Nothing beside a device (`-o /dev/null`): no `/dev/null.truth.json`.
+    let special = is_special(&a.output);
+    let truth = (!stdout && !special)
         .then(|| Pending::create(&truth_file))
         .transpose()?;
     let out = sc.simulate(&common).map_err(input)?;
@@ -266,6 +268,8 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         writeln!(w, "{json}").map_err(|e| write_failed(&truth_file, e))?;
         pending.commit(w)?;
         format!("{} and {}", a.output.display(), truth_file.display())
+    } else if special {
+        format!("{} (not a regular file: no truth file)", a.output.display())
     } else {
         "standard output (no truth file)".into()
     };

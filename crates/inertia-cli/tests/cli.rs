@@ -1449,3 +1449,53 @@ fn equalities_and_a_cad_prior() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("contradict"), "{}", stderr(&o));
 }
+
+/// `-o /dev/null` writes to the device and leaves it one (the temporary-file-and-rename
+/// of a regular output would put a file in its place as root, and fail otherwise); `-o`
+/// through a symbolic link replaces the file it names and keeps the link. Both used to
+/// go wrong: `/dev/null` became a regular file, which later runs of other programs read.
+#[cfg(unix)]
+#[test]
+fn outputs_to_devices_and_symbolic_links() {
+    use std::os::unix::fs::FileTypeExt;
+    let d = tempfile::tempdir().unwrap();
+    let input = simulate(d.path(), "s", "slew", "5");
+    for args in [
+        &["estimate", input.to_str().unwrap(), "-o", "/dev/null"][..],
+        &[
+            "simulate",
+            "--scenario",
+            "slew",
+            "--duration",
+            "2",
+            "-o",
+            "/dev/null",
+        ][..],
+    ] {
+        let o = inertia(args);
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        let kind = std::fs::symlink_metadata("/dev/null").unwrap().file_type();
+        assert!(kind.is_char_device(), "{args:?}: /dev/null is now {kind:?}");
+    }
+    // Nothing written beside the device.
+    assert!(!Path::new("/dev/null.truth.json").exists());
+    let real = d.path().join("real.csv");
+    std::fs::write(&real, "earlier\n").unwrap();
+    let link = d.path().join("link.csv");
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    let before = listing(d.path());
+    let o = inertia(&[
+        "estimate",
+        input.to_str().unwrap(),
+        "-o",
+        link.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(std::fs::read_to_string(&real).unwrap().starts_with("t,J11"));
+    // No temporary file left beside either.
+    assert_eq!(listing(d.path()), before);
+}
