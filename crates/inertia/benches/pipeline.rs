@@ -1,13 +1,16 @@
 //! Per-sample cost of whole pipelines on the `slew` telemetry of
 //! `benches/discrete_momentum.rs`: the discrete momentum estimator's automatic path (the
 //! `Pipeline` with estimator `discrete-momentum` and default settings, which folds every
-//! candidate row model per sample: gyro and attitude rotations × plain and Richardson
-//! rows, four in all, and solves the best) beside the variational pipeline with the same
-//! defaults (physical constraint set, uncertainty, audit).
+//! candidate row model per sample: gyro and attitude rotations × four chain lengths,
+//! eight in all, and solves the best) beside the variational pipeline with the same
+//! defaults (physical constraint set, uncertainty, audit). A third measurement takes the
+//! same slew for 600 s and times the samples after 400 s: by then (3000 row blocks) the
+//! gyro-propagated attitude has been found to be the gyro's own integral and only the
+//! four gyro candidates are folded (`pipeline/twins.rs`).
 //!
 //! A `Pipeline` cannot be cloned, so each measurement builds one, feeds it the first
-//! 200 s untimed, and times the samples after that (the estimate is determined and the
-//! state steady there), building a new one when they run out.
+//! 200 s (400 s) untimed, and times the samples after that (the estimate is determined
+//! and the state steady there), building a new one when they run out.
 //!
 //! Run: `cargo bench -p inertia --bench pipeline -- --warm-up-time 1 --measurement-time 3`.
 
@@ -19,12 +22,27 @@ use std::time::{Duration, Instant};
 
 fn bench(c: &mut Criterion) {
     let run = Scenario::slew().simulate(&Common::paper()).unwrap();
-    let samples = &run.samples;
-    let start = 2000;
+    let long = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(600.0),
+            ..Common::paper()
+        })
+        .unwrap();
     let mut g = c.benchmark_group("pipeline_per_sample_slew");
-    for (name, estimator) in [
-        ("variational", "variational"),
-        ("discrete_momentum_auto", "discrete-momentum"),
+    for (name, estimator, samples, start) in [
+        ("variational", "variational", &run.samples, 2000),
+        (
+            "discrete_momentum_auto",
+            "discrete-momentum",
+            &run.samples,
+            2000,
+        ),
+        (
+            "discrete_momentum_auto_after_400s",
+            "discrete-momentum",
+            &long.samples,
+            4000,
+        ),
     ] {
         let settings = PipelineSettings {
             estimator: estimator.into(),
