@@ -788,6 +788,19 @@ fn simulate_realism_options() {
 // Issue 11: never hang, never NaN, never a silent drop.
 
 /// The files in `dir` (names), sorted.
+/// The arguments of `inertia simulate` for 2 s of the slew into `out`.
+fn simulate_2s_slew(out: &str) -> [&str; 7] {
+    [
+        "simulate",
+        "--scenario",
+        "slew",
+        "--duration",
+        "2",
+        "-o",
+        out,
+    ]
+}
+
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -1066,15 +1079,7 @@ fn failed_runs_leave_no_output() {
     let before = listing(d.path());
     let out = d.path().join("sim.csv");
     assert_io_error(
-        &[
-            "simulate",
-            "--scenario",
-            "slew",
-            "--duration",
-            "2",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+        &simulate_2s_slew(out.to_str().unwrap()),
         &["sim.truth.json", "is a directory"],
     );
     assert_eq!(listing(d.path()), before);
@@ -1462,15 +1467,7 @@ fn outputs_to_devices_and_symbolic_links() {
     let input = simulate(d.path(), "s", "slew", "5");
     for args in [
         &["estimate", input.to_str().unwrap(), "-o", "/dev/null"][..],
-        &[
-            "simulate",
-            "--scenario",
-            "slew",
-            "--duration",
-            "2",
-            "-o",
-            "/dev/null",
-        ][..],
+        &simulate_2s_slew("/dev/null")[..],
     ] {
         let o = inertia(args);
         assert!(o.status.success(), "{args:?}: {}", stderr(&o));
