@@ -3,11 +3,15 @@
 //! A file is written to a temporary file beside its destination (`.NAME.PID.tmp`) and
 //! renamed over the destination only when the run succeeds ([`Pending::commit`]): a
 //! failed run leaves no partial output, and an unwritable destination is found when the
-//! temporary file is created, before any work. A destination that is a symbolic link is
-//! followed: the file it names is replaced, and the link stays. A destination that
-//! exists and is not a regular file (`/dev/null`, a named pipe, a terminal) is written
-//! directly, as a shell redirection would: renaming over it would replace the device
-//! with a file (as root) or fail (otherwise), and it cannot hold a partial file anyway.
+//! temporary file is created, before any work. A destination that is a symbolic link to
+//! a regular file is replaced by the new file, never written through (following it would
+//! let a link planted in a shared directory such as `/tmp` redirect the output of a
+//! privileged run, and the rename would drop the named file's owner and mode). A
+//! destination that exists and is not a regular file (`/dev/null`, a named pipe, a
+//! terminal; through a link too) is written directly, as a shell redirection would:
+//! renaming over it would replace the device with a file (as root) or fail (otherwise),
+//! and it cannot hold a partial file anyway. (A named pipe with no reader waits for one,
+//! as the shell's `>` does.)
 
 use crate::error::{write_failed, CliError};
 use std::ffi::OsString;
@@ -31,9 +35,7 @@ pub fn is_special(path: &Path) -> bool {
 pub struct Pending {
     /// The temporary file, `None` when the destination is written directly.
     tmp: Option<PathBuf>,
-    /// Where the file goes: the destination with its symbolic links followed.
-    target: PathBuf,
-    /// The destination as the user named it, for messages.
+    /// The destination.
     dest: PathBuf,
     committed: bool,
 }
@@ -52,25 +54,18 @@ impl Pending {
                 .map_err(|e| write_failed(dest, e))?;
             let pending = Self {
                 tmp: None,
-                target: dest.to_path_buf(),
                 dest: dest.to_path_buf(),
                 committed: false,
             };
             return Ok((pending, BufWriter::new(file)));
         }
-        // A symbolic link is followed: the file it names is replaced.
-        let target = if dest.exists() {
-            std::fs::canonicalize(dest).map_err(|e| write_failed(dest, e))?
-        } else {
-            dest.to_path_buf()
-        };
-        let name = target
+        let name = dest
             .file_name()
             .ok_or_else(|| write_failed(dest, "not a file name"))?;
         let mut tmp_name = OsString::from(".");
         tmp_name.push(name);
         tmp_name.push(format!(".{}.tmp", std::process::id()));
-        let tmp = target.with_file_name(tmp_name);
+        let tmp = dest.with_file_name(tmp_name);
         let file = File::options()
             .write(true)
             .create_new(true)
@@ -78,7 +73,6 @@ impl Pending {
             .map_err(|e| write_failed(dest, e))?;
         let pending = Self {
             tmp: Some(tmp),
-            target,
             dest: dest.to_path_buf(),
             committed: false,
         };
@@ -98,7 +92,7 @@ impl Pending {
         if let Some(tmp) = &self.tmp {
             file.sync_all().map_err(|e| write_failed(&self.dest, e))?;
             drop(file);
-            std::fs::rename(tmp, &self.target).map_err(|e| write_failed(&self.dest, e))?;
+            std::fs::rename(tmp, &self.dest).map_err(|e| write_failed(&self.dest, e))?;
         }
         self.committed = true;
         Ok(())

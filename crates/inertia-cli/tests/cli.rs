@@ -787,7 +787,6 @@ fn simulate_realism_options() {
 
 // Issue 11: never hang, never NaN, never a silent drop.
 
-/// The files in `dir` (names), sorted.
 /// The arguments of `inertia simulate` for 2 s of the slew into `out`.
 fn simulate_2s_slew(out: &str) -> [&str; 7] {
     [
@@ -801,6 +800,7 @@ fn simulate_2s_slew(out: &str) -> [&str; 7] {
     ]
 }
 
+/// The files in `dir` (names), sorted.
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -1456,9 +1456,10 @@ fn equalities_and_a_cad_prior() {
 }
 
 /// `-o /dev/null` writes to the device and leaves it one (the temporary-file-and-rename
-/// of a regular output would put a file in its place as root, and fail otherwise); `-o`
-/// through a symbolic link replaces the file it names and keeps the link. Both used to
-/// go wrong: `/dev/null` became a regular file, which later runs of other programs read.
+/// of a regular output would put a file in its place as root, and fail otherwise: it
+/// did, and later runs of other programs read that file). `-o` naming a symbolic link
+/// replaces the link with the new file and never writes through it: the file it named is
+/// untouched.
 #[cfg(unix)]
 #[test]
 fn outputs_to_devices_and_symbolic_links() {
@@ -1491,8 +1492,9 @@ fn outputs_to_devices_and_symbolic_links() {
     assert!(std::fs::symlink_metadata(&link)
         .unwrap()
         .file_type()
-        .is_symlink());
-    assert!(std::fs::read_to_string(&real).unwrap().starts_with("t,J11"));
+        .is_file());
+    assert!(std::fs::read_to_string(&link).unwrap().starts_with("t,J11"));
+    assert_eq!(std::fs::read_to_string(&real).unwrap(), "earlier\n");
     // No temporary file left beside either.
     assert_eq!(listing(d.path()), before);
 }

@@ -274,6 +274,28 @@ fn own_solution(
     }
 }
 
+/// A reduced state's unconstrained answer ([`own_solution`]) and its least-squares σ
+/// ([`twins::least_squares_sigma`]) from the same rows: with prior knowledge stacked on
+/// for both, so that a strong prior does not leave a σ of the data alone beside an answer
+/// the prior holds ([`super::twins`]).
+fn own_answer(
+    qr: &RecursiveQr,
+    gyro: Option<f64>,
+    constraints: &Constraints,
+) -> Option<(InertiaVector, [f64; 6])> {
+    let augmented;
+    let solved = if prior::applies(constraints) {
+        augmented = prior::augment(qr, constraints).0;
+        &augmented
+    } else {
+        qr
+    };
+    Some((
+        own_solution(qr, gyro, constraints)?,
+        twins::least_squares_sigma(solved)?,
+    ))
+}
+
 /// Sample `a` as a node of the stride-2 grid: its gyro rate (the average over the step
 /// to `b`) becomes the mean of `a`'s and `b`'s rates, the average over the double step
 /// when the two steps are equal (the step after `b` is not known when `b` arrives; with
@@ -972,47 +994,38 @@ impl DiscreteMomentum {
     fn check_twins(&mut self) {
         let gyro = self.config.gyro_noise_rad_s_rthz;
         let constraints = &self.config.constraints;
-        let answer = |c: &Candidate| {
-            let qr = c.qr().reduced();
-            Some((
-                own_solution(&qr, gyro, constraints)?,
-                twins::least_squares_sigma(&qr)?,
-            ))
-        };
-        let mut worst: Option<f64> = Some(0.0);
-        let mut pairs = 0;
-        for (a, ra) in self.rows.iter().enumerate() {
-            if ra.rotation != RotationSource::Attitude || !self.standing.live(a) {
-                continue;
-            }
-            let twin = self.rows.iter().position(|r| {
-                r.rotation == RotationSource::Gyro
-                    && MomentumRowSettings {
-                        rotation: RotationSource::Attitude,
-                        ..*r
-                    } == *ra
-            });
-            let Some(g) = twin.filter(|&g| g == 0 || self.standing.live(g)) else {
-                continue;
-            };
-            pairs += 1;
-            let z = match (answer(&self.candidates[g]), answer(&self.candidates[a])) {
-                (Some((jg, sg)), Some((ja, sa))) => twins::ratio(&jg, &sg, &ja, &sa),
-                _ => None,
-            };
-            worst = worst.zip(z).map(|(w, z)| w.max(z));
-        }
-        if pairs == 0 {
+        let answer = |c: &Candidate| own_answer(&c.qr().reduced(), gyro, constraints);
+        let standing = &self.standing;
+        let pairs = twins::pairs(&self.rows, |i| i == 0 || standing.live(i));
+        if pairs.clone().next().is_none() {
             self.twins = Twins::NoPairs;
             return;
         }
+        let candidates = &self.candidates;
+        let worst = twins::worst(pairs.clone(), |i| answer(&candidates[i]));
+        // The chosen candidate's twin, should the chosen one be ruled out.
+        let chosen_twin = pairs
+            .clone()
+            .find(|&(_, a)| a == self.chosen)
+            .and_then(|(g, _)| g);
+        // The attitude's side of each pair, as a set of bits: nothing is allocated
+        // after warm-up (there are at most 8 candidates; every one has a twin here, or
+        // the verdict is not `Same`).
+        let attitude = pairs.fold(0u64, |m, (_, a)| {
+            m | 1u64.checked_shl(a as u32).unwrap_or(0)
+        });
         self.twins = self.twins.after(worst, self.blocks, self.rule_out_after);
         if self.twins == Twins::Same {
-            for (i, c) in self.candidates.iter_mut().enumerate() {
-                if self.rows[i].rotation == RotationSource::Attitude {
-                    self.standing.rule_out(i);
+            for (a, c) in self.candidates.iter_mut().enumerate() {
+                if attitude & 1u64.checked_shl(a as u32).unwrap_or(0) != 0 {
+                    self.standing.rule_out(a);
                     c.stop_jackknife();
                 }
+            }
+            // Until the next solve picks again (`solve_every` > 1), the report describes
+            // the twin's rows, whose answer is the same within the test's margin.
+            if let Some(g) = chosen_twin {
+                self.chosen = g;
             }
         }
     }
@@ -1247,6 +1260,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     for rows in candidates(c, has_gyro) {
         reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
+    let attitude_is_gyro_integral = drop_batch_twins(&mut reduced, c);
     let fits: Vec<(f64, f64, Option<f64>)> = reduced
         .iter()
         .map(|(rows, b)| {
@@ -1391,7 +1405,39 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         gaps: batch.gaps,
         row_model: Some(*rows),
         torque_test,
+        attitude_is_gyro_integral,
     })
+}
+
+/// The batch form of the test for an attitude that is the gyro's own integral
+/// ([`super::twins`]): over a record of at least [`RULE_OUT_AFTER`] row blocks (the
+/// recursive test's horizon), the pairs of candidates that differ only in the rotation
+/// source are compared once, on the whole record; within [`twins::TWIN_Z`], the
+/// attitude's candidates are left out. `Some(verdict)` where the test was made, `None`
+/// for a shorter record or without both sources.
+fn drop_batch_twins(
+    reduced: &mut Vec<(MomentumRowSettings, BatchReduction)>,
+    c: &PipelineConfig,
+) -> Option<bool> {
+    let rows: Vec<MomentumRowSettings> = reduced.iter().map(|(r, _)| *r).collect();
+    let pairs: Vec<(Option<usize>, usize)> = twins::pairs(&rows, |_| true).collect();
+    let blocks = reduced.first().map_or(0, |(_, b)| b.qr.rows / 3);
+    if pairs.is_empty() || blocks < RULE_OUT_AFTER {
+        return None;
+    }
+    let worst = twins::worst(pairs.iter().copied(), |i| {
+        own_answer(&reduced[i].1.qr, c.gyro_noise_rad_s_rthz, &c.constraints)
+    });
+    let same = worst.is_some_and(|z| z <= twins::TWIN_Z);
+    if same {
+        let mut k = 0;
+        reduced.retain(|_| {
+            let keep = !pairs.iter().any(|&(_, a)| a == k);
+            k += 1;
+            keep
+        });
+    }
+    Some(same)
 }
 
 #[cfg(test)]
@@ -1552,6 +1598,8 @@ mod tests {
             // until the fit rules one out.
             assert_eq!(pruned.twins, Twins::Independent);
             assert_eq!(pruned.attitude_is_gyro_integral(), Some(false));
+            let batch = run_batch(&run.samples, &config).unwrap();
+            assert_eq!(batch.attitude_is_gyro_integral, Some(false));
         }
     }
 
@@ -1606,6 +1654,17 @@ mod tests {
             pruned.row_model().map(|r| r.rotation),
             Some(RotationSource::Gyro)
         );
+        // The batch run makes the same test once, on the whole record: the same
+        // verdict, and the attitude's candidates left out of the choice. Over a record
+        // shorter than the horizon, no test.
+        let batch = run_batch(&run.samples, &config).unwrap();
+        assert_eq!(batch.attitude_is_gyro_integral, Some(true));
+        assert_eq!(
+            batch.row_model.map(|r| r.rotation),
+            Some(RotationSource::Gyro)
+        );
+        let short = run_batch(&run.samples[..2000], &config).unwrap();
+        assert_eq!(short.attitude_is_gyro_integral, None);
     }
 
     /// [`pick`] on made-up fits: the shortest chain fits best; a longer chain of the

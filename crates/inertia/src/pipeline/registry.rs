@@ -82,6 +82,9 @@ pub struct BatchOutput {
     /// The test for a constant disturbance torque, for estimators that make it
     /// ([`crate::estimator::discrete_momentum::torque_tested`]).
     pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
+    /// Whether the attitude was found to be the gyro's own integral, for estimators that
+    /// make that test ([`Estimator::attitude_is_gyro_integral`]).
+    pub attitude_is_gyro_integral: Option<bool>,
 }
 
 /// What an estimator uses and needs.

@@ -231,6 +231,7 @@ impl Report {
             .with_row_model(out.row_model, None)
             .with_torque_test(out.torque_test)
             .with_residual_tests(None, out.gyro_density_ratio)
+            .with_attitude_is_gyro_integral(out.attitude_is_gyro_integral)
     }
 
     /// With the input summary.

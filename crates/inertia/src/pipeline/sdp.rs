@@ -233,5 +233,6 @@ fn run_batch<S: RowSource + Default>(
         gaps: source.gaps(),
         row_model: None,
         torque_test: None,
+        attitude_is_gyro_integral: None,
     })
 }

@@ -16,8 +16,13 @@
 //! [`super::standing::RULE_OUT_AFTER`] row blocks, the attitude's candidates are ruled
 //! out for good (the gyro's rows, coning-compensated, are kept); one check beyond it, or
 //! one that cannot be made (a pair without an answer), and both stay for the whole run.
-//! The answer then moves by at most [`TWIN_Z`] of its noise σ.
+//! The unconstrained answers then differ by at most [`TWIN_Z`] of their combined σ
+//! (about 0.07 of either's); the chosen, constrained answer moved by at most 0.0013 of
+//! its σ on the paper's slew (test). The verdict is for good: an attitude that is the
+//! gyro's integral for the first [`super::standing::RULE_OUT_AFTER`] row blocks and
+//! corrected by a star tracker later is not tested again.
 
+use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::tensor::InertiaVector;
 
@@ -71,6 +76,49 @@ impl Twins {
     }
 }
 
+/// For each attitude candidate still folded (`folded(i)`; indices into `rows`), the
+/// candidate whose row settings differ only in the rotation source, if it is still folded
+/// too: `(Some(gyro), attitude)`, or `(None, attitude)` for one without a twin to compare
+/// (which makes the check fail: [`worst`]). An iterator, not a list: the recursive test
+/// runs after warm-up, where nothing may allocate (`inertia-c`'s `no_alloc` test).
+pub(crate) fn pairs<'a>(
+    rows: &'a [MomentumRowSettings],
+    folded: impl Fn(usize) -> bool + Clone + 'a,
+) -> impl Iterator<Item = (Option<usize>, usize)> + Clone + 'a {
+    rows.iter().enumerate().filter_map(move |(a, ra)| {
+        if ra.rotation != RotationSource::Attitude || !folded(a) {
+            return None;
+        }
+        let twin = rows.iter().position(|r| {
+            r.rotation == RotationSource::Gyro
+                && MomentumRowSettings {
+                    rotation: RotationSource::Attitude,
+                    ..*r
+                } == *ra
+        });
+        Some((twin.filter(|&g| folded(g)), a))
+    })
+}
+
+/// The largest `|ĵ_g − ĵ_a| / √(σ_g² + σ_a²)` over `pairs`, from each candidate's
+/// `(unconstrained ĵ, least-squares σ)`; `None` when a pair cannot be compared (an
+/// attitude candidate without a twin, an answer or σ missing or not finite) or there is
+/// none.
+pub(crate) fn worst(
+    pairs: impl Iterator<Item = (Option<usize>, usize)>,
+    answer: impl Fn(usize) -> Option<(InertiaVector, [f64; 6])>,
+) -> Option<f64> {
+    let mut out: Option<f64> = None;
+    for (g, a) in pairs {
+        let z = match (answer(g?), answer(a)) {
+            (Some((jg, sg)), Some((ja, sa))) => ratio(&jg, &sg, &ja, &sa)?,
+            _ => return None,
+        };
+        out = Some(out.unwrap_or(0.0).max(z));
+    }
+    out
+}
+
 /// The least-squares σ per element of a reduced state's unconstrained solution,
 /// `√(ρ²/ν · ((RᵀR)⁻¹)_kk)`; `None` without residual degrees of freedom or with a
 /// singular `R`.
@@ -86,7 +134,8 @@ pub(crate) fn least_squares_sigma(qr: &RecursiveQr) -> Option<[f64; 6]> {
     out.iter().all(|s| s.is_finite()).then_some(out)
 }
 
-/// `max_k |a_k − b_k| / √(σa_k² + σb_k²)`; `None` where a variance is zero or not finite.
+/// `max_k |a_k − b_k| / √(σa_k² + σb_k²)`; `None` where a variance is zero or not finite,
+/// or a difference is not finite (a NaN would otherwise pass as agreement).
 pub(crate) fn ratio(
     a: &InertiaVector,
     sa: &[f64; 6],
@@ -99,7 +148,11 @@ pub(crate) fn ratio(
         if !(v > 0.0 && v.is_finite()) {
             return None;
         }
-        worst = worst.max((a[k] - b[k]).abs() / v.sqrt());
+        let z = (a[k] - b[k]).abs() / v.sqrt();
+        if !z.is_finite() {
+            return None;
+        }
+        worst = worst.max(z);
     }
     worst.is_finite().then_some(worst)
 }
@@ -176,6 +229,51 @@ mod tests {
     }
 
     #[test]
+    fn pairs_differ_only_in_the_rotation_source_and_are_both_folded() {
+        let rows = |rotation, max_chain_s| MomentumRowSettings {
+            rotation,
+            max_chain_s,
+            ..MomentumRowSettings::default()
+        };
+        let (g, a) = (RotationSource::Gyro, RotationSource::Attitude);
+        let all = [
+            rows(g, Some(7.5)),
+            rows(a, Some(7.5)),
+            rows(g, Some(30.0)),
+            rows(a, Some(30.0)),
+            rows(a, None),
+        ];
+        let list = |p: &dyn Fn(usize) -> bool| -> std::vec::Vec<(Option<usize>, usize)> {
+            pairs(&all, p).collect()
+        };
+        // The whole-record attitude candidate has no gyro twin.
+        assert_eq!(
+            list(&|_| true),
+            std::vec![(Some(0), 1), (Some(2), 3), (None, 4)]
+        );
+        // An attitude candidate whose twin is no longer folded has none; one no longer
+        // folded itself is not listed.
+        assert_eq!(
+            list(&|i| i != 2 && i != 4),
+            std::vec![(Some(0), 1), (None, 3)]
+        );
+        let answer = |i: usize| {
+            let j = InertiaVector::repeat(1.0 + 0.01 * (i % 2) as f64);
+            Some((j, [1.0; 6]))
+        };
+        let z = worst(pairs(&all, |i| i != 4), answer).expect("comparable");
+        assert!((z - 0.01 / 2f64.sqrt()).abs() < 1e-12, "{z}");
+        // A candidate without a twin, no pairs, an answer missing or not finite: no
+        // verdict.
+        assert_eq!(worst(pairs(&all, |_| true), answer), None);
+        assert_eq!(worst(core::iter::empty(), answer), None);
+        let one_sided = |i: usize| (i == 0).then(|| answer(0)).flatten();
+        assert_eq!(worst([(Some(0), 1)].into_iter(), one_sided), None);
+        let nan = |i: usize| Some((InertiaVector::repeat(f64::NAN * i as f64), [1.0; 6]));
+        assert_eq!(worst([(Some(0), 1)].into_iter(), nan), None);
+    }
+
+    #[test]
     fn ratio_is_the_largest_element_in_the_combined_sigma() {
         let a = Vector6::new(1.0, 2.0, 3.0, 0.0, 0.0, 0.0);
         let b = Vector6::new(1.3, 2.0, 3.0, 0.0, 0.0, 0.4);
@@ -186,5 +284,11 @@ mod tests {
         let mut zero = s;
         zero[2] = 0.0;
         assert!(ratio(&a, &zero, &b, &zero).is_none());
+        // A NaN or infinite answer is no agreement.
+        let mut c = b;
+        c[4] = f64::NAN;
+        assert!(ratio(&a, &s, &c, &s).is_none());
+        c[4] = f64::INFINITY;
+        assert!(ratio(&c, &s, &c, &s).is_none());
     }
 }
