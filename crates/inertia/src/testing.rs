@@ -10,3 +10,15 @@ pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
         (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     }
 }
+
+/// Default momentum row settings with the given rotation source and longest chain.
+pub(crate) fn rows(
+    rotation: crate::estimator::momentum_rows::RotationSource,
+    max_chain_s: Option<f64>,
+) -> crate::estimator::momentum_rows::MomentumRowSettings {
+    crate::estimator::momentum_rows::MomentumRowSettings {
+        rotation,
+        max_chain_s,
+        ..Default::default()
+    }
+}

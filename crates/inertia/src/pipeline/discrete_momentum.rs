@@ -1674,11 +1674,7 @@ mod tests {
     /// jackknife σ for the fitted one leave the fit's pick.
     #[test]
     fn a_clearly_steadier_longer_chain_takes_the_place_of_the_best_fit() {
-        let rows = |rotation, max_chain_s| MomentumRowSettings {
-            rotation,
-            max_chain_s,
-            ..MomentumRowSettings::default()
-        };
+        let rows = crate::testing::rows;
         let (g, a) = (RotationSource::Gyro, RotationSource::Attitude);
         let all = [
             rows(g, Some(7.5)),

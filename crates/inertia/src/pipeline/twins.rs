@@ -230,11 +230,7 @@ mod tests {
 
     #[test]
     fn pairs_differ_only_in_the_rotation_source_and_are_both_folded() {
-        let rows = |rotation, max_chain_s| MomentumRowSettings {
-            rotation,
-            max_chain_s,
-            ..MomentumRowSettings::default()
-        };
+        let rows = crate::testing::rows;
         let (g, a) = (RotationSource::Gyro, RotationSource::Attitude);
         let all = [
             rows(g, Some(7.5)),
