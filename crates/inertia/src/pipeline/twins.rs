@@ -11,11 +11,12 @@
 //! differ only in the rotation source is solved (unconstrained) and compared, element by
 //! element, in their least-squares σ: `|ĵ_g − ĵ_a| / √(σ_g² + σ_a²)`. Independent
 //! sources (a star tracker, an MEKF, a truth attitude beside a noisy gyro) differ by
-//! their noise, `O(1)` in that ratio; a gyro-propagated attitude by less than 0.002 on the
-//! paper's slew. If every pair stays within [`TWIN_Z`] at every check up to
+//! their noise, 2–434 in that ratio on the README's cases; a gyro-propagated attitude by
+//! at most 0.004 (the paper's, FOG and MEMS gyros on the slew). If every pair stays within [`TWIN_Z`] at every check up to
 //! [`super::standing::RULE_OUT_AFTER`] row blocks, the attitude's candidates are ruled
 //! out for good (the gyro's rows, coning-compensated, are kept); one check beyond it, or
-//! one that cannot be made (a pair without an answer), and both stay for the whole run.
+//! one that cannot be made (an attitude candidate whose gyro twin is no longer folded, an
+//! answer missing or not finite), and both stay for the whole run.
 //! The unconstrained answers then differ by at most [`TWIN_Z`] of their combined σ
 //! (about 0.07 of either's); the chosen, constrained answer moved by at most 0.0013 of
 //! its σ on the paper's slew (test). The verdict is for good: an attitude that is the
