@@ -117,7 +117,7 @@ pub(crate) const LONG_CHAIN_FACTOR: f64 = 4.0;
 pub(crate) const SHORT_CHAIN_DIVISOR: f64 = 4.0;
 
 /// How many times smaller a longer chain's jackknife σ must be than that of the chain
-/// [`choose`] picked for it to take its place ([`DiscreteMomentum::steadier`]): the
+/// [`choose`] picked for it to take its place ([`steadier`]): the
 /// jackknife σ of 8 groups has a relative standard error of about 0.27, so this is about
 /// two of them.
 pub(crate) const STEADIER: f64 = 1.5;
