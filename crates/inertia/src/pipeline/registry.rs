@@ -58,8 +58,8 @@ pub trait Estimator: Send {
         None
     }
     /// With both rotation sources in play: whether the attitude was found to be the
-    /// gyro's own integral, so that only the gyro's rows are folded
-    /// (README, "Attitude against gyro"); `None` until the test has decided, or without both sources.
+    /// gyro's own integral, so that only the gyro's rows are folded (README, "Attitude
+    /// against gyro"); `None` until the test has decided, or without both sources.
     fn attitude_is_gyro_integral(&self) -> Option<bool> {
         None
     }
