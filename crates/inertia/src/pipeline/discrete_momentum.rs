@@ -1005,22 +1005,17 @@ impl DiscreteMomentum {
         let worst = twins::worst(pairs.clone(), |i| answer(&candidates[i]));
         // The chosen candidate's twin, should the chosen one be ruled out.
         let chosen_twin = pairs
-            .clone()
-            .find(|&(_, a)| a == self.chosen)
-            .and_then(|(g, _)| g);
-        // The attitude's side of each pair, as a set of bits: nothing is allocated
-        // after warm-up (there are at most 8 candidates; every one has a twin here, or
-        // the verdict is not `Same`).
-        let attitude = pairs.fold(0u64, |m, (_, a)| {
-            m | 1u64.checked_shl(a as u32).unwrap_or(0)
-        });
+            .filter(|&(_, a)| a == self.chosen)
+            .find_map(|(g, _)| g);
         self.twins = self.twins.after(worst, self.blocks, self.rule_out_after);
         if self.twins == Twins::Same {
-            for (a, c) in self.candidates.iter_mut().enumerate() {
-                if attitude & 1u64.checked_shl(a as u32).unwrap_or(0) != 0 {
-                    self.standing.rule_out(a);
-                    c.stop_jackknife();
-                }
+            // Every attitude candidate still folded was compared with its twin (one
+            // without keeps the verdict from `Same`): all of them go.
+            let attitude = self.candidates.iter_mut().zip(&self.rows).enumerate();
+            for (a, (c, _)) in attitude.filter(|(_, (_, r))| r.rotation == RotationSource::Attitude)
+            {
+                self.standing.rule_out(a);
+                c.stop_jackknife();
             }
             // Until the next solve picks again (`solve_every` > 1), the report describes
             // the twin's rows, whose answer is the same within the test's margin.
@@ -1420,22 +1415,18 @@ fn drop_batch_twins(
     c: &PipelineConfig,
 ) -> Option<bool> {
     let rows: Vec<MomentumRowSettings> = reduced.iter().map(|(r, _)| *r).collect();
-    let pairs: Vec<(Option<usize>, usize)> = twins::pairs(&rows, |_| true).collect();
+    let pairs = twins::pairs(&rows, |_| true);
     let blocks = reduced.first().map_or(0, |(_, b)| b.qr.rows / 3);
-    if pairs.is_empty() || blocks < RULE_OUT_AFTER {
+    if pairs.clone().next().is_none() || blocks < RULE_OUT_AFTER {
         return None;
     }
-    let worst = twins::worst(pairs.iter().copied(), |i| {
+    let worst = twins::worst(pairs, |i| {
         own_answer(&reduced[i].1.qr, c.gyro_noise_rad_s_rthz, &c.constraints)
     });
+    // Every attitude candidate has a twin where the verdict is `Same` ([`twins::worst`]).
     let same = worst.is_some_and(|z| z <= twins::TWIN_Z);
     if same {
-        let mut k = 0;
-        reduced.retain(|_| {
-            let keep = !pairs.iter().any(|&(_, a)| a == k);
-            k += 1;
-            keep
-        });
+        reduced.retain(|(r, _)| r.rotation != RotationSource::Attitude);
     }
     Some(same)
 }
