@@ -7,7 +7,8 @@ batch least-squares problem in numpy, on the same simulated files, seed by seed.
     python3 scripts/rls_vs_rows.py mems 30        # the MEMS slew, seeds 1..30
     python3 scripts/rls_vs_rows.py small-sat 30   # the small satellite with a FOG
 
-Needs numpy. Simulates into a temporary directory with target/release/inertia, then
+Needs numpy. Simulates into a temporary directory with target/release/inertia (or the
+binary named by the environment variable INERTIA_BIN), then
 prints, per row form, the median relative Frobenius error, its median ratio to the RLS's
 and the mean error per element (relative to ‖J‖; the attenuation of errors-in-variables
 shows there), plus each form's error on noise-free telemetry of the same case.
@@ -47,7 +48,7 @@ import tempfile
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "target", "release", "inertia")
+BIN = os.environ.get("INERTIA_BIN", os.path.join(ROOT, "target", "release", "inertia"))
 
 NO_BIAS = ["--gyro-bias-deg-h", "0:0:0", "--gyro-bias-instability-deg-h", "0"]
 CLEAN = ["--attitude", "truth", "--gyro-noise", "0", "--disturbance", "0",

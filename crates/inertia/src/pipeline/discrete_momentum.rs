@@ -782,7 +782,7 @@ impl DiscreteMomentum {
         let mut folded = false;
         let record = self.config.memory_s.is_none();
         self.residuals
-            .resize(self.candidates.len(), ResidualSegments::new());
+            .resize_with(self.candidates.len(), ResidualSegments::new);
         for src in &mut self.sources {
             let standing = &self.standing;
             let wanted = |i: &usize| *i == 0 || standing.live(*i);
