@@ -6,12 +6,18 @@ batch least-squares problem in numpy, on the same simulated files, seed by seed.
     cargo build --release -p inertia-cli
     python3 scripts/rls_vs_rows.py mems 30        # the MEMS slew, seeds 1..30
     python3 scripts/rls_vs_rows.py small-sat 30   # the small satellite with a FOG
+    python3 scripts/rls_vs_rows.py fog-midway 30  # the slew, FOG, commands mid-way
+    INERTIA_BIN=/path/to/inertia python3 scripts/rls_vs_rows.py mems 30   # another binary
 
 Needs numpy. Simulates into a temporary directory with target/release/inertia (or the
 binary named by the environment variable INERTIA_BIN), then
 prints, per row form, the median relative Frobenius error, its median ratio to the RLS's
 and the mean error per element (relative to ‖J‖; the attenuation of errors-in-variables
 shows there), plus each form's error on noise-free telemetry of the same case.
+
+Cases: "mems" (the slew, MEMS-propagated attitude), "small-sat" (the small satellite,
+FOG-propagated attitude, no gyro bias), "fog-midway" (the slew, FOG-propagated attitude,
+10 Hz commands changing half-way between samples); all 10 Hz, commands held at 10 Hz.
 
 Row forms (all with one initial momentum for the whole record, no torque unknown):
   rls            C_k G(ω_k) j − h = −C_k ρ_k, ω_k the mean of the two adjacent intervals'
@@ -26,6 +32,20 @@ Row forms (all with one initial momentum for the whole record, no torque unknown
                  make it: each block by Ĵ⁻¹ (C N)ᵀ, Ĵ the averaged rows' answer (the gyro's
                  noise enters the momentum as C J δω); tried, not adopted (README)
   averaged, GLS, comp  both
+  plain|averaged, IV …  instrumental variables, no density needed: the instruments of
+                 row block k are the same form's regressor blocks at k−L ("IV k-L"), the
+                 mean of those at k−L and k+L ("IV (k±L)/2"; both just-identified,
+                 (Zᵀ X)⁻¹ Zᵀ y), or the blocks side by side by two-stage least squares
+                 ("2SLS k±2": k−2 and k+2; "2SLS k-2:4": k−2, k−3, k−4); the −I column of the
+                 initial momentum is its own instrument. Their gyro noise (φ, white per
+                 interval) is independent of block k's; the attitude's random walk (C_k of a
+                 gyro-propagated attitude) is common to all and stays (second order, small).
+  averaged, GLS-IV k-2  the same with the GLS weight, block k and its instruments
+                 weighted by block k−2's Ĵ⁻¹ (C N)ᵀ (free of block k's gyro noise)
+  avg κ, …       the averaged rows with the default stencil's κ column (ρ̄ of both
+                 intervals moved by κ Δ²ρ at their common node, κ estimated with j; exact
+                 to O(h²) when the commands change between samples): least squares,
+                 compensated, IV, GLS and GLS-IV as above
 
 Then two tests of whether the data can tell when the GLS weighting pays. The residuals'
 shape: the unweighted rows' residuals rotated back to the body, (C N)ᵀ r, fitted by
@@ -37,7 +57,11 @@ the averaged rows unweighted and GLS-weighted, and per seed the one whose delete
 jackknife σ (Frobenius) is the smaller.
 
 "spread" is the root of the summed variances of the six elements over the seeds, the
-noise part of the error; the mean error per element is its bias part.
+noise part of the error; the mean error per element is its bias part. (On the small
+satellite most of that mean, about −5e-5 on J11, +4e-5 on J13 and −2e-5 on J23 in every
+form, is the wheels' 1e-5 N m s quantisation, whose error nearly repeats from seed to seed
+on the same trajectory: it goes with `--wheel-quantization-nms 0`, not with
+`--disturbance 0`.)
 """
 import json
 import os
@@ -59,6 +83,10 @@ CASES = {
              ["--attitude", "gyro", "--gyro-noise", "0.0025"], 0.0025),
     "small-sat": (["--preset", "small-sat", "--controller-hz", "10", *NO_BIAS],
                   ["--attitude", "gyro", "--gyro-arw-deg-rthr", "0.02"], 0.02 / 60),
+    # The paper slew with a FOG-propagated attitude, commands changing mid-way between
+    # samples (the matrix's "slew | FOG-propagated | 10 Hz mid-way").
+    "fog-midway": (["--scenario", "slew", "--controller-hz", "10", "--command-phase", "0.05"],
+                   ["--attitude", "gyro", "--gyro-arw-deg-rthr", "0.02"], 0.02 / 60),
 }
 
 
@@ -92,21 +120,54 @@ def n_matrix(p):
 G_AXES = [g(np.eye(3)[i]) for i in range(3)]
 
 
-def solve(a, b, eiv=0.0, whiten=None, j_white=None):
+def solve(a, b, eiv=0.0, whiten=None, j_white=None, extra=None):
     """min Σ‖W_k (a_k j − L − b_k)‖² over j and one L (W_k = I unless `whiten`);
     `eiv` the rows' expected noise Gram per row block (σ² noise_s), removed from the
     normal equations: `σ² noise_s D` unweighted, `Σ_i G(e_i)ᵀ J⁻² G(e_i)` times it when
-    whitened by `J⁻¹ (C N)ᵀ` (`j_white` that J)."""
+    whitened by `J⁻¹ (C N)ᵀ` (`j_white` that J). `extra` (n × 3 × p): more nuisance
+    columns (the κ column)."""
     n = len(a)
     w = np.broadcast_to(np.eye(3), (n, 3, 3)) if whiten is None else whiten
-    m = np.zeros((3 * n, 9))
-    m[:, :6] = (w @ a).reshape(3 * n, 6)
-    m[:, 6:] = (-w).reshape(3 * n, 3)
+    cols = [w @ a, -w] + ([] if extra is None else [w @ extra])
+    m = np.concatenate(cols, axis=2).reshape(3 * n, -1)
     normal = m.T @ m
     j_inv = np.eye(3) if j_white is None else np.linalg.inv(j_white)
     normal[:6, :6] -= n * eiv * sum(x.T @ j_inv @ j_inv @ x for x in G_AXES)
     j = np.linalg.solve(normal, m.T @ (w @ b[..., None]).reshape(-1))[:6]
     return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
+
+
+def solve_iv(a, b, offsets, stack=False, whiten=None, extra=None):
+    """Instrumental variables for `a_k j − L = b_k` (one L): the instruments of row block k
+    are the same form's regressor blocks at k + o, o in `offsets` (e.g. −2, or −2 and +2),
+    whose gyro noise is independent of block k's when the noise is white per interval;
+    the nuisance column −I is its own instrument. Averaged over the offsets and
+    just-identified, Ĵ from (Zᵀ X) θ = Zᵀ y (`stack` False), or the blocks side by side
+    and two-stage least squares (`stack` True). Blocks whose instruments fall outside the
+    record are dropped. `whiten`, per block, weights row block k and its instruments by
+    the weight of block k − 2 (Σ_k⁻¹ ≈ W_{k−2}ᵀ W_{k−2}, a weight free of block k's own
+    gyro noise). `extra` (n × 3 × p): more nuisance columns, their own instruments (the
+    κ column: wheel data and the attitude, no interval's gyro noise but through C N)."""
+    n = len(a)
+    back = max([-o for o in offsets if o < 0], default=0)
+    ahead = max([o for o in offsets if o > 0], default=0)
+    rows = np.arange(max(back, 2 if whiten is not None else 0), n - ahead)
+    m = len(rows)
+    w = (np.broadcast_to(np.eye(3), (m, 3, 3)) if whiten is None else whiten[rows - 2])
+    nuisance = [-w] + ([] if extra is None else [w @ extra[rows]])
+    x = np.concatenate([w @ a[rows], *nuisance], axis=2).reshape(3 * m, -1)
+    y = (w @ b[rows][..., None]).reshape(-1)
+    blocks = [w @ a[rows + o] for o in offsets]
+    if stack:
+        z = np.concatenate([*blocks, *nuisance], axis=2).reshape(3 * m, -1)
+        # Two-stage least squares: X projected on the instruments, then least squares.
+        x_hat = z @ np.linalg.lstsq(z, x, rcond=None)[0]
+        j = np.linalg.solve(x_hat.T @ x, x_hat.T @ y)[:6]
+    else:
+        z = np.concatenate([sum(blocks) / len(blocks), *nuisance],
+                           axis=2).reshape(3 * m, -1)
+        j = np.linalg.solve(z.T @ x, z.T @ y)[:6]
+    return to_matrix(j)
 
 
 def solve_chains(a, b, w, chain):
@@ -169,6 +230,30 @@ def forms(path, density_deg):
     whiten = np.linalg.inv(first) @ np.transpose((cn[:-1] + cn[1:]) / 2, (0, 2, 1))
     out["averaged, GLS"] = solve(a2, b2, whiten=whiten)
     out["averaged, GLS, comp"] = solve(a2, b2, eiv, whiten, first)
+    # Instrumental variables (the regressor blocks of the same form at other intervals):
+    # no density needed. For the averaged rows the blocks at k ± 1 share an interval with
+    # block k, so the offsets start at 2; the attitude's random walk (gyro-propagated C_k)
+    # is common to all blocks and not removed (a second-order term, small).
+    for name, rows_a, rows_b in [("plain", a, b), ("averaged", a2, b2)]:
+        for label, offsets, stack in [("IV k-2", [-2], False), ("IV k-4", [-4], False),
+                                      ("IV (k±2)/2", [-2, 2], False),
+                                      ("IV (k±4)/2", [-4, 4], False),
+                                      ("2SLS k±2", [-2, 2], True),
+                                      ("2SLS k-2:4", [-2, -3, -4], True)]:
+            out[f"{name}, {label}"] = solve_iv(rows_a, rows_b, offsets, stack)
+    out["averaged, GLS-IV k-2"] = solve_iv(a2, b2, [-2], whiten=whiten)
+    # The averaged rows with the κ column of the default stencil (ρ̄ of both intervals
+    # moved by κ Δ²ρ at their common node; exact to O(h²) when the commands change
+    # between samples, which the trapezoid is not).
+    d2 = rho[2:] - 2 * rho[1:-1] + rho[:-2]
+    kappa = ((cn[:-1] + cn[1:]) / 2 @ d2[..., None])
+    out["avg κ"] = solve(a2, b2, extra=kappa)
+    out["avg κ, comp"] = solve(a2, b2, eiv, extra=kappa)
+    out["avg κ, IV k-2"] = solve_iv(a2, b2, [-2], extra=kappa)
+    out["avg κ, IV (k±2)/2"] = solve_iv(a2, b2, [-2, 2], extra=kappa)
+    out["avg κ, 2SLS k±2"] = solve_iv(a2, b2, [-2, 2], True, extra=kappa)
+    out["avg κ, GLS"] = solve(a2, b2, whiten=whiten, extra=kappa)
+    out["avg κ, GLS-IV k-2"] = solve_iv(a2, b2, [-2], whiten=whiten, extra=kappa)
     scale = np.linalg.norm(truth)
     # Chains, unweighted and GLS-weighted (by the unweighted chains' answer), and the
     # one with the smaller jackknife σ.
