@@ -43,7 +43,8 @@ pub const SYNC_EVERY_BYTES: u64 = 32 << 20;
 
 /// A file whose data are synced to disk every [`SYNC_EVERY_BYTES`] written (the inode's
 /// metadata at [`Pending::commit`]): the write-back of a large output overlaps its
-/// writing instead of waiting at the end. A failed sync is the write's error.
+/// writing instead of waiting at the end. A failed sync is the write's error, which
+/// fails the run (the temporary file is then removed).
 #[derive(Debug)]
 pub struct Synced {
     file: File,
@@ -68,11 +69,7 @@ impl Synced {
     /// A destination written directly (a device, a pipe): never synced (`fsync` of a
     /// device fails).
     fn direct(file: File) -> Self {
-        Self {
-            file,
-            since_sync: 0,
-            every: u64::MAX,
-        }
+        Self::every(file, u64::MAX)
     }
 }
 

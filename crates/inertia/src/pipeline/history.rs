@@ -150,9 +150,8 @@ pub const BEHIND_BATCHES: usize = 32;
 /// A [`HistoryWriter`] on its own thread: formatting the numbers (about a tenth of a
 /// long run) overlaps the estimator. Estimates are handed over in batches of
 /// [`BEHIND_BATCH`] through a channel bounded at [`BEHIND_BATCHES`], so memory stays
-/// fixed. The output is the
-/// same byte for byte; a write error stops the thread and is returned by the next
-/// [`Self::write`] or by [`Self::finish`].
+/// fixed. The output is the same byte for byte; a write error stops the thread and is
+/// returned by the next [`Self::write`] or by [`Self::finish`].
 pub struct WriteBehind<W: Write + Send + 'static> {
     batch: std::vec::Vec<Estimate>,
     to_writer: Option<std::sync::mpsc::SyncSender<std::vec::Vec<Estimate>>>,
