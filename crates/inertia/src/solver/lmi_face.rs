@@ -27,7 +27,7 @@ use crate::constraints::description::Lmi;
 use crate::constraints::Constraints;
 use crate::givens::{fold_row, solve_normal};
 use crate::math::sqrt;
-use nalgebra::{Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 /// Most Newton steps.
 const MAX_STEPS: u32 = 12;
@@ -48,8 +48,27 @@ pub struct FaceSolution {
 }
 
 /// Sorted eigenpairs of a symmetric 3×3 matrix, ascending.
-fn eigen(f: &nalgebra::Matrix3<f64>) -> (Vector3<f64>, [Vector3<f64>; 3]) {
-    crate::eigen3::symmetric_eigen3(f)
+type Eigen = (Vector3<f64>, [Vector3<f64>; 3]);
+
+/// The last matrix whose eigenpairs [`solve`] took, with them. A recursive run starts
+/// each solve at the previous answer, where the previous solve's last step (its
+/// convergence test) took the eigenpairs of the same `F(j)`: they are reused, not
+/// recomputed (one of the two eigendecompositions of a typical solve). Only an exactly
+/// equal matrix hits, so the answer is the same bit for bit.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EigenMemo(Option<(Matrix3<f64>, Eigen)>);
+
+impl EigenMemo {
+    fn eigen(&mut self, f: &Matrix3<f64>) -> Eigen {
+        match self.0 {
+            Some((g, e)) if g == *f => e,
+            _ => {
+                let e = crate::eigen3::symmetric_eigen3(f);
+                self.0 = Some((*f, e));
+                e
+            }
+        }
+    }
 }
 
 /// `w[k] = aᵀ F_k b` for the LMI's coefficient matrices.
@@ -65,6 +84,7 @@ pub fn solve(
     constraints: &Constraints,
     index: usize,
     start: &Vector6<f64>,
+    memo: &mut EigenMemo,
 ) -> Option<FaceSolution> {
     let lmi = constraints.lmis().get(index)?;
     let scale = start.amax().max(1.0);
@@ -72,7 +92,7 @@ pub fn solve(
     let rt = r.transpose();
     let mut mu = f64::NAN;
     for step in 1..=MAX_STEPS {
-        let (lam, v) = eigen(&lmi.eval(&j));
+        let (lam, v) = memo.eigen(&lmi.eval(&j));
         if !(lam[1] - lam[0] > 1e-9 * scale) {
             return None; // not a simple eigenvalue: the face is not smooth here
         }
@@ -180,6 +200,61 @@ fn accept(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Problem: 200 slowly changing least-squares problems whose unconstrained answer
+    /// violates the triangle inequality (`J = diag(1, 1.1, 2.3)` plus noise: the physical
+    /// set's `Σ ⪰ 0` face is active), each solved from the previous answer by one solver
+    /// that keeps its memo, as a recursive run does. Reference: a fresh solver (empty
+    /// memo) for each. Tolerance: none, bit for bit. And the memo is left holding the
+    /// answer's `F(j)`, so that the next solve starts with a hit.
+    #[test]
+    fn the_eigen_memo_changes_no_answer_and_is_hit_from_the_previous_answer() {
+        use crate::constraints::ConstraintSet;
+        use crate::solver::native::NativeSolver;
+        let constraints = ConstraintSet::physical().validate().expect("valid set");
+        let mut rnd = crate::testing::uniform(0x2545_f491_4f6c_dd1d);
+        let truth = Vector6::new(1.0, 1.1, 2.3, 0.01, -0.02, 0.015);
+        let mut r = Matrix6::from_fn(|i, k| {
+            if k < i {
+                0.0
+            } else if k == i {
+                2.0 + rnd()
+            } else {
+                0.3 * rnd()
+            }
+        });
+        let mut kept = NativeSolver::default();
+        let mut warm: Option<Vector6<f64>> = None;
+        let mut faces = 0;
+        for step in 0..200 {
+            for k in 0..6 {
+                r[(k, k)] += 0.01 * rnd().abs();
+            }
+            let z = r * truth + Vector6::from_fn(|_, _| 1e-3 * rnd());
+            let with_memo = crate::solver::solve(&mut kept, &r, &z, &constraints, warm.as_ref())
+                .expect("solve");
+            let fresh = crate::solver::solve(
+                &mut NativeSolver::default(),
+                &r,
+                &z,
+                &constraints,
+                warm.as_ref(),
+            )
+            .expect("solve");
+            assert_eq!(with_memo, fresh, "step {step}");
+            if with_memo.status == crate::solver::SolveStatus::Optimal && step > 0 {
+                faces += 1;
+                let held = kept.memo().0.map(|(f, _)| f);
+                let at_answer = constraints.lmis().iter().map(|l| l.eval(&with_memo.j));
+                assert!(
+                    at_answer.into_iter().any(|f| Some(f) == held),
+                    "step {step}: the memo does not hold F at the answer"
+                );
+            }
+            warm = Some(with_memo.j);
+        }
+        assert!(faces > 150, "only {faces} solves on the face");
+    }
 
     /// Problem: random upper triangular `R` with positive diagonals, spanning 12 orders of
     /// magnitude. Reference: the rows `√2 R` folded one by one. Tolerance: none, bit for

@@ -96,19 +96,29 @@ impl NativeSettings {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NativeSolver {
     settings: NativeSettings,
+    /// The LMI face's last eigendecomposition ([`super::lmi_face::EigenMemo`]).
+    memo: super::lmi_face::EigenMemo,
 }
 
 impl NativeSolver {
     /// A solver with the given (validated) settings.
     pub fn new(settings: NativeSettings) -> Result<Self, SettingsError> {
         settings.validate()?;
-        Ok(Self { settings })
+        Ok(Self {
+            settings,
+            memo: super::lmi_face::EigenMemo::default(),
+        })
     }
 
     /// The settings.
     #[must_use]
     pub fn settings(&self) -> &NativeSettings {
         &self.settings
+    }
+
+    #[cfg(test)]
+    pub(crate) fn memo(&self) -> &super::lmi_face::EigenMemo {
+        &self.memo
     }
 }
 
@@ -154,7 +164,7 @@ impl Backend for NativeSolver {
         }
         // One LMI face active: Newton on its KKT system from the previous answer.
         if let Some(w) = warm.filter(|_| self.settings.warm_start) {
-            if let Some(sol) = face_solution(r, z, constraints, w, 0) {
+            if let Some(sol) = face_solution(r, z, constraints, w, 0, &mut self.memo) {
                 return Ok(sol);
             }
         }
@@ -181,7 +191,9 @@ impl Backend for NativeSolver {
         })?;
         // Polish: if the barrier answer sits on one LMI face, solve that face exactly.
         if out.converged {
-            if let Some(sol) = face_solution(r, z, constraints, &out.x, out.newton_steps) {
+            if let Some(sol) =
+                face_solution(r, z, constraints, &out.x, out.newton_steps, &mut self.memo)
+            {
                 return Ok(sol);
             }
         }
@@ -210,6 +222,7 @@ fn face_solution(
     constraints: &Constraints,
     start: &InertiaVector,
     prior_steps: u32,
+    memo: &mut super::lmi_face::EigenMemo,
 ) -> Option<Solution> {
     let scale = start.amax().max(1.0);
     for (i, l) in constraints.lmis().iter().enumerate() {
@@ -218,7 +231,7 @@ fn face_solution(
         if shifted.cholesky().is_some() {
             continue;
         }
-        if let Some(f) = super::lmi_face::solve(r, z, constraints, i, start) {
+        if let Some(f) = super::lmi_face::solve(r, z, constraints, i, start, memo) {
             return Some(Solution {
                 j: f.j,
                 objective: (r * f.j - z).norm_squared(),
