@@ -12,7 +12,12 @@
 //! 1. rejects non-finite data;
 //! 2. takes the **fast path**: when `R` is well enough conditioned for a triangular solve
 //!    and the unconstrained minimiser `R⁻¹ z` is strictly feasible, it is returned exactly,
-//!    with no iterations ([`SolveStatus::Unconstrained`]);
+//!    with no iterations ([`SolveStatus::Unconstrained`]). Where the warm start is the
+//!    backend's last answer and that answer lay on an LMI face (a recursive run whose
+//!    data sit just outside the set, as the paper's slew does), that face is tried first
+//!    ([`Backend::solve_on_last_face`]): the fast path would fail there, and the face's
+//!    Newton steps are what the backend would take next. Both succeed only where the
+//!    unconstrained answer lies on the face to rounding, and then agree to rounding;
 //! 3. otherwise scales the data so that the objective is O(1) (`σ² = ‖z‖²`, the
 //!    objective at j = 0; when `z = 0`, `‖R‖²_F ‖j_c‖²` with `j_c` the constraint set's
 //!    interior point) and hands `(R/σ, z/σ)` to a [`Backend`].
@@ -107,6 +112,20 @@ pub trait Backend {
         constraints: &Constraints,
         warm: Option<&InertiaVector>,
     ) -> Result<Solution, SolveError>;
+
+    /// The scaled problem's answer on the LMI face that this backend's last answer lay
+    /// on, when `warm` is that answer bit for bit and there are no linear constraints;
+    /// `None` otherwise, or when that face no longer holds the optimum ([`solve`] then
+    /// goes the whole way). Provided: always `None`.
+    fn solve_on_last_face(
+        &mut self,
+        _r: &Matrix6<f64>,
+        _z: &Vector6<f64>,
+        _constraints: &Constraints,
+        _warm: &InertiaVector,
+    ) -> Option<Solution> {
+        None
+    }
 }
 
 /// The one definition of "singular" in this crate: a triangular pivot `|R_ii|` or a
@@ -236,6 +255,15 @@ fn solve_free(
     constraints: &Constraints,
     warm: Option<&InertiaVector>,
 ) -> Result<Solution, SolveError> {
+    let sigma = objective_scale(r, z, constraints);
+    if let Some(w) = warm.filter(|_| constraints.lins().is_empty()) {
+        if let Some(mut sol) =
+            backend.solve_on_last_face(&(r / sigma), &(z / sigma), constraints, w)
+        {
+            sol.objective = (r * sol.j - z).norm_squared();
+            return Ok(sol);
+        }
+    }
     if let Some(j) = unconstrained_minimiser(r, z) {
         if constraints.strictly_feasible(&j) {
             return Ok(Solution {
@@ -247,20 +275,24 @@ fn solve_free(
             });
         }
     }
+    let mut sol = backend.solve_scaled(&(r / sigma), &(z / sigma), constraints, warm)?;
+    sol.objective = (r * sol.j - z).norm_squared();
+    Ok(sol)
+}
+
+/// The scale `σ` of the data handed to a backend (module docs, step 3).
+fn objective_scale(r: &Matrix6<f64>, z: &Vector6<f64>, constraints: &Constraints) -> f64 {
     let zn = z.norm_squared();
     let sigma2 = if zn > 0.0 {
         zn
     } else {
         r.norm_squared() * constraints.interior().norm_squared()
     };
-    let sigma = if sigma2 > 0.0 {
+    if sigma2 > 0.0 {
         crate::math::sqrt(sigma2)
     } else {
         1.0
-    };
-    let mut sol = backend.solve_scaled(&(r / sigma), &(z / sigma), constraints, warm)?;
-    sol.objective = (r * sol.j - z).norm_squared();
-    Ok(sol)
+    }
 }
 
 /// A borrowed backend is a backend (so that an unsized one can be handed to [`solve`]).
@@ -278,6 +310,16 @@ impl<B: Backend + ?Sized> Backend for &mut B {
     ) -> Result<Solution, SolveError> {
         (**self).solve_scaled(r, z, constraints, warm)
     }
+
+    fn solve_on_last_face(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: &InertiaVector,
+    ) -> Option<Solution> {
+        (**self).solve_on_last_face(r, z, constraints, warm)
+    }
 }
 
 #[cfg(feature = "std")]
@@ -294,5 +336,15 @@ impl<B: Backend + ?Sized> Backend for std::boxed::Box<B> {
         warm: Option<&InertiaVector>,
     ) -> Result<Solution, SolveError> {
         (**self).solve_scaled(r, z, constraints, warm)
+    }
+
+    fn solve_on_last_face(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: &InertiaVector,
+    ) -> Option<Solution> {
+        (**self).solve_on_last_face(r, z, constraints, warm)
     }
 }

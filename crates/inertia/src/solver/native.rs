@@ -98,6 +98,8 @@ pub struct NativeSolver {
     settings: NativeSettings,
     /// The LMI face's last eigendecomposition ([`super::lmi_face::EigenMemo`]).
     memo: super::lmi_face::EigenMemo,
+    /// The last answer, when it lay on an LMI face ([`Backend::solve_on_last_face`]).
+    last_face: Option<Vector6<f64>>,
 }
 
 impl NativeSolver {
@@ -107,6 +109,7 @@ impl NativeSolver {
         Ok(Self {
             settings,
             memo: super::lmi_face::EigenMemo::default(),
+            last_face: None,
         })
     }
 
@@ -119,6 +122,11 @@ impl NativeSolver {
     #[cfg(test)]
     pub(crate) fn memo(&self) -> &super::lmi_face::EigenMemo {
         &self.memo
+    }
+
+    #[cfg(test)]
+    pub(crate) fn last_face(&self) -> Option<Vector6<f64>> {
+        self.last_face
     }
 }
 
@@ -134,6 +142,39 @@ impl Backend for NativeSolver {
         constraints: &Constraints,
         warm: Option<&InertiaVector>,
     ) -> Result<Solution, SolveError> {
+        let (sol, on_face) = self.solve_noting_face(r, z, constraints, warm)?;
+        self.last_face = on_face.then_some(sol.j);
+        Ok(sol)
+    }
+
+    fn solve_on_last_face(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: &InertiaVector,
+    ) -> Option<Solution> {
+        if !self.settings.warm_start
+            || !constraints.lins().is_empty()
+            || self.last_face != Some(*warm)
+        {
+            return None;
+        }
+        let sol = face_solution(r, z, constraints, warm, 0, &mut self.memo);
+        self.last_face = sol.map(|s| s.j);
+        sol
+    }
+}
+
+impl NativeSolver {
+    /// [`Backend::solve_scaled`], and whether the answer lies on an LMI face.
+    fn solve_noting_face(
+        &mut self,
+        r: &Matrix6<f64>,
+        z: &Vector6<f64>,
+        constraints: &Constraints,
+        warm: Option<&InertiaVector>,
+    ) -> Result<(Solution, bool), SolveError> {
         let problem = Problem {
             a: *r,
             b: *z,
@@ -149,7 +190,7 @@ impl Backend for NativeSolver {
                 .iter()
                 .all(|l| l.eval(&a.j).cholesky().is_some());
             if lmis_hold {
-                return Ok(Solution {
+                let sol = Solution {
                     j: a.j,
                     objective: (r * a.j - z).norm_squared(),
                     status: SolveStatus::Optimal,
@@ -159,13 +200,14 @@ impl Backend for NativeSolver {
                         dual: a.dual_residual,
                         gap: a.gap,
                     },
-                });
+                };
+                return Ok((sol, false));
             }
         }
         // One LMI face active: Newton on its KKT system from the previous answer.
         if let Some(w) = warm.filter(|_| self.settings.warm_start) {
             if let Some(sol) = face_solution(r, z, constraints, w, 0, &mut self.memo) {
-                return Ok(sol);
+                return Ok((sol, true));
             }
         }
         let interior = constraints.interior();
@@ -194,10 +236,10 @@ impl Backend for NativeSolver {
             if let Some(sol) =
                 face_solution(r, z, constraints, &out.x, out.newton_steps, &mut self.memo)
             {
-                return Ok(sol);
+                return Ok((sol, true));
             }
         }
-        Ok(Solution {
+        let sol = Solution {
             j: out.x,
             objective: (r * out.x - z).norm_squared(),
             status: if out.converged {
@@ -211,7 +253,8 @@ impl Backend for NativeSolver {
                 dual: out.dual_residual,
                 gap: out.gap,
             },
-        })
+        };
+        Ok((sol, false))
     }
 }
 
