@@ -89,9 +89,14 @@ impl SvdTracker {
         let (scale, unscale) = power_of_two_scale(amax);
         let rs: Columns = core::array::from_fn(|k| core::array::from_fn(|i| r[(i, k)] * scale));
         let mut b: Columns = [[0.0; 6]; 6];
+        // Column m of an upper-triangular R is zero below row m: those terms add an exact
+        // zero to a sum that starts at +0 (and so is never −0), and are skipped, with the
+        // same sums in the same order (for any other R, every term).
+        let triangular = (1..6).all(|i| (0..i).all(|m| r[(i, m)] == 0.0));
         for (bk, vk) in b.iter_mut().zip(&v) {
-            for (rm, &vmk) in rs.iter().zip(vk) {
-                for (x, &y) in bk.iter_mut().zip(rm) {
+            for (m, (rm, &vmk)) in rs.iter().zip(vk).enumerate() {
+                let rows = if triangular { m + 1 } else { 6 };
+                for (x, &y) in bk[..rows].iter_mut().zip(&rm[..rows]) {
                     *x += y * vmk;
                 }
             }
