@@ -45,6 +45,10 @@ pub struct FaceSolution {
     pub dual_residual: f64,
     /// The active eigenvalue `λ_min(F(j))` (≈ 0; negative values are the violation).
     pub eigenvalue: f64,
+    /// `μ ‖∇g‖∞ / max(1, ‖∇f‖∞)`: how clearly the objective presses on the face, in the
+    /// units of the dual tolerance (`1e-12`, on `dual_residual`). Near the tolerance the
+    /// face cannot be told from the interior ([`crate::solver::Backend::solve_on_last_face`]).
+    pub multiplier_margin: f64,
 }
 
 /// Sorted eigenpairs of a symmetric 3×3 matrix, ascending.
@@ -53,15 +57,21 @@ type Eigen = (Vector3<f64>, [Vector3<f64>; 3]);
 /// The last matrix whose eigenpairs [`solve`] took, with them. A recursive run starts
 /// each solve at the previous answer, where the previous solve's last step (its
 /// convergence test) took the eigenpairs of the same `F(j)`: they are reused, not
-/// recomputed (one of the two eigendecompositions of a typical solve). Only an exactly
-/// equal matrix hits, so the answer is the same bit for bit.
+/// recomputed (one of the two eigendecompositions of a typical solve). Only a matrix
+/// equal bit for bit hits (`+0` and `−0` differ), so the answer is the same bit for bit.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct EigenMemo(Option<(Matrix3<f64>, Eigen)>);
 
 impl EigenMemo {
     fn eigen(&mut self, f: &Matrix3<f64>) -> Eigen {
         match self.0 {
-            Some((g, e)) if g == *f => e,
+            Some((g, e))
+                if g.iter()
+                    .zip(f.iter())
+                    .all(|(a, b)| a.to_bits() == b.to_bits()) =>
+            {
+                e
+            }
             _ => {
                 let e = crate::eigen3::symmetric_eigen3(f);
                 self.0 = Some((*f, e));
@@ -110,7 +120,17 @@ pub fn solve(
         let g = lam[0];
         let done = g.abs() <= 1e-14 * scale && rd.amax() <= 1e-12 * grad_f.amax().max(1.0);
         if done {
-            return accept(constraints, index, j, mu, g, step - 1, &rd, &grad_f);
+            return accept(
+                constraints,
+                index,
+                j,
+                mu,
+                g,
+                step - 1,
+                &rd,
+                &grad_f,
+                &grad_g,
+            );
         }
         // Factor of the Lagrangian Hessian 2RᵀR − μ∇²g.
         let mut u = hessian_factor(r);
@@ -137,7 +157,7 @@ pub fn solve(
         }
         // Converged to round-off: the step no longer changes j.
         if dj.amax() <= 1e-15 * scale && g.abs() <= 1e-13 * scale {
-            return accept(constraints, index, j, mu, g, step, &rd, &grad_f);
+            return accept(constraints, index, j, mu, g, step, &rd, &grad_f, &grad_g);
         }
     }
     None
@@ -175,6 +195,7 @@ fn accept(
     steps: u32,
     rd: &Vector6<f64>,
     grad_f: &Vector6<f64>,
+    grad_g: &Vector6<f64>,
 ) -> Option<FaceSolution> {
     if mu < 0.0 {
         return None; // the constraint would not be active: not this face
@@ -194,6 +215,7 @@ fn accept(
         steps,
         dual_residual: rd.amax() / grad_f.amax().max(1.0),
         eigenvalue: g,
+        multiplier_margin: mu * grad_g.amax() / grad_f.amax().max(1.0),
     })
 }
 
@@ -254,7 +276,7 @@ mod tests {
                     let held = kept.memo().0.map(|(f, _)| f);
                     let at_answer = constraints.lmis().iter().map(|l| l.eval(&with_memo.j));
                     assert!(
-                        at_answer.into_iter().any(|f| Some(f) == held),
+                        at_answer.clone().any(|f| Some(f) == held),
                         "step {step}: the memo does not hold F at the answer"
                     );
                 }

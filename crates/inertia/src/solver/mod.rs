@@ -16,8 +16,11 @@
 //!    backend's last answer and that answer lay on an LMI face (a recursive run whose
 //!    data sit just outside the set, as the paper's slew does), that face is tried first
 //!    ([`Backend::solve_on_last_face`]): the fast path would fail there, and the face's
-//!    Newton steps are what the backend would take next. Both succeed only where the
-//!    unconstrained answer lies on the face to rounding, and then agree to rounding;
+//!    Newton steps are what the backend would take next. Its answer is taken only where
+//!    the objective presses on the face a thousand times more clearly than the face
+//!    solver's dual tolerance (`multiplier_margin`); otherwise the fast path follows, as
+//!    before. Both could succeed only where the face solver's tolerance, magnified by an
+//!    ill-conditioned `R`, cannot separate the face from the interior;
 //! 3. otherwise scales the data so that the objective is O(1) (`σ² = ‖z‖²`, the
 //!    objective at j = 0; when `z = 0`, `‖R‖²_F ‖j_c‖²` with `j_c` the constraint set's
 //!    interior point) and hands `(R/σ, z/σ)` to a [`Backend`].
@@ -114,9 +117,10 @@ pub trait Backend {
     ) -> Result<Solution, SolveError>;
 
     /// The scaled problem's answer on the LMI face that this backend's last answer lay
-    /// on, when `warm` is that answer bit for bit and there are no linear constraints;
-    /// `None` otherwise, or when that face no longer holds the optimum ([`solve`] then
-    /// goes the whole way). Provided: always `None`.
+    /// on, when `warm` is that answer bit for bit, there are no linear constraints and
+    /// the objective clearly presses on the face (module docs, step 2); `None`
+    /// otherwise ([`solve`] then takes the fast path and the backend as before).
+    /// Provided: always `None`.
     fn solve_on_last_face(
         &mut self,
         _r: &Matrix6<f64>,

@@ -154,15 +154,18 @@ impl Backend for NativeSolver {
         constraints: &Constraints,
         warm: &InertiaVector,
     ) -> Option<Solution> {
-        if !self.settings.warm_start
-            || !constraints.lins().is_empty()
-            || self.last_face != Some(*warm)
-        {
+        let last = self.last_face.filter(|j| {
+            j.iter()
+                .zip(warm.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        });
+        if !self.settings.warm_start || !constraints.lins().is_empty() || last.is_none() {
             return None;
         }
-        let sol = face_solution(r, z, constraints, warm, 0, &mut self.memo);
-        self.last_face = sol.map(|s| s.j);
-        sol
+        let found = face_solution(r, z, constraints, warm, 0, &mut self.memo)
+            .filter(|(_, margin)| *margin > FACE_FIRST_MARGIN);
+        self.last_face = found.map(|(s, _)| s.j);
+        found.map(|(s, _)| s)
     }
 }
 
@@ -206,7 +209,7 @@ impl NativeSolver {
         }
         // One LMI face active: Newton on its KKT system from the previous answer.
         if let Some(w) = warm.filter(|_| self.settings.warm_start) {
-            if let Some(sol) = face_solution(r, z, constraints, w, 0, &mut self.memo) {
+            if let Some((sol, _)) = face_solution(r, z, constraints, w, 0, &mut self.memo) {
                 return Ok((sol, true));
             }
         }
@@ -233,7 +236,7 @@ impl NativeSolver {
         })?;
         // Polish: if the barrier answer sits on one LMI face, solve that face exactly.
         if out.converged {
-            if let Some(sol) =
+            if let Some((sol, _)) =
                 face_solution(r, z, constraints, &out.x, out.newton_steps, &mut self.memo)
             {
                 return Ok((sol, true));
@@ -258,7 +261,15 @@ impl NativeSolver {
     }
 }
 
-/// Try the exact face solver on each LMI that is nearly active at `start`.
+/// The least [`super::lmi_face::FaceSolution::multiplier_margin`] for which
+/// [`Backend::solve_on_last_face`] gives the face's answer: a thousand times the face
+/// solver's dual tolerance. Below it the unconstrained answer could lie on the face to
+/// within that tolerance, and the whole way (the fast path first) decides, as it did
+/// before the shortcut.
+const FACE_FIRST_MARGIN: f64 = 1e-9;
+
+/// Try the exact face solver on each LMI that is nearly active at `start`: the answer
+/// and its multiplier margin.
 fn face_solution(
     r: &Matrix6<f64>,
     z: &Vector6<f64>,
@@ -266,7 +277,7 @@ fn face_solution(
     start: &InertiaVector,
     prior_steps: u32,
     memo: &mut super::lmi_face::EigenMemo,
-) -> Option<Solution> {
+) -> Option<(Solution, f64)> {
     let scale = start.amax().max(1.0);
     for (i, l) in constraints.lmis().iter().enumerate() {
         // Only nearly active LMIs: F − 1e-3·scale·I not positive definite.
@@ -275,7 +286,7 @@ fn face_solution(
             continue;
         }
         if let Some(f) = super::lmi_face::solve(r, z, constraints, i, start, memo) {
-            return Some(Solution {
+            let sol = Solution {
                 j: f.j,
                 objective: (r * f.j - z).norm_squared(),
                 status: SolveStatus::Optimal,
@@ -285,7 +296,8 @@ fn face_solution(
                     dual: f.dual_residual,
                     gap: (f.mu * f.eigenvalue).abs(),
                 },
-            });
+            };
+            return Some((sol, f.multiplier_margin));
         }
     }
     None
