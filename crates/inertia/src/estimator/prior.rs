@@ -148,6 +148,9 @@ fn reduce(qr: &RecursiveQr, fixed: &[Option<f64>; 6]) -> (RecursiveQr, f64) {
 /// stay the data's, so its residual variance is `s²`.
 #[must_use]
 pub fn augment(qr: &RecursiveQr, constraints: &Constraints) -> (RecursiveQr, Option<PriorFit>) {
+    if !applies(constraints) {
+        return (*qr, None);
+    }
     let fixed = constraints.fixed();
     let (mut out, scale) = reduce(qr, fixed);
     let Some(p) = constraints.set().prior else {

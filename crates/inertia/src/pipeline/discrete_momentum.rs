@@ -198,13 +198,16 @@ fn model_spread(
         return out;
     }
     let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
-    let Some(j_best) = own_solution(best, gyro, constraints) else {
-        return out;
-    };
+    // The chosen candidate's answer once another is comparable (none may be).
+    let mut j_best: Option<Option<InertiaVector>> = None;
     for qr in others {
         if !(qr.residual_variance() <= ratio * v_best) {
             continue;
         }
+        let Some(j_best) = *j_best.get_or_insert_with(|| own_solution(best, gyro, constraints))
+        else {
+            return out;
+        };
         if let Some(j) = own_solution(&qr, gyro, constraints) {
             for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
                 *o = o.max((a - b).abs());
