@@ -69,3 +69,9 @@ pub(crate) fn abs(x: f64) -> f64 {
 /// (non-finite or wildly scaled entries) never returns; every call here goes through
 /// `try_new` with this bound and handles the failure.
 pub(crate) const MAX_DECOMPOSITION_ITERATIONS: usize = 10_000;
+
+/// Whether two arrays hold the same numbers bit for bit (`+0` and `−0` differ, a NaN
+/// equals only the same NaN): the key of the solver's exact-match memos.
+pub(crate) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}

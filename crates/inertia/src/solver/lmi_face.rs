@@ -65,13 +65,7 @@ pub struct EigenMemo(Option<(Matrix3<f64>, Eigen)>);
 impl EigenMemo {
     fn eigen(&mut self, f: &Matrix3<f64>) -> Eigen {
         match self.0 {
-            Some((g, e))
-                if g.iter()
-                    .zip(f.iter())
-                    .all(|(a, b)| a.to_bits() == b.to_bits()) =>
-            {
-                e
-            }
+            Some((g, e)) if crate::math::same_bits(g.as_slice(), f.as_slice()) => e,
             _ => {
                 let e = crate::eigen3::symmetric_eigen3(f);
                 self.0 = Some((*f, e));

@@ -154,11 +154,9 @@ impl Backend for NativeSolver {
         constraints: &Constraints,
         warm: &InertiaVector,
     ) -> Option<Solution> {
-        let last = self.last_face.filter(|j| {
-            j.iter()
-                .zip(warm.iter())
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        });
+        let last = self
+            .last_face
+            .filter(|j| crate::math::same_bits(j.as_slice(), warm.as_slice()));
         if !self.settings.warm_start || !constraints.lins().is_empty() || last.is_none() {
             return None;
         }
