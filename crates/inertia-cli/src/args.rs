@@ -287,6 +287,10 @@ pub struct InputArgs {
     /// The quaternion follows the JPL/Shuster convention (inertial → body, scalar last).
     #[arg(long)]
     pub jpl: bool,
+    /// The rho columns hold the rotor momentum with the opposite sign (e.g. the wheels'
+    /// reaction on the body): negate them as they are read.
+    #[arg(long)]
+    pub negate_rho: bool,
     /// Rename a column, e.g. `--column t=time --column rho_x=h_wheel_x`.
     #[arg(long = "column", value_name = "DEFAULT=NAME")]
     pub columns: Vec<String>,

@@ -391,5 +391,6 @@ pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
         unit_tolerance: a.unit_tolerance,
         period_tolerance: a.period_tolerance,
         delimiter: b',',
+        negate_rho: a.negate_rho,
     })
 }

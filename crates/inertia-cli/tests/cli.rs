@@ -177,9 +177,23 @@ fn reproduce_writes_every_figure_and_table() {
         "| momentum |",
         "| finite difference |",
         "variational, physical set",
+        "| discrete momentum |",
         "Final estimates",
     ] {
         assert!(summary.contains(needle), "summary lacks {needle:?}");
+    }
+    // Both estimators' errors beside the baselines' in the total-error figures' data.
+    for stem in ["fig03_slew_total_error", "fig08_spin_total_error"] {
+        let data = std::fs::read_to_string(out.join(format!("{stem}.csv"))).unwrap();
+        let header: Vec<&str> = data.lines().next().unwrap().split(',').collect();
+        for column in [
+            "variational",
+            "discrete_momentum",
+            "momentum",
+            "finite_difference",
+        ] {
+            assert!(header.contains(&column), "{stem}: {header:?}");
+        }
     }
     assert!(stderr(&o).contains("summary.md"));
 }
@@ -230,12 +244,24 @@ fn input_conventions_give_the_same_answer() {
         }
     });
     let renamed = write("ren.csv", &header.replacen("t,", "time,", 1), &|_, _| {});
+    // The wheels' momentum with the opposite sign (columns rho_x..rho_z).
+    assert!(header.starts_with("t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z,"));
+    let reversed = write("rho.csv", header, &|_, r| {
+        for c in r.iter_mut().take(8).skip(5) {
+            *c = if let Some(s) = c.strip_prefix('-') {
+                s.to_string()
+            } else {
+                format!("-{c}")
+            };
+        }
+    });
     let base = json(&inertia(&["estimate", csv.to_str().unwrap(), "--json"]));
-    let cases: [(&PathBuf, &[&str]); 4] = [
+    let cases: [(&PathBuf, &[&str]); 5] = [
         (&sf, &["--scalar-first"]),
         (&jpl, &["--jpl"]),
         (&flipped, &[]),
         (&renamed, &["--column", "t=time"]),
+        (&reversed, &["--negate-rho"]),
     ];
     for (p, extra) in cases {
         let mut args = vec!["estimate", p.to_str().unwrap(), "--json"];
@@ -253,6 +279,15 @@ fn input_conventions_give_the_same_answer() {
     }
     let v = json(&inertia(&["estimate", flipped.to_str().unwrap(), "--json"]));
     assert_eq!(v["sign_flips"].as_u64().unwrap(), 1200);
+    // Without the option the reversed momentum stops the run, naming the option, the file
+    // and the line.
+    let o = inertia(&["estimate", reversed.to_str().unwrap()]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("--negate-rho") && err.contains("rho.csv:"),
+        "{err}"
+    );
     // Reading a scalar-last file as scalar-first is caught (non-unit or huge steps), not
     // silently accepted... or gives a different answer.
     let o = inertia(&[

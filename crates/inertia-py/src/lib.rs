@@ -150,6 +150,7 @@ impl Telemetry {
         for name in [
             "scalar_first",
             "jpl",
+            "negate_rho",
             "unit_tolerance",
             "period_tolerance",
             "columns",
@@ -280,6 +281,7 @@ fn read_csv(
         unit_tolerance: conv.unit_tolerance,
         period_tolerance: conv.period_tolerance,
         delimiter: b',',
+        negate_rho: conv.negate_rho,
     };
     py.allow_threads(|| read(&path, options))
         .map_err(|f| f.into_py(py))

@@ -87,11 +87,12 @@ impl Origin {
 }
 
 /// The message with the keyword arguments for the command-line options it names
-/// (`--jpl`, `--scalar-first`, `--glitches keep`), after it.
+/// (`--jpl`, `--scalar-first`, `--negate-rho`, `--glitches keep`), after it.
 pub fn python_options(m: String) -> String {
     let names: Vec<&str> = [
         ("--scalar-first", "scalar_first=True"),
         ("--jpl", "jpl=True"),
+        ("--negate-rho", "negate_rho=True"),
         ("--glitches keep", "glitches=\"keep\""),
     ]
     .iter()

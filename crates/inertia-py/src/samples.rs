@@ -200,7 +200,7 @@ impl Checker {
         let s = Sample {
             t_s: t,
             q,
-            rho_nms: rho,
+            rho_nms: if c.negate_rho { -rho } else { rho },
             tau_nm: tau,
             omega_rad_s: w,
         };

@@ -24,6 +24,8 @@ pub struct Convention {
     pub format: QuaternionFormat,
     pub unit_tolerance: f64,
     pub period_tolerance: Option<f64>,
+    /// The rho columns hold the rotor momentum with the opposite sign: negate them.
+    pub negate_rho: bool,
 }
 
 impl Default for Convention {
@@ -32,6 +34,7 @@ impl Default for Convention {
             format: QuaternionFormat::HamiltonScalarLast,
             unit_tolerance: DEFAULT_UNIT_TOLERANCE,
             period_tolerance: None,
+            negate_rho: false,
         }
     }
 }
@@ -288,6 +291,7 @@ pub fn convention(kw: &Kwargs<'_>) -> PyResult<Convention> {
         } else {
             QuaternionFormat::HamiltonScalarLast
         },
+        negate_rho: kw.bool("negate_rho", false)?,
         ..Convention::default()
     };
     for (name, slot) in [("unit_tolerance", 0), ("period_tolerance", 1)] {

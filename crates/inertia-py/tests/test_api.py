@@ -216,9 +216,17 @@ def test_conventions_on_arrays(slew):
     conj = tel.q * [-1, -1, -1, 1]
     with pytest.raises(inertia.DataError, match="look conjugated"):
         inertia.estimate(tel.t, conj, tel.rho, tau=tel.tau, w=tel.w)
+    # A wheel momentum of the opposite sign stops the run, naming the keyword that fixes
+    # it; with that keyword the answer is the same.
+    with pytest.raises(inertia.DataError, match=r"negate_rho=True"):
+        inertia.estimate(tel.t, tel.q, -tel.rho, tau=tel.tau, w=tel.w)
+    got = inertia.estimate(tel.t, tel.q, -tel.rho, tau=tel.tau, w=tel.w, negate_rho=True)
+    np.testing.assert_array_equal(got.inertia, ref.inertia)
     # Conventions belong to reading: telemetry already read refuses them.
     with pytest.raises(ValueError, match="^scalar_first: these samples were already read"):
         inertia.estimate(tel, scalar_first=True)
+    with pytest.raises(ValueError, match="^negate_rho: these samples were already read"):
+        inertia.estimate(tel, negate_rho=True)
 
 
 def test_read_csv_stats_and_lines(tmp_path, slew):

@@ -433,6 +433,24 @@ mod status {
                 },
                 "drop --scalar-first",
             ),
+            (
+                // JPL quaternions stored scalar first.
+                "scalar first and conjugated",
+                |q: &Quaternion| {
+                    let [w, x, y, z] = q.conjugate().to_wxyz();
+                    Quaternion::from_xyzw([w, x, y, z])
+                },
+                "use --scalar-first --jpl",
+            ),
+            (
+                // JPL quaternions stored scalar last, read with --scalar-first.
+                "scalar last read as scalar first, conjugated",
+                |q: &Quaternion| {
+                    let [x, y, z, w] = q.conjugate().to_xyzw();
+                    Quaternion::from_wxyz([x, y, z, w])
+                },
+                "drop --scalar-first and use --jpl",
+            ),
         ] {
             let bad: Vec<Sample> = good.iter().map(|s| Sample { q: f(&s.q), ..*s }).collect();
             for estimator in ["discrete-momentum", "variational"] {
@@ -448,6 +466,20 @@ mod status {
                 assert!(b.to_string().contains(option), "{b}");
             }
         }
+        // Gyro rates of the opposite sign: the rates are named, not the quaternions.
+        let negated: Vec<Sample> = good
+            .iter()
+            .map(|s| Sample {
+                omega_rad_s: s.omega_rad_s.map(|w| -w),
+                ..*s
+            })
+            .collect();
+        let e = run(&negated, &settings("discrete-momentum")).expect_err("negated gyro");
+        assert!(
+            matches!(e, PipelineError::AttitudeConvention { .. })
+                && e.to_string().contains("sign of w_x"),
+            "{e}"
+        );
         // The good data pass the same check.
         assert!(run(&good, &settings("discrete-momentum")).is_ok());
     }
@@ -534,28 +566,67 @@ mod status {
     }
 
     #[test]
-    fn a_reversed_wheel_momentum_sign_is_not_determined() {
-        let bad: Vec<Sample> = slew()
+    fn a_reversed_wheel_momentum_sign_stops_with_the_option_that_fixes_it() {
+        // ρ negated: the least-squares answer is −J (the rows are linear in j and ρ), which
+        // the J ⪰ εI floor refuses and whose negation would be determined.
+        let good = slew();
+        let negated = |s: &Sample| Sample {
+            rho_nms: -s.rho_nms,
+            ..*s
+        };
+        let bad: Vec<Sample> = good.iter().map(negated).collect();
+        let no_gyro: Vec<Sample> = bad
             .iter()
             .map(|s| Sample {
-                rho_nms: -s.rho_nms,
+                omega_rad_s: None,
                 ..*s
             })
             .collect();
         for estimator in ["discrete-momentum", "variational"] {
-            let o = run(&bad, &settings(estimator)).expect("runs");
+            let config = settings(estimator).validate().expect("valid");
+            for (name, data) in [("gyro", &bad), ("no gyro", &no_gyro)] {
+                let e = run(data, &settings(estimator)).expect_err(name);
+                assert!(
+                    matches!(e, PipelineError::ReversedMomentum { .. })
+                        && e.to_string().contains("--negate-rho"),
+                    "{estimator}, {name}: {e}"
+                );
+                // Where the gyro has not confirmed the quaternions, a conjugated one is
+                // named too.
+                if name == "no gyro" {
+                    assert!(e.to_string().contains("--jpl"), "{e}");
+                }
+            }
+            // The batch run checks its answer over the whole record, whose quaternion
+            // convention the gyro rates confirmed: only the signs of ρ and τ are left.
+            let b = inertia::pipeline::batch(&bad, &config).expect_err("batch");
             assert!(
                 matches!(
-                    o,
-                    Observability::NotObservable(Unobservable::AtFloor {
-                        unconstrained_negative: true,
+                    b,
+                    PipelineError::ReversedMomentum {
+                        attitude_checked: true,
                         ..
-                    })
-                ),
+                    }
+                ) && !b.to_string().contains("--jpl"),
+                "{estimator}: {b}"
+            );
+            // Negated back (what `--negate-rho` does as the file is read), it is determined.
+            let fixed: Vec<Sample> = bad.iter().map(negated).collect();
+            let o = run(&fixed, &settings(estimator)).expect("runs");
+            assert!(
+                matches!(o, Observability::Determined { .. }),
                 "{estimator}: {o}"
             );
-            assert!(o.to_string().contains("reversed sign of rho"));
         }
+        // Data that refuse a positive-definite J without a determined mirror image (a
+        // short record with nearly no excitation) are withdrawn, not stopped: the floor's
+        // status names the possible causes.
+        let short: Vec<Sample> = bad.iter().take(40).copied().collect();
+        let o = run(&short, &settings("discrete-momentum")).expect("runs");
+        assert!(
+            !matches!(o, Observability::Determined { .. }),
+            "a 4 s record: {o}"
+        );
     }
 
     #[test]

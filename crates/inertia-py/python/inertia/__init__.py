@@ -221,6 +221,7 @@ class Telemetry:
         *,
         scalar_first: bool = False,
         jpl: bool = False,
+        negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> "Telemetry":
@@ -232,6 +233,7 @@ class Telemetry:
                 kwargs=dict(
                     scalar_first=scalar_first,
                     jpl=jpl,
+                    negate_rho=negate_rho,
                     unit_tolerance=unit_tolerance,
                     period_tolerance=period_tolerance,
                 ),
@@ -287,6 +289,7 @@ def read_csv(
     *,
     scalar_first: bool = False,
     jpl: bool = False,
+    negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
     period_tolerance: Optional[float] = None,
@@ -301,6 +304,8 @@ def read_csv(
         path: the file.
         scalar_first: the quaternion columns hold ``[w, x, y, z]`` (``--scalar-first``).
         jpl: JPL/Shuster quaternions, inertial → body (``--jpl``).
+        negate_rho: the rho columns hold the rotor momentum with the opposite sign
+            (e.g. the wheels' reaction on the body): negate them (``--negate-rho``).
         columns: renamed columns, ``{"t": "time", "rho_x": "hw_x"}`` (``--column``).
         unit_tolerance: largest ``| |q| − 1 |`` renormalised (default 1e-3).
         period_tolerance: strict mode: a step differing from the first by more than
@@ -316,6 +321,7 @@ def read_csv(
             kwargs=dict(
                 scalar_first=scalar_first,
                 jpl=jpl,
+                negate_rho=negate_rho,
                 columns=None if columns is None else dict(columns),
                 unit_tolerance=unit_tolerance,
                 period_tolerance=period_tolerance,
@@ -396,7 +402,7 @@ _SETTINGS = (
     "solver", "uncertainty",
 )
 #: How the data are read.
-_CONVENTIONS = ("scalar_first", "jpl", "unit_tolerance", "period_tolerance")
+_CONVENTIONS = ("scalar_first", "jpl", "negate_rho", "unit_tolerance", "period_tolerance")
 
 
 def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
@@ -444,6 +450,7 @@ def estimate(
     truth: Any = None,
     scalar_first: bool = False,
     jpl: bool = False,
+    negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
     period_tolerance: Optional[float] = None,
@@ -499,7 +506,7 @@ def estimate(
         truth: the true J (3×3, kg m²), for ``Estimate.relative_error``.
 
     Input conventions (arrays, DataFrame, path): ``scalar_first``, ``jpl``,
-    ``unit_tolerance``, ``period_tolerance``; ``columns`` for a DataFrame or a path.
+    ``negate_rho``, ``unit_tolerance``, ``period_tolerance``; ``columns`` for a DataFrame or a path.
 
     The GIL is released while the data are checked and the estimator runs.
 
@@ -557,7 +564,7 @@ class Estimator:
     """A streaming estimator: push samples one at a time (or in blocks).
 
     Takes the settings of :func:`estimate` (not ``batch``, ``history``, ``truth``) and
-    the input conventions (``scalar_first``, ``jpl``, ``unit_tolerance``,
+    the input conventions (``scalar_first``, ``jpl``, ``negate_rho``, ``unit_tolerance``,
     ``period_tolerance``). Each sample is checked as a file's row is. Pushing the
     samples of a file one by one gives the same estimate as :func:`estimate` on it.
     The GIL is released while a sample is processed.
@@ -589,6 +596,7 @@ class Estimator:
         uncertainty: bool = True,
         scalar_first: bool = False,
         jpl: bool = False,
+        negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> None:

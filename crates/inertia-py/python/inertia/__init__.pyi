@@ -57,6 +57,7 @@ class Telemetry:
         *,
         scalar_first: bool = ...,
         jpl: bool = ...,
+        negate_rho: bool = ...,
         unit_tolerance: Optional[float] = ...,
         period_tolerance: Optional[float] = ...,
     ) -> Telemetry: ...
@@ -84,6 +85,7 @@ def read_csv(
     *,
     scalar_first: bool = ...,
     jpl: bool = ...,
+    negate_rho: bool = ...,
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
     period_tolerance: Optional[float] = ...,
@@ -122,6 +124,7 @@ def estimate(
     truth: Optional[ArrayLike] = ...,
     scalar_first: bool = ...,
     jpl: bool = ...,
+    negate_rho: bool = ...,
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
     period_tolerance: Optional[float] = ...,
@@ -154,6 +157,7 @@ class Estimator:
         uncertainty: bool = ...,
         scalar_first: bool = ...,
         jpl: bool = ...,
+        negate_rho: bool = ...,
         unit_tolerance: Optional[float] = ...,
         period_tolerance: Optional[float] = ...,
     ) -> None: ...

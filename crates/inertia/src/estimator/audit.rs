@@ -4,7 +4,10 @@
 //!
 //! * the answer rests on the `J ⪰ εI` floor (smallest principal moment below 2ε): the
 //!   data do not support a positive-definite J, which is what a reversed sign of ρ or τ or
-//!   a conjugated quaternion produce → [`Unobservable::AtFloor`], no answer;
+//!   a conjugated quaternion produce → [`Unobservable::AtFloor`], no answer; where the
+//!   negated least-squares answer would pass as determined (what a reversed sign of ρ
+//!   gives: the rows are linear in `j` and ρ) the pipeline stops
+//!   ([`crate::pipeline::PipelineError::ReversedMomentum`]);
 //! * the stated σ is comparable to J (`σ_F > max_relative_sigma · ‖Ĵ‖_F`) →
 //!   [`Unobservable::Uncertain`], no answer;
 //! * the constraints moved the answer further than the noise allows:
@@ -52,11 +55,26 @@ pub fn audit_at(
     let min_moment_kg_m2 = moments.min();
     let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
     if min_moment_kg_m2 < 2.0 * epsilon_kg_m2 {
-        let unconstrained_negative = unconstrained
-            .is_some_and(|u| crate::eigen3::symmetric_eigen3(&matrix_from_j(&u)).0.max() < 0.0);
+        let largest =
+            unconstrained.map(|u| crate::eigen3::symmetric_eigen3(&matrix_from_j(&u)).0.max());
+        let unconstrained_negative = largest.is_some_and(|m| m < 0.0);
+        // −J_ls as the audit would judge it: above the floor, σ (the stated one, else the
+        // least-squares one) within the threshold.
+        let sigma = e
+            .uncertainty
+            .as_ref()
+            .map(super::uncertainty::Uncertainty::frobenius_sigma_kg_m2)
+            .or_else(|| least_squares_frobenius_sigma(qr));
+        let mirror_determined = match (unconstrained, largest, sigma) {
+            (Some(u), Some(m), Some(s)) => {
+                -m >= 2.0 * epsilon_kg_m2 && s <= max_relative_sigma * matrix_from_j(&u).norm()
+            }
+            _ => false,
+        };
         e.observability = Observability::NotObservable(Unobservable::AtFloor {
             min_moment_kg_m2,
             unconstrained_negative,
+            mirror_determined,
         });
         e.solution = None;
         e.uncertainty = None;
@@ -86,4 +104,21 @@ pub fn audit_at(
                 Observability::FromPrior(Unobservable::ConflictsWithConstraints { chi2 });
         }
     }
+}
+
+/// The least-squares σ of `‖Ĵ − J‖_F`, kg m², from `qr` (`s² (RᵀR)⁻¹`, each product of
+/// inertia counted twice); `None` without residual degrees of freedom or with a singular
+/// `R`.
+fn least_squares_frobenius_sigma(qr: &RecursiveQr) -> Option<f64> {
+    let dof = qr.residual_dof();
+    if !(dof > 0.0) {
+        return None;
+    }
+    let inverse = qr.r.try_inverse()?;
+    let weights = [1.0, 1.0, 1.0, 2.0, 2.0, 2.0];
+    let v: f64 = (0..6)
+        .map(|i| weights[i] * inverse.row(i).norm_squared())
+        .sum();
+    let sigma = crate::math::sqrt(qr.rss / dof * v);
+    sigma.is_finite().then_some(sigma)
 }

@@ -87,6 +87,13 @@ pub enum Unobservable {
         /// Whether the unconstrained least-squares J is negative definite: the signature
         /// of a reversed sign of ρ or τ, or of a wrong quaternion convention.
         unconstrained_negative: bool,
+        /// Whether its negation `−J_ls` would pass as determined: positive definite above
+        /// the floor, with the stated σ within the relative-σ threshold of it. With no
+        /// known torque, negating ρ negates the least-squares answer and nothing else
+        /// (the rows are linear in `j` and ρ), so this is what telemetry whose ρ has the
+        /// opposite sign of this library's convention gives ([`crate::pipeline`] stops
+        /// there, naming the fix).
+        mirror_determined: bool,
     },
     /// The constraints moved the answer further than the data's noise allows: the data
     /// contradict the constraint set, and the answer is the constraint set's.
@@ -180,6 +187,7 @@ impl core::fmt::Display for Unobservable {
             Unobservable::AtFloor {
                 min_moment_kg_m2,
                 unconstrained_negative,
+                ..
             } => {
                 write!(
                     f,

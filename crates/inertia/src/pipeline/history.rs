@@ -322,6 +322,7 @@ mod tests {
             Observability::NotObservable(Unobservable::AtFloor {
                 min_moment_kg_m2: -1e-3,
                 unconstrained_negative: true,
+                mirror_determined: false,
             }),
             Observability::NotObservable(Unobservable::RankDeficient { rank: 4 }),
             Observability::NotObservable(Unobservable::Uncertain {

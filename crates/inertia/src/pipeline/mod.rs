@@ -65,6 +65,7 @@ pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
+use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
 use crate::sample::{check_range, OutOfRange, Sample};
@@ -145,6 +146,23 @@ pub enum PipelineError {
         fixed: f64,
         /// Steps compared.
         steps: usize,
+    },
+    /// The data fit a negative-definite J whose negation would be determined
+    /// ([`Unobservable::AtFloor`] with `mirror_determined`): the wheel momentum ρ has the
+    /// opposite sign of this library's convention (the rotors' momentum, body axes,
+    /// docs/conventions.md §1), or so has the known torque τ; until gyro rates have
+    /// confirmed the quaternion convention, a conjugated quaternion cannot be ruled out.
+    #[error("input sample {sample}: the data fit a negative-definite J whose negation would be determined: {}", if *attitude_checked {
+        "the wheel momentum rho has the opposite sign of this library's convention (the rotors' momentum in body axes, docs/conventions.md §1); if rho is the reaction on the body, use --negate-rho (CsvOptions::negate_rho), or check the sign of tau"
+    } else {
+        "the wheel momentum rho has the opposite sign of this library's convention (the rotors' momentum in body axes, docs/conventions.md §1; use --negate-rho, CsvOptions::negate_rho), or tau has, or the quaternions are conjugated (--jpl): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"
+    })]
+    ReversedMomentum {
+        /// 0-based index of the input sample whose estimate showed it.
+        sample: usize,
+        /// Whether the gyro rates confirmed the quaternion convention (then only the sign
+        /// of ρ or τ is left).
+        attitude_checked: bool,
     },
     /// One step of the attitude jumps against the gyro ([`crate::telemetry::glitch`]),
     /// and the policy is [`GlitchPolicy::Stop`].
@@ -324,6 +342,7 @@ impl Pipeline {
             estimator,
             estimator_samples,
             last,
+            checks,
             ..
         } = self;
         let mut feed = |u: &Sample| -> Result<(), PipelineError> {
@@ -335,6 +354,7 @@ impl Pipeline {
                     source,
                 })?;
             if let Some(e) = e {
+                reversed_momentum(&e, index, checks.verdict())?;
                 *last = Some(e);
                 on_estimate(&e);
             }
@@ -487,5 +507,26 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         }
     }
     checks::convention_error(&check)?;
-    run(samples, config)
+    let out = run(samples, config)?;
+    reversed_momentum(
+        &out.estimate,
+        samples.len().saturating_sub(1),
+        check.verdict(),
+    )?;
+    Ok(out)
+}
+
+/// [`PipelineError::ReversedMomentum`] where estimate `e` (of input sample `sample`) rests
+/// on the floor and the negated least-squares answer would be determined.
+fn reversed_momentum(e: &Estimate, sample: usize, verdict: Verdict) -> Result<(), PipelineError> {
+    match e.observability {
+        Observability::NotObservable(Unobservable::AtFloor {
+            mirror_determined: true,
+            ..
+        }) => Err(PipelineError::ReversedMomentum {
+            sample,
+            attitude_checked: matches!(verdict, Verdict::Consistent(_)),
+        }),
+        _ => Ok(()),
+    }
 }

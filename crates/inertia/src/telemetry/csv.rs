@@ -143,6 +143,11 @@ pub struct CsvOptions {
     pub period_tolerance: Option<f64>,
     /// Field delimiter. Default `,`.
     pub delimiter: u8,
+    /// The `rho_*` columns hold the rotor momentum with the opposite sign of this
+    /// library's convention (e.g. the wheels' reaction on the body): negate them as they
+    /// are read. Default `false`. The pipeline stops where the data show a reversed sign
+    /// ([`crate::pipeline::PipelineError::ReversedMomentum`]).
+    pub negate_rho: bool,
 }
 
 impl Default for CsvOptions {
@@ -153,6 +158,7 @@ impl Default for CsvOptions {
             unit_tolerance: DEFAULT_UNIT_TOLERANCE,
             period_tolerance: None,
             delimiter: b',',
+            negate_rho: false,
         }
     }
 }
@@ -703,7 +709,7 @@ impl<R: Read> TelemetryReader<R> {
         Ok(Sample {
             t_s: t,
             q,
-            rho_nms: rho,
+            rho_nms: if self.options.negate_rho { -rho } else { rho },
             tau_nm: tau,
             omega_rad_s: w,
         })
