@@ -1533,3 +1533,47 @@ fn outputs_to_devices_and_symbolic_links() {
     // No temporary file left beside either.
     assert_eq!(listing(d.path()), before);
 }
+
+/// The rotation source: with a star tracker's attitude beside a gyro, the gyro's rows are
+/// chosen (they fit better), the report says so in its `rows:` line and JSON
+/// `row_model.rotation`, and `--rotation-source` overrides it.
+#[test]
+fn the_rotation_source_is_chosen_reported_and_overridable() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("st.csv");
+    let o = inertia(&[
+        "simulate",
+        "--scenario",
+        "slew",
+        "--attitude",
+        "star-tracker",
+        "--duration",
+        "120",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let truth = dir.path().join("st.truth.json");
+    for (extra, rotation) in [
+        (&[][..], "gyro"),
+        (&["--rotation-source", "gyro"][..], "gyro"),
+        (&["--rotation-source", "attitude"][..], "attitude"),
+    ] {
+        let mut args = vec!["estimate", csv.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let text = inertia(&args);
+        assert!(text.status.success(), "{extra:?}: {}", stderr(&text));
+        assert!(
+            stdout(&text).contains(&format!("rows: rotation from {rotation},")),
+            "{extra:?}: {}",
+            stdout(&text)
+        );
+        args.extend_from_slice(&["--json", "--truth", truth.to_str().unwrap()]);
+        let v = json(&inertia(&args));
+        assert_eq!(v["row_model"]["rotation"], rotation, "{extra:?}");
+        if extra.is_empty() {
+            let err = v["relative_error"].as_f64().unwrap();
+            assert!(err < 1e-4, "default: {err}");
+        }
+    }
+}

@@ -1,5 +1,5 @@
 //! Per-sample cost of the discrete momentum estimator beside the paper's variational
-//! estimator, on the same `slew` telemetry: one `push` (rows, 15-unknown QR update,
+//! estimator, on the same `slew` telemetry: one `push` (rows, 16-unknown QR update,
 //! observability on the reduced 6×6 problem, constrained solve), for the plain and the
 //! Richardson rows.
 //!

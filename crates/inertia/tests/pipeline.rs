@@ -377,6 +377,7 @@ mod status {
     use inertia::pipeline::{Pipeline, PipelineError, PipelineSettings};
     use inertia::sample::Sample;
     use inertia::sim::scenario::{Common, Scenario};
+    use inertia::tensor::{matrix_from_j, relative_frobenius_error};
 
     fn run(
         samples: &[Sample],
@@ -627,6 +628,66 @@ mod status {
             !matches!(o, Observability::Determined { .. }),
             "a 4 s record: {o}"
         );
+    }
+
+    #[test]
+    fn a_sigma_comparable_to_j_is_not_determined() {
+        // An unmodelled disturbance torque 3e5 times the paper's (3e-3 N m/√Hz) over a
+        // 120 s slew: J is excited and the rows well conditioned, but the momentum's random
+        // walk leaves a σ comparable to J.
+        let samples = Scenario::slew()
+            .simulate(&Common {
+                duration_s: Some(120.0),
+                disturbance_nm_rthz: 3e-3,
+                ..Common::paper()
+            })
+            .expect("sim")
+            .samples;
+        let last = |max_relative_sigma: f64| {
+            let mut p = Pipeline::new(&PipelineSettings {
+                observability: inertia::estimator::observability::ObservabilitySettings {
+                    max_relative_sigma,
+                    ..Default::default()
+                },
+                ..PipelineSettings::default()
+            })
+            .expect("pipeline");
+            for s in &samples {
+                p.push(s).expect("runs");
+            }
+            *p.last().expect("estimates")
+        };
+        let e = last(inertia::estimator::observability::DEFAULT_MAX_RELATIVE_SIGMA);
+        assert!(
+            matches!(
+                e.observability,
+                Observability::NotObservable(Unobservable::Uncertain { relative_sigma, threshold })
+                    if relative_sigma > threshold
+            ),
+            "{}",
+            e.observability
+        );
+        assert!(e.j().is_none(), "no answer is given");
+        // The refusal is warranted: with the threshold lifted the answer comes out, its
+        // error is comparable to J, and its σ says so.
+        let e = last(10.0);
+        let (j, sigma) = (e.j().expect("j"), e.sigma_kg_m2().expect("σ"));
+        let truth = inertia::tensor::paper_j_true();
+        let error = relative_frobenius_error(&matrix_from_j(&j), &truth);
+        let relative_sigma = e.uncertainty.expect("σ").frobenius_sigma_kg_m2() / truth.norm();
+        assert!(
+            error > 0.01 && relative_sigma > 0.1,
+            "error {error:.2e}, σ {relative_sigma:.2e}"
+        );
+        let t = inertia::tensor::j_from_matrix(&truth);
+        for k in 0..6 {
+            assert!(
+                (j[k] - t[k]).abs() <= 3.0 * sigma[k],
+                "element {k}: error {:.2e}, σ {:.2e}",
+                j[k] - t[k],
+                sigma[k]
+            );
+        }
     }
 
     #[test]
