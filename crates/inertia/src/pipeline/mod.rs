@@ -354,7 +354,7 @@ impl Pipeline {
                     source,
                 })?;
             if let Some(e) = e {
-                reversed_momentum(&e, index, checks.verdict())?;
+                reversed_momentum(&e, index, || checks.verdict())?;
                 *last = Some(e);
                 on_estimate(&e);
             }
@@ -508,24 +508,27 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     }
     checks::convention_error(&check)?;
     let out = run(samples, config)?;
-    reversed_momentum(
-        &out.estimate,
-        samples.len().saturating_sub(1),
-        check.verdict(),
-    )?;
+    reversed_momentum(&out.estimate, samples.len().saturating_sub(1), || {
+        check.verdict()
+    })?;
     Ok(out)
 }
 
 /// [`PipelineError::ReversedMomentum`] where estimate `e` (of input sample `sample`) rests
-/// on the floor and the negated least-squares answer would be determined.
-fn reversed_momentum(e: &Estimate, sample: usize, verdict: Verdict) -> Result<(), PipelineError> {
+/// on the floor and the negated least-squares answer would be determined; `verdict`, the
+/// convention check's (asked only then).
+fn reversed_momentum(
+    e: &Estimate,
+    sample: usize,
+    verdict: impl FnOnce() -> Verdict,
+) -> Result<(), PipelineError> {
     match e.observability {
         Observability::NotObservable(Unobservable::AtFloor {
             mirror_determined: true,
             ..
         }) => Err(PipelineError::ReversedMomentum {
             sample,
-            attitude_checked: matches!(verdict, Verdict::Consistent(_)),
+            attitude_checked: matches!(verdict(), Verdict::Consistent(_)),
         }),
         _ => Ok(()),
     }
