@@ -187,13 +187,15 @@ impl core::fmt::Display for Unobservable {
             Unobservable::AtFloor {
                 min_moment_kg_m2,
                 unconstrained_negative,
-                ..
+                mirror_determined,
             } => {
                 write!(
                     f,
                     "the answer rests on the J ⪰ εI floor (smallest principal moment {min_moment_kg_m2:.2e} kg m²): the data do not support a positive-definite J"
                 )?;
-                if *unconstrained_negative {
+                if *mirror_determined {
+                    f.write_str("; its negation would be determined: rho (or tau) has the opposite sign of this library's convention (negate it: --negate-rho), or the quaternions are conjugated (docs/conventions.md §1, §3)")?;
+                } else if *unconstrained_negative {
                     f.write_str("; the unconstrained J is negative definite, the signature of a reversed sign of rho or tau or of a wrong quaternion convention (docs/conventions.md §1, §3)")?;
                 }
                 Ok(())
