@@ -34,7 +34,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from rls_vs_rows import BIN, NO_BIAS, g, n_matrix, rotation, solve  # noqa: E402
+from rls_vs_rows import BIN, NO_BIAS, g, plain_rows, rotation, solve  # noqa: E402
 
 SIM = ["--preset", "small-sat", "--attitude", "truth", "--gyro-noise", "0", *NO_BIAS]
 
@@ -65,12 +65,7 @@ def answers(path, width, drop_holds):
         keep = ~np.all((raw[1:-1] == raw[:-2]) & (raw[1:-1] == raw[2:]), axis=1)
     a_rls = node @ g((w[:-2] + w[1:-1]) / 2)
     b_rls = -(node @ ((rho[:-2] + 2 * rho[1:-1] + rho[2:]) / 4)[..., None])[..., 0]
-    theta = w[:-1] * h
-    angle = np.linalg.norm(theta, axis=1, keepdims=True)
-    phi = np.sin(angle / 2) * theta / np.where(angle > 0, angle, 1)
-    cn = c[:-1] @ n_matrix(phi)
-    a = cn @ g(phi) * (2 / h)
-    b = -(cn @ ((rho[:-1] + rho[1:]) / 2)[..., None])[..., 0]
+    _, a, b = plain_rows(c, w, rho, h)
     a2, b2 = (a[:-1] + a[1:]) / 2, (b[:-1] + b[1:]) / 2
     return {"RLS rows, ρ matched": solve(a_rls[keep], b_rls[keep]),
             "averaged rows": solve(a2[keep], b2[keep])}, keep.mean()

@@ -199,6 +199,18 @@ def to_matrix(j):
     return np.array([[j[0], j[3], j[4]], [j[3], j[1], j[5]], [j[4], j[5], j[2]]])
 
 
+def plain_rows(c, w, rho, h):
+    """The discrete momentum rows of one interval each, `a j − L = b`, and their `C N`
+    (c: the attitude matrices at the nodes, w: the gyro's interval rates)."""
+    theta = w[:-1] * h
+    angle = np.linalg.norm(theta, axis=1, keepdims=True)
+    phi = np.sin(angle / 2) * theta / np.where(angle > 0, angle, 1)
+    cn = c[:-1] @ n_matrix(phi)
+    a = cn @ g(phi) * (2 / h)
+    b = -(cn @ ((rho[:-1] + rho[1:]) / 2)[..., None])[..., 0]
+    return cn, a, b
+
+
 def forms(path, density_deg):
     d = np.genfromtxt(path, delimiter=",", names=True)
     t = d["t"]
@@ -215,12 +227,7 @@ def forms(path, density_deg):
         "rls, ρ matched": solve(
             a_rls, -(node @ ((rho[:-2] + 2 * rho[1:-1] + rho[2:]) / 4)[..., None])[..., 0]),
     }
-    theta = w[:-1] * h
-    angle = np.linalg.norm(theta, axis=1, keepdims=True)
-    phi = np.sin(angle / 2) * theta / np.where(angle > 0, angle, 1)
-    cn = c[:-1] @ n_matrix(phi)
-    a = cn @ g(phi) * (2 / h)
-    b = -(cn @ ((rho[:-1] + rho[1:]) / 2)[..., None])[..., 0]
+    cn, a, b = plain_rows(c, w, rho, h)
     out["plain"] = solve(a, b)
     a2, b2 = (a[:-1] + a[1:]) / 2, (b[:-1] + b[1:]) / 2
     out["averaged"] = solve(a2, b2)
