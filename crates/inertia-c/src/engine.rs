@@ -5,7 +5,7 @@
 //! * [`Engine::Fixed`]: the constrained least-squares estimators (`variational`,
 //!   `finite-difference`) with the native solver, in fixed-size state: the same steps the
 //!   pipeline's adapter takes (`pipeline/sdp.rs`: the half-rate shadow for σ, the status
-//!   audit, the residual test, the glitch and convention checks), on concrete types with
+//!   audit, the residual test, the glitch, convention and reversed-momentum checks), on concrete types with
 //!   no box. It can live in caller storage, and neither its construction nor a push
 //!   allocates (`tests/no_alloc.rs` counts). `tests/engines.rs` checks that it gives the
 //!   pipeline's estimates bit for bit.
@@ -66,12 +66,17 @@ impl<S: RowSource + Default> Fixed<S> {
         let index = self.samples;
         self.checks.push(index, s, self.config.glitches)?;
         self.samples += 1;
-        self.adapter
+        let e = self
+            .adapter
             .push(s)
             .map_err(|source| PipelineError::Estimator {
                 sample: Some(index),
                 source,
-            })
+            })?;
+        if let Some(e) = &e {
+            self.checks.estimate(index, e)?;
+        }
+        Ok(e)
     }
 }
 

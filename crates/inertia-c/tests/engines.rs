@@ -156,3 +156,36 @@ fn settings_reach_the_estimator() {
     });
     assert_eq!((base.has_sigma, no_sigma.has_sigma), (1, 0));
 }
+
+/// A wheel momentum of the opposite sign stops both engines at the same sample, with the
+/// same status and message (naming `--negate-rho`).
+#[test]
+fn a_reversed_wheel_momentum_stops_both_engines_alike() {
+    let run = Scenario::slew().simulate(&Common::paper()).unwrap();
+    for settings in [
+        variational(),
+        InertiaSettings {
+            estimator: InertiaEstimatorKind::FiniteDifference as u32,
+            ..inertia_settings_default()
+        },
+    ] {
+        let mut storage = Box::new(Storage([0; 1 << 16]));
+        let (heap, fixed) = (new(&settings), init(&mut storage, &settings));
+        let mut stops = Vec::new();
+        for est in [heap, fixed] {
+            let stop = run.samples.iter().enumerate().find_map(|(k, s)| {
+                let mut c = c_sample(s);
+                for r in &mut c.rho_nms {
+                    *r = -*r;
+                }
+                let status = push(est, &c);
+                (status != InertiaStatus::Ok).then(|| (k, status, last_error()))
+            });
+            stops.push(stop.expect("stopped"));
+            free(est);
+        }
+        assert_eq!(stops[0], stops[1]);
+        assert_eq!(stops[0].1, InertiaStatus::Data);
+        assert!(stops[0].2.contains("--negate-rho"), "{}", stops[0].2);
+    }
+}

@@ -52,30 +52,9 @@ pub fn audit_at(
         return;
     };
     let m = matrix_from_j(&j);
-    let min_moment_kg_m2 = moments.min();
     let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
-    if min_moment_kg_m2 < 2.0 * epsilon_kg_m2 {
-        let largest =
-            unconstrained.map(|u| crate::eigen3::symmetric_eigen3(&matrix_from_j(&u)).0.max());
-        let unconstrained_negative = largest.is_some_and(|m| m < 0.0);
-        // −J_ls as the audit would judge it: above the floor, σ (the stated one, else the
-        // least-squares one) within the threshold.
-        let sigma = e
-            .uncertainty
-            .as_ref()
-            .map(super::uncertainty::Uncertainty::frobenius_sigma_kg_m2)
-            .or_else(|| least_squares_frobenius_sigma(qr));
-        let mirror_determined = match (unconstrained, largest, sigma) {
-            (Some(u), Some(m), Some(s)) => {
-                -m >= 2.0 * epsilon_kg_m2 && s <= max_relative_sigma * matrix_from_j(&u).norm()
-            }
-            _ => false,
-        };
-        e.observability = Observability::NotObservable(Unobservable::AtFloor {
-            min_moment_kg_m2,
-            unconstrained_negative,
-            mirror_determined,
-        });
+    if let Some(floor) = at_floor(e, qr, epsilon_kg_m2, max_relative_sigma, moments) {
+        e.observability = Observability::NotObservable(floor);
         e.solution = None;
         e.uncertainty = None;
         return;
@@ -121,4 +100,67 @@ fn least_squares_frobenius_sigma(qr: &RecursiveQr) -> Option<f64> {
         .sum();
     let sigma = crate::math::sqrt(qr.rss / dof * v);
     sigma.is_finite().then_some(sigma)
+}
+
+/// [`Unobservable::AtFloor`] where `e`'s answer (principal moments `moments`) rests on the
+/// `J ⪰ εI` floor, with what the unconstrained answer `J_ls` of `qr` says: whether it is
+/// negative definite, and whether `−J_ls` would pass as determined (above the floor, σ —
+/// the stated one, else the least-squares one — within `max_relative_sigma · ‖J_ls‖`).
+/// `None` off the floor.
+#[must_use]
+pub fn at_floor(
+    e: &Estimate,
+    qr: &RecursiveQr,
+    epsilon_kg_m2: f64,
+    max_relative_sigma: f64,
+    moments: &nalgebra::Vector3<f64>,
+) -> Option<Unobservable> {
+    let min_moment_kg_m2 = moments.min();
+    if !(min_moment_kg_m2 < 2.0 * epsilon_kg_m2) {
+        return None;
+    }
+    let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
+    let largest =
+        unconstrained.map(|u| crate::eigen3::symmetric_eigen3(&matrix_from_j(&u)).0.max());
+    let sigma = e
+        .uncertainty
+        .as_ref()
+        .map(super::uncertainty::Uncertainty::frobenius_sigma_kg_m2)
+        .or_else(|| least_squares_frobenius_sigma(qr));
+    let mirror_determined = match (unconstrained, largest, sigma) {
+        (Some(u), Some(m), Some(s)) => {
+            -m >= 2.0 * epsilon_kg_m2 && s <= max_relative_sigma * matrix_from_j(&u).norm()
+        }
+        _ => false,
+    };
+    Some(Unobservable::AtFloor {
+        min_moment_kg_m2,
+        unconstrained_negative: largest.is_some_and(|m| m < 0.0),
+        mirror_determined,
+    })
+}
+
+/// Whether `e`, solved (determined or from the prior) with principal moments `moments`,
+/// rests on the floor where `−J_ls` would be determined ([`at_floor`]): what a reversed
+/// sign of ρ gives. Checked before a cross-check that would withdraw the answer for
+/// another reason.
+#[must_use]
+pub fn reversed_at_floor(
+    e: &Estimate,
+    qr: &RecursiveQr,
+    epsilon_kg_m2: f64,
+    max_relative_sigma: f64,
+    moments: &nalgebra::Vector3<f64>,
+) -> bool {
+    matches!(
+        e.observability,
+        Observability::Determined { .. } | Observability::FromPrior(_)
+    ) && e.j().is_some()
+        && matches!(
+            at_floor(e, qr, epsilon_kg_m2, max_relative_sigma, moments),
+            Some(Unobservable::AtFloor {
+                mirror_determined: true,
+                ..
+            })
+        )
 }

@@ -1,10 +1,13 @@
 //! The checks of the attitude against the gyro that every streaming run makes on its
 //! input before estimating: a step where the attitude jumps against the gyro
 //! ([`crate::telemetry::glitch`]) and a quaternion convention that the rates contradict
-//! ([`crate::telemetry::convention`]). One type, so that the pipeline and a fixed-size
+//! ([`crate::telemetry::convention`]); and, on its estimates, a wheel momentum of the
+//! opposite sign ([`reversed_momentum`]). One type, so that the pipeline and a fixed-size
 //! build (the C API's caller storage) make them alike.
 
 use super::PipelineError;
+use crate::estimator::observability::{Observability, Unobservable};
+use crate::estimator::Estimate;
 use crate::sample::Sample;
 use crate::telemetry::convention::{ConventionCheck, Verdict, STEPS_NEEDED};
 use crate::telemetry::glitch::{GlitchCheck, GlitchPolicy};
@@ -14,6 +17,8 @@ use crate::telemetry::glitch::{GlitchCheck, GlitchPolicy};
 pub struct AttitudeChecks {
     glitch: GlitchCheck,
     convention: ConventionCheck,
+    /// Whether any sample so far had a non-zero known torque.
+    tau_given: bool,
 }
 
 impl AttitudeChecks {
@@ -38,7 +43,14 @@ impl AttitudeChecks {
             self.convention.push(s);
             convention_error(&self.convention)?;
         }
+        self.tau_given |= s.tau_nm != nalgebra::Vector3::zeros();
         Ok(())
+    }
+
+    /// Check estimate `e` of input sample `index`: stop where it shows a wheel momentum
+    /// of the opposite sign ([`reversed_momentum`]).
+    pub fn estimate(&self, index: usize, e: &Estimate) -> Result<(), PipelineError> {
+        reversed_momentum(e, Some(index), self.tau_given, || self.convention.verdict())
     }
 
     /// The glitch check.
@@ -68,5 +80,53 @@ pub(crate) fn convention_error(check: &ConventionCheck) -> Result<(), PipelineEr
             steps: check.steps(),
         }),
         _ => Ok(()),
+    }
+}
+
+/// [`PipelineError::ReversedMomentum`] where estimate `e` (of input sample `sample`; `None`
+/// for a batch answer) rests on the floor and the negated least-squares answer would be
+/// determined ([`Unobservable::AtFloor`], `mirror_determined`); `tau_given`, whether the
+/// telemetry had a non-zero known torque; `verdict`, the convention check's (asked only
+/// then).
+pub(crate) fn reversed_momentum(
+    e: &Estimate,
+    sample: Option<usize>,
+    tau_given: bool,
+    verdict: impl FnOnce() -> Verdict,
+) -> Result<(), PipelineError> {
+    match e.observability {
+        Observability::NotObservable(Unobservable::AtFloor {
+            mirror_determined: true,
+            ..
+        }) => Err(PipelineError::ReversedMomentum {
+            sample,
+            tau_given,
+            quaternions: verdict(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The message of [`PipelineError::ReversedMomentum`].
+pub(crate) struct ReversedMessage<'a> {
+    pub sample: &'a Option<usize>,
+    pub tau_given: &'a bool,
+    pub quaternions: &'a Verdict,
+}
+
+impl core::fmt::Display for ReversedMessage<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if let Some(s) = self.sample {
+            write!(f, "input sample {s}: ")?;
+        }
+        f.write_str("the data fit a negative-definite J whose negation would be determined: the wheel momentum rho has the opposite sign of this library's convention (the rotors' own momentum in body axes, docs/conventions.md §1; negate it: --negate-rho)")?;
+        if *self.tau_given {
+            f.write_str(", or the known torque tau has")?;
+        }
+        match self.quaternions {
+            Verdict::Consistent(_) => Ok(()),
+            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (--jpl): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
+            _ => f.write_str(", or the quaternions are conjugated (--jpl): the attitude disagrees with the gyro rates too"),
+        }
     }
 }

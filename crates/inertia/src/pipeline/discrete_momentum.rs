@@ -27,7 +27,7 @@ use super::PipelineError;
 use crate::constraints::Constraints;
 use crate::eigen3::symmetric_eigen3;
 use crate::estimator::attitude_drift::AttitudeDrift;
-use crate::estimator::audit::{audit, audit_at};
+use crate::estimator::audit::{audit, audit_at, reversed_at_floor};
 use crate::estimator::compensation::compensate;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::discrete_momentum::{
@@ -920,6 +920,25 @@ impl DiscreteMomentum {
                 e.uncertainty = Some(with_bias_at(&noise, &bias, &eig));
             }
         }
+        // An answer on the floor whose negation would be determined (a reversed ρ: the
+        // pipeline stops there) is told as that, before the cross-check, which would
+        // withdraw it as the rotation sources' disagreement.
+        let (epsilon, max_relative_sigma) = (
+            self.config.constraints.set().epsilon_kg_m2,
+            self.config.observability.max_relative_sigma,
+        );
+        if let Some(c) = self.candidates.get(self.chosen) {
+            if reversed_at_floor(&e, c.solved(), epsilon, max_relative_sigma, &eig.0) {
+                audit_at(
+                    &mut e,
+                    c.solved(),
+                    epsilon,
+                    max_relative_sigma,
+                    Some(&eig.0),
+                );
+                return Ok(Some(e));
+            }
+        }
         self.cross_check(&mut e, &eig, s.t_s)?;
         let Some(c) = self.candidates.get(self.chosen) else {
             return Ok(Some(e));
@@ -1352,7 +1371,17 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
             let bias = quadrature(&spread, &discretisation);
             estimate.uncertainty = Some(with_bias(&noise, &bias, &j));
         }
-        if matches!(estimate.observability, Observability::Determined { .. }) {
+        // As in the recursive path: a reversed ρ is told before the cross-check.
+        let reversed = estimate.j().is_some_and(|j| {
+            reversed_at_floor(
+                &estimate,
+                &prior::augment(&tested, &c.constraints).0,
+                c.constraints.set().epsilon_kg_m2,
+                c.observability.max_relative_sigma,
+                &symmetric_eigen3(&matrix_from_j(&j)).0,
+            )
+        });
+        if !reversed && matches!(estimate.observability, Observability::Determined { .. }) {
             let mut others = Vec::new();
             for (i, (r, b)) in reduced.iter().enumerate() {
                 if i == chosen

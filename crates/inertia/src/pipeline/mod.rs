@@ -65,7 +65,6 @@ pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
-use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
 use crate::sample::{check_range, OutOfRange, Sample};
@@ -149,20 +148,21 @@ pub enum PipelineError {
     },
     /// The data fit a negative-definite J whose negation would be determined
     /// ([`Unobservable::AtFloor`] with `mirror_determined`): the wheel momentum ρ has the
-    /// opposite sign of this library's convention (the rotors' momentum, body axes,
+    /// opposite sign of this library's convention (the rotors' own momentum, body axes,
     /// docs/conventions.md §1), or so has the known torque τ; until gyro rates have
     /// confirmed the quaternion convention, a conjugated quaternion cannot be ruled out.
-    #[error("input sample {sample}: the data fit a negative-definite J whose negation would be determined: {}", if *attitude_checked {
-        "the wheel momentum rho has the opposite sign of this library's convention (the rotors' momentum in body axes, docs/conventions.md §1); if rho is the reaction on the body, use --negate-rho (CsvOptions::negate_rho), or check the sign of tau"
-    } else {
-        "the wheel momentum rho has the opposite sign of this library's convention (the rotors' momentum in body axes, docs/conventions.md §1; use --negate-rho, CsvOptions::negate_rho), or tau has, or the quaternions are conjugated (--jpl): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"
-    })]
+    ///
+    /// [`Unobservable::AtFloor`]: crate::estimator::observability::Unobservable::AtFloor
+    #[error("{}", checks::ReversedMessage { sample, tau_given, quaternions })]
     ReversedMomentum {
-        /// 0-based index of the input sample whose estimate showed it.
-        sample: usize,
-        /// Whether the gyro rates confirmed the quaternion convention (then only the sign
-        /// of ρ or τ is left).
-        attitude_checked: bool,
+        /// 0-based index of the input sample whose estimate showed it (`None`: a batch
+        /// answer, from the whole record).
+        sample: Option<usize>,
+        /// Whether the telemetry had a non-zero known torque.
+        tau_given: bool,
+        /// The quaternion convention check's verdict: [`Verdict::Consistent`] where the
+        /// gyro rates confirmed it (then only the sign of ρ or τ is left).
+        quaternions: Verdict,
     },
     /// One step of the attitude jumps against the gyro ([`crate::telemetry::glitch`]),
     /// and the policy is [`GlitchPolicy::Stop`].
@@ -354,7 +354,7 @@ impl Pipeline {
                     source,
                 })?;
             if let Some(e) = e {
-                reversed_momentum(&e, index, || checks.verdict())?;
+                checks.estimate(index, &e)?;
                 *last = Some(e);
                 on_estimate(&e);
             }
@@ -508,28 +508,9 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     }
     checks::convention_error(&check)?;
     let out = run(samples, config)?;
-    reversed_momentum(&out.estimate, samples.len().saturating_sub(1), || {
-        check.verdict()
-    })?;
+    let tau_given = samples
+        .iter()
+        .any(|s| s.tau_nm != nalgebra::Vector3::zeros());
+    checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
-}
-
-/// [`PipelineError::ReversedMomentum`] where estimate `e` (of input sample `sample`) rests
-/// on the floor and the negated least-squares answer would be determined; `verdict`, the
-/// convention check's (asked only then).
-fn reversed_momentum(
-    e: &Estimate,
-    sample: usize,
-    verdict: impl FnOnce() -> Verdict,
-) -> Result<(), PipelineError> {
-    match e.observability {
-        Observability::NotObservable(Unobservable::AtFloor {
-            mirror_determined: true,
-            ..
-        }) => Err(PipelineError::ReversedMomentum {
-            sample,
-            attitude_checked: matches!(verdict(), Verdict::Consistent(_)),
-        }),
-        _ => Ok(()),
-    }
 }
