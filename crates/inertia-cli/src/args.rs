@@ -45,13 +45,23 @@ pub struct MonteCarloArgs {
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
     /// Gyro rate noise spectral density, deg/s/√Hz.
-    #[arg(long, value_name = "DEG_S_RTHZ", default_value_t = 1e-5)]
+    #[arg(
+        long,
+        visible_alias = "gyro-noise-deg-s-rthz",
+        value_name = "DEG_S_RTHZ",
+        default_value_t = 1e-5
+    )]
     pub gyro_noise: f64,
     /// Unknown disturbance torque spectral density, N m/√Hz.
-    #[arg(long, value_name = "NM_RTHZ", default_value_t = 1e-8)]
+    #[arg(
+        long,
+        visible_alias = "disturbance-nm-rthz",
+        value_name = "NM_RTHZ",
+        default_value_t = 1e-8
+    )]
     pub disturbance: f64,
     /// Duration, s [default: the scenario's].
-    #[arg(long, value_name = "S")]
+    #[arg(long, visible_alias = "duration-s", value_name = "S")]
     pub duration: Option<f64>,
     /// Output directory.
     #[arg(long, value_name = "DIR", default_value = "monte-carlo")]
@@ -109,20 +119,25 @@ pub struct SimulateArgs {
     #[arg(long, value_enum)]
     pub preset: Option<PresetArg>,
     /// Duration, s [default: 300 for slew, 180 for spin, the preset's].
-    #[arg(long, value_name = "S")]
+    #[arg(long, visible_alias = "duration-s", value_name = "S")]
     pub duration: Option<f64>,
     /// Integration node period h, s: the telemetry period unless --telemetry-dt is given.
-    #[arg(long, value_name = "S", default_value_t = 0.1)]
+    #[arg(long, visible_alias = "dt-s", value_name = "S", default_value_t = 0.1)]
     pub dt: f64,
     /// Telemetry period, s: a whole multiple of --dt (write every n-th node; the gyro's
     /// delta angle covers the whole period), e.g. `--dt 0.1 --telemetry-dt 1`.
-    #[arg(long, value_name = "S")]
+    #[arg(long, visible_alias = "telemetry-dt-s", value_name = "S")]
     pub telemetry_dt: Option<f64>,
     /// Noise seed.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub seed: u64,
     /// Gyro rate noise spectral density, deg/s/√Hz [default: 1e-5, or the preset's].
-    #[arg(long, value_name = "DEG_S_RTHZ", conflicts_with = "gyro_arw_deg_rthr")]
+    #[arg(
+        long,
+        visible_alias = "gyro-noise-deg-s-rthz",
+        value_name = "DEG_S_RTHZ",
+        conflicts_with = "gyro_arw_deg_rthr"
+    )]
     pub gyro_noise: Option<f64>,
     /// Gyro angle random walk, deg/√h (= 60 × the density in deg/s/√Hz).
     #[arg(long, value_name = "DEG_RTHR")]
@@ -139,7 +154,7 @@ pub struct SimulateArgs {
     pub gyro_bias_correlation_s: Option<f64>,
     /// Unknown disturbance torque spectral density, N m/√Hz [default: 1e-8, or the
     /// preset's].
-    #[arg(long, value_name = "NM_RTHZ")]
+    #[arg(long, visible_alias = "disturbance-nm-rthz", value_name = "NM_RTHZ")]
     pub disturbance: Option<f64>,
     /// Source of the telemetered attitude [default: gyro, or the preset's (mekf)].
     #[arg(long, value_enum)]
@@ -164,7 +179,12 @@ pub struct SimulateArgs {
     pub controller_hz: Option<f64>,
     /// Time of the first command tick after t = 0, s, in [0, 1/controller-hz): 0 puts
     /// ticks on the telemetry nodes, dt/2 half-way between them.
-    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    #[arg(
+        long,
+        visible_alias = "command-phase-s",
+        value_name = "S",
+        default_value_t = 0.0
+    )]
     pub command_phase: f64,
     /// Wheel-momentum telemetry LSB, N m s (rounding) [default: 0, or the preset's].
     #[arg(long, value_name = "NMS")]
@@ -362,7 +382,11 @@ pub struct EstimateArgs {
     pub resample: Option<f64>,
     /// The gyro's rate-noise density, deg/s/√Hz: compensates the errors-in-variables bias
     /// of the variational estimator (README). Without it, no compensation.
-    #[arg(long, value_name = "DEG_S_RTHZ")]
+    #[arg(
+        long,
+        visible_alias = "gyro-noise-deg-s-rthz",
+        value_name = "DEG_S_RTHZ"
+    )]
     pub gyro_noise: Option<f64>,
     /// Angle random walk of the attitude solution, deg/√h (discrete-momentum estimator,
     /// with --gyro-noise): for an attitude propagated from a gyro, that gyro's ARW. The

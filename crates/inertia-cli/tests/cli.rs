@@ -1762,3 +1762,57 @@ fn simulate_options_change_what_they_name() {
     .unwrap();
     assert_eq!(truth["inertia_kg_m2"][0][0], 4.6);
 }
+
+/// The simulator's options also go by names that carry their units (SI, or the density's
+/// unit): the same file either way.
+#[test]
+fn simulate_options_with_units_in_their_names_are_the_same_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, options: &[&str]| -> String {
+        let out = dir.path().join(format!("{name}.csv"));
+        let mut args = vec!["simulate", "--scenario", "slew", "--controller-hz", "10"];
+        args.extend_from_slice(options);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let o = inertia(&args);
+        assert!(o.status.success(), "{options:?}: {}", stderr(&o));
+        std::fs::read_to_string(out).unwrap()
+    };
+    let short = run(
+        "short",
+        &[
+            "--duration",
+            "6",
+            "--dt",
+            "0.05",
+            "--telemetry-dt",
+            "0.1",
+            "--gyro-noise",
+            "1e-4",
+            "--disturbance",
+            "1e-7",
+            "--command-phase",
+            "0.05",
+        ],
+    );
+    let long = run(
+        "long",
+        &[
+            "--duration-s",
+            "6",
+            "--dt-s",
+            "0.05",
+            "--telemetry-dt-s",
+            "0.1",
+            "--gyro-noise-deg-s-rthz",
+            "1e-4",
+            "--disturbance-nm-rthz",
+            "1e-7",
+            "--command-phase-s",
+            "0.05",
+        ],
+    );
+    assert_eq!(short, long);
+    assert_eq!(short.lines().count(), 62);
+    let help = stdout(&inertia(&["simulate", "--help"]));
+    assert!(help.contains("duration-s") && help.contains("disturbance-nm-rthz"));
+}
