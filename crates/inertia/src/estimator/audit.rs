@@ -51,14 +51,14 @@ pub fn audit_at(
     let (Some(j), Some(moments)) = (e.j(), moments) else {
         return;
     };
-    let m = matrix_from_j(&j);
-    let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
     if let Some(floor) = at_floor(e, qr, epsilon_kg_m2, max_relative_sigma, moments) {
         e.observability = Observability::NotObservable(floor);
         e.solution = None;
         e.uncertainty = None;
         return;
     }
+    let m = matrix_from_j(&j);
+    let unconstrained = crate::solver::unconstrained_minimiser(&qr.r, &qr.z);
     if let Some(u) = &e.uncertainty {
         let relative_sigma = u.frobenius_sigma_kg_m2() / m.norm();
         if !(relative_sigma <= max_relative_sigma) {

@@ -1348,6 +1348,8 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         Ok((e, noise))
     };
     let (mut estimate, noise) = own(chosen)?;
+    // The chosen rows with the prior's: what the audit judges.
+    let augmented = prior::augment(&tested, &c.constraints).0;
     if c.uncertainty {
         if let (Some(j), Some(noise)) = (estimate.j(), noise) {
             let others = reduced
@@ -1375,7 +1377,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
         let reversed = estimate.j().is_some_and(|j| {
             reversed_at_floor(
                 &estimate,
-                &prior::augment(&tested, &c.constraints).0,
+                &augmented,
                 c.constraints.set().epsilon_kg_m2,
                 c.observability.max_relative_sigma,
                 &symmetric_eigen3(&matrix_from_j(&j)).0,
@@ -1409,7 +1411,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
     }
     audit(
         &mut estimate,
-        &prior::augment(&tested, &c.constraints).0,
+        &augmented,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
     );

@@ -497,9 +497,11 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     })?;
     let mut check = ConventionCheck::default();
     let mut glitches = GlitchCheck::default();
+    let mut tau_given = false;
     for (sample, s) in samples.iter().enumerate() {
         check_range(s).map_err(|source| PipelineError::OutOfRange { sample, source })?;
         check.push(s);
+        tau_given |= s.tau_nm != nalgebra::Vector3::zeros();
         if let Some(glitch) = glitches.push(s) {
             if config.glitches == GlitchPolicy::Stop {
                 return Err(PipelineError::AttitudeGlitch { sample, glitch });
@@ -508,9 +510,6 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     }
     checks::convention_error(&check)?;
     let out = run(samples, config)?;
-    let tau_given = samples
-        .iter()
-        .any(|s| s.tau_nm != nalgebra::Vector3::zeros());
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
 }
