@@ -1,5 +1,6 @@
-"""The README's Python and Dask examples run as written (the fenced blocks after the
-`python-example` and `dask-example` markers in the repository's README.md)."""
+"""The documentation's Python and Dask examples run as written: the fenced blocks after
+the `python-example` and `dask-example` markers in the repository's README.md or in its
+book (book/src/*.md; the book's Python chapter includes the README's example)."""
 
 import pathlib
 import re
@@ -8,14 +9,16 @@ import sys
 
 import pytest
 
-README = pathlib.Path(__file__).resolve().parents[3] / "README.md"
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "book" / "src").glob("*.md"))]
 
 
 def example(marker: str = "python-example") -> str:
-    text = README.read_text(encoding="utf-8")
-    m = re.search(r"<!-- " + marker + r"[^>]*-->\s*```python\n(.*?)```", text, re.S)
-    assert m, f"README.md: no ```python block after a <!-- {marker} --> marker"
-    return m.group(1)
+    for doc in DOCS:
+        m = re.search(r"<!-- " + marker + r"[^>]*-->\s*```python\n(.*?)```", doc.read_text(encoding="utf-8"), re.S)
+        if m:
+            return m.group(1)
+    raise AssertionError(f"README.md, book/src/*.md: no ```python block after a <!-- {marker} --> marker")
 
 
 def test_readme_example_runs_as_written(tmp_path):
