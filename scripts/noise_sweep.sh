@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README's noise sweep: final error percentiles of every estimator at 1x, 10x,
+# The noise sweep (book/src/monte-carlo.md): final error percentiles of every estimator at 1x, 10x,
 # 100x and 1000x the paper's gyro noise, both scenarios, 200 seeds each.
 # Usage: scripts/noise_sweep.sh [OUT_DIR]   (about a minute on 2 cores)
 set -euo pipefail

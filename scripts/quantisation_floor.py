@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Why no row form gets ahead on the small satellite (README, "Against the momentum RLS"):
+"""Why no row form gets ahead on the small satellite (book/src/monte-carlo.md, "Why the RLS leads there"):
 the wheel telemetry's 1e-5 N m s quantisation leaves an error floor that is shared by every
 row form, is not removed by smoothing the wheel momentum, and does not come from the rows
 where the wheels hold still.

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Why the momentum RLS leads the discrete momentum rows in a few cells of the matrix
-(README, "The Monte Carlo matrix", "Against the momentum RLS"): every row form as one
+(book/src/monte-carlo.md, "Why the RLS leads there"): every row form as one
 batch least-squares problem in numpy, on the same simulated files, seed by seed.
 
     cargo build --release -p inertia-cli
@@ -30,7 +30,7 @@ Row forms (all with one initial momentum for the whole record, no torque unknown
   averaged, comp the same, errors-in-variables compensated with the gyro's density
   averaged, GLS  the same weighted by its noise's covariance as the gyro's alone would
                  make it: each block by Ĵ⁻¹ (C N)ᵀ, Ĵ the averaged rows' answer (the gyro's
-                 noise enters the momentum as C J δω); tried, not adopted (README)
+                 noise enters the momentum as C J δω); tried, not adopted
   averaged, GLS, comp  both
   plain|averaged, IV …  instrumental variables, no density needed: the instruments of
                  row block k are the same form's regressor blocks at k−L ("IV k-L"), the
