@@ -7,7 +7,7 @@
 //!   pipeline's adapter takes (`pipeline/sdp.rs`: the half-rate shadow for σ, the status
 //!   audit, the residual test, the glitch, convention and reversed-momentum checks), on concrete types with
 //!   no box. It can live in caller storage, and neither its construction nor a push
-//!   allocates (`tests/no_alloc.rs` counts). `tests/engines.rs` checks that it gives the
+//!   allocates (`tests/no_alloc.rs` counts). `tests/c_api/engines.rs` checks that it gives the
 //!   pipeline's estimates bit for bit.
 
 use inertia::attitude::Quaternion;

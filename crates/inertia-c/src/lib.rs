@@ -561,7 +561,7 @@ impl Plan {
             ));
         }
         // The row-model settings at `PipelineSettings::default()`'s values (not built here:
-        // it holds `String`s). `tests/engines.rs` checks the two agree.
+        // it holds `String`s). `tests/c_api/engines.rs` checks the two agree.
         for (setting, changed) in [
             ("rotation_source", self.rotation_source.is_some()),
             ("rho_model", self.rho_model != RhoModel::Auto),

@@ -8,6 +8,7 @@
 //!   first 100 samples of a slew no push allocates, for every estimator (required;
 //!   printed with `cargo test -p inertia-c --test no_alloc -- --nocapture`).
 
+#[path = "c_api/common/mod.rs"]
 mod common;
 use common::*;
 use inertia::sim::scenario::{Common, Scenario};

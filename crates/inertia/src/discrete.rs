@@ -14,7 +14,7 @@
 //!   of node samples keeps the residual `H_k j − y_k` of an exact trajectory `O(h⁴)`.
 //! * `τ_{k+1}` is the known external torque at the shared node `t_{k+1}`.
 //! * The printed eq. 54 has `− h²/2 τ_{k+1}`; that sign makes the residual `O(h²)`. The
-//!   tests in `tests/discrete_convergence.rs` measure both orders.
+//!   tests in `tests/integration/discrete_convergence.rs` measure both orders.
 //!
 //! # Unequal steps
 //!
@@ -29,7 +29,7 @@
 //! ```
 //!
 //! Its continuum limit is `((h₀ + h₁)/4)(L̇ + ω × L − τ) = 0`, i.e. eq. 26; the residual
-//! on a ±20 % jittered grid is measured in `tests/discrete_convergence.rs`.
+//! on a ±20 % jittered grid is measured in `tests/integration/discrete_convergence.rs`.
 //!
 //! Units: `h` in s, `ρ` in N m s, `τ` in N m, `j` in kg m²; `H_k` has units of rad
 //! (dimensionless) squared and `y_k` of N m s².

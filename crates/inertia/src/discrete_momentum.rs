@@ -1,6 +1,6 @@
 //! The discrete momentum form of the variational rows: paper eqs. 46–54 telescoped into a
 //! discrete conservation of inertial angular momentum (beyond the paper; the derivation is
-//! restated here and each step is tested in `tests/discrete_momentum.rs`).
+//! restated here and each step is tested in `tests/integration/discrete_momentum.rs`).
 //!
 //! # Derivation
 //!

@@ -64,7 +64,7 @@ pub const INCONSISTENT_RATIO: f64 = 300.0;
 /// span beyond [`INCONSISTENT_RATIO`] inconsistent. On a noise-free spin, whose spans
 /// reach ratios of 970 from the discretisation remainder alone, the answers moved by up
 /// to 10.1 of their early σ (which, without noise, is too small); in the broken runs of
-/// `tests/consistency.rs`, by at least 52.
+/// `tests/integration/consistency.rs`, by at least 52.
 pub const SHIFT_Z: f64 = 20.0;
 
 /// An answer and its stated σ per element.

@@ -32,7 +32,7 @@
 //! wheels do between samples ([`Stencil`]): its trapezoid for smooth `ρ`, the mean of the
 //! two steps' trapezoids for commands held over each step, and that mean corrected by an
 //! estimated `κ Δ²ρ` for either, or for commands that change between samples
-//! ([`Stencil::Adaptive`], the default; `tests/discrete_momentum.rs` measures each).
+//! ([`Stencil::Adaptive`], the default; `tests/integration/discrete_momentum.rs` measures each).
 //!
 //! # Rotation source
 //!

@@ -49,7 +49,7 @@ pub const SCALE_FLOOR: f64 = 1e-4;
 /// flags `χ² > RESIDUAL_VARIANCE_ALLOWANCE · χ²_{p, 0.999}`. The rows' errors are
 /// correlated (the reason the discrete momentum estimator states a jackknife σ), so the
 /// residuals understate the variance of `ĵ`: on the under-excited test data
-/// (`tests/prior.rs`) the median χ² of a right prior is 9.5 against χ²₃'s 2.4, a factor
+/// (`tests/integration/prior.rs`) the median χ² of a right prior is 9.5 against χ²₃'s 2.4, a factor
 /// of 4.
 pub const RESIDUAL_VARIANCE_ALLOWANCE: f64 = 4.0;
 

@@ -3,7 +3,7 @@
 //! The variable-step variational row is O(h³) on a jittered grid (see
 //! [`crate::discrete`]); rows built on a uniform grid are O(h⁴). Interpolating the
 //! telemetry with a cubic through the four nearest nodes is itself O(h⁴), so resampled
-//! rows keep the O(h⁴) residual (`tests/discrete_convergence.rs`). Attitude is
+//! rows keep the O(h⁴) residual (`tests/integration/discrete_convergence.rs`). Attitude is
 //! interpolated in the tangent space: rotation vectors `log(q_ref† q_i)` relative to the
 //! second of the four nodes, then `q = q_ref exp(r(t))`; rotor momentum, torque and gyro
 //! rate component by component. Output time `t` is produced once the input brackets it

@@ -13,7 +13,7 @@
 //! `σ = √(σ_LS² + b̂²)`. With errors-in-variables compensation
 //! ([`super::compensation`], the gyro noise given), a Monte Carlo of 200 seeds per case
 //! finds the error inside ±3σ for every element in 90–100 % of runs at the paper's noise
-//! and at 100× its gyro noise (`tests/uncertainty.rs`). Without compensation the
+//! and at 100× its gyro noise (`tests/integration/uncertainty.rs`). Without compensation the
 //! errors-in-variables bias (README noise sweep) is not covered at high gyro noise.
 //! Active constraints are not reflected: where a bound or the physical-consistency
 //! condition is active, the constrained estimate is at least as close to the truth in the

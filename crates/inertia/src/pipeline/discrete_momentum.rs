@@ -242,7 +242,7 @@ fn discretisation_bias(
 
 /// Without excitation (`y ≡ 0`) only a Gaussian prior could give this estimator's answer
 /// its scale, and it does not do so reliably: on a pure spin with a 5 % prior its answers
-/// were 24 % off with a stated σ of 3 % (`tests/prior.rs`; the variational estimator's
+/// were 24 % off with a stated σ of 3 % (`tests/integration/prior.rs`; the variational estimator's
 /// are right). Such an answer is withdrawn: known failure, README "Prior knowledge".
 fn scale_from_prior(e: &mut Estimate, data: &RecursiveQr, constraints: &Constraints) {
     if constraints.set().prior.is_some() && data.y_energy == 0.0 && e.j().is_some() {

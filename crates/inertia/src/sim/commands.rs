@@ -16,7 +16,7 @@
 //!
 //! The simulator splits every integration interval at the ticks inside it, so no RK4
 //! substep straddles a change of command: ρ is then exactly piecewise linear and the
-//! integration keeps its fourth order (`tests/sim_realism.rs`).
+//! integration keeps its fourth order (`tests/integration/sim_realism.rs`).
 
 use super::SimError;
 

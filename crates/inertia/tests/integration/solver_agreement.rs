@@ -14,7 +14,7 @@
 //! zero-residual problems whose optimum lies exactly on the boundary.)
 #![cfg(feature = "clarabel")]
 
-mod common;
+use crate::common;
 
 use inertia::solver::clarabel_backend::ClarabelSolver;
 use inertia::solver::native::NativeSolver;

@@ -1,7 +1,7 @@
 //! The native solver on seeded random problems, judged by its own optimality conditions
 //! (runs in the default build; `solver_agreement.rs` compares with Clarabel).
 
-mod common;
+use crate::common;
 
 use inertia::solver::native::NativeSolver;
 use inertia::solver::{solve, SolveStatus};

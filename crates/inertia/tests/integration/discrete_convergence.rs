@@ -16,7 +16,7 @@ use nalgebra::Vector3;
 const DURATION_S: f64 = 8.0;
 const STEPS: [f64; 5] = [0.2, 0.1, 0.05, 0.025, 0.0125];
 
-mod trajectory;
+use crate::trajectory;
 use trajectory::{config, rho_dot, torque};
 
 fn exact_samples(h: f64, rho: &dyn InputLaw, tau: &dyn InputLaw) -> Vec<Sample> {

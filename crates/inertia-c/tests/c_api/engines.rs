@@ -3,7 +3,7 @@
 //! estimators, with bounds, compensation, memory and `solve_every`; and each C setting
 //! reaches the pipeline (a changed setting changes the answer).
 
-mod common;
+use crate::common;
 use common::*;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia_c::*;

@@ -25,7 +25,7 @@ use nalgebra::{Matrix3x6, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-mod trajectory;
+use crate::trajectory;
 use trajectory::{exact_samples, rho_dot, torque};
 
 fn random_unit(rng: &mut ChaCha8Rng, scale: f64) -> Quaternion {

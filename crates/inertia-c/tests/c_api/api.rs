@@ -2,7 +2,7 @@
 //! samples that change nothing, a stop after a data error until reset, and the last
 //! error message copied out like `snprintf`.
 
-mod common;
+use crate::common;
 use common::*;
 use core::ptr::{null, null_mut};
 use inertia::sim::scenario::{Common, Scenario};

@@ -1,0 +1,24 @@
+//! The library's integration tests, one binary (one link, one set of monomorphised
+//! dependencies): each module is one subject. `no_alloc` stays a binary of its own, as it
+//! counts allocations process-wide.
+
+mod common;
+mod trajectory;
+
+mod attitude;
+mod attitude_drift;
+mod changing_inertia;
+mod consistency;
+mod constraints;
+mod csv_robustness;
+mod discrete_convergence;
+mod discrete_momentum;
+mod dynamics;
+mod estimators;
+mod numeric_range;
+mod pipeline;
+mod prior;
+mod sim_realism;
+mod solver_agreement;
+mod solver_random;
+mod uncertainty;
