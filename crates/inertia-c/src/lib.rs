@@ -41,7 +41,8 @@ use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::estimator::observability::{Observability, ObservabilitySettings, Unobservable};
 use inertia::estimator::recursive::RecursiveSettings;
 use inertia::estimator::{Estimate, EstimatorError};
-use inertia::pipeline::{Pipeline, PipelineError, PipelineSettings};
+use inertia::fix::{Fix, Fixes};
+use inertia::pipeline::{check_first_step, Pipeline, PipelineError, PipelineSettings};
 use inertia::sample::{check_range, Sample};
 use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::{matrix_from_j, Component};
@@ -310,6 +311,10 @@ pub struct InertiaEstimator {
     last_t_s: Option<f64>,
     samples: u64,
     last: Option<Estimate>,
+    /// The memory and resampling settings, for the library's check of the first step
+    /// (`inertia::pipeline::check_first_step`).
+    memory_s: Option<f64>,
+    resample_s: Option<f64>,
 }
 
 /// What the C settings ask for, without the heap (no estimator name string).
@@ -370,7 +375,35 @@ fn pipeline_fail(e: &PipelineError) -> InertiaStatus {
             sample: None,
             source,
         } => fail(status_of(e), format_args!("{source}")),
-        other => fail(status_of(e), format_args!("{other}")),
+        other => fail(
+            status_of(e),
+            format_args!("{other}{}", fixes(other.fixes())),
+        ),
+    }
+}
+
+/// How a C caller applies a fix ([`inertia::fix`]): what to change before pushing, or
+/// the `InertiaSettings` field.
+fn c_names(fix: Fix) -> Option<&'static str> {
+    Some(match fix {
+        Fix::Jpl => "conjugate q before pushing (JPL to Hamilton)",
+        Fix::ScalarFirst => "q is [w, x, y, z]: push [x, y, z, w]",
+        Fix::ScalarLast => "q is already [x, y, z, w]: push it unchanged",
+        Fix::NegateRho => "negate rho_nms (and tau_nm) before pushing",
+        Fix::KeepGlitches => "glitches = 1 (keep)",
+        Fix::Memory => "memory_s",
+        Fix::Resample => "resample_s",
+        Fix::GyroNoise => "gyro_noise_deg_s_rthz",
+        _ => return None,
+    })
+}
+
+/// The fixes after a message, as a C caller applies them.
+fn fixes(fixes: &'static [Fix]) -> Fixes<'static> {
+    Fixes {
+        fixes,
+        names: c_names,
+        label: "in C",
     }
 }
 
@@ -610,7 +643,7 @@ impl Plan {
 }
 
 impl InertiaEstimator {
-    fn new(engine: Engine, heap: bool) -> Self {
+    fn new(engine: Engine, heap: bool, plan: &Plan) -> Self {
         Self {
             engine,
             heap,
@@ -619,6 +652,8 @@ impl InertiaEstimator {
             last_t_s: None,
             samples: 0,
             last: None,
+            memory_s: plan.memory_s,
+            resample_s: plan.resample_s,
         }
     }
 
@@ -662,6 +697,14 @@ impl InertiaEstimator {
                 InertiaStatus::Data,
                 format_args!("this estimator needs gyro rates (has_w) in every sample"),
             );
+        }
+        if let (Some(t0), 1) = (self.last_t_s, self.samples) {
+            if let Err(e) = check_first_step(self.memory_s, self.resample_s, s.t_s - t0) {
+                return fail(
+                    InertiaStatus::InvalidSetting,
+                    format_args!("sample 1: {e}{}", fixes(&[Fix::Memory])),
+                );
+            }
         }
         if let Some(t0) = self.last_t_s {
             if !(s.t_s > t0) {
@@ -868,6 +911,7 @@ pub unsafe extern "C" fn inertia_estimator_new(
         let est = Box::new(InertiaEstimator::new(
             Engine::Pipeline { pipeline, settings },
             true,
+            &plan,
         ));
         // SAFETY: as above, `out` is valid for writes.
         unsafe { out.write(Box::into_raw(est)) };
@@ -927,15 +971,15 @@ pub unsafe extern "C" fn inertia_estimator_init(
         // SAFETY: non-null, points to an `InertiaSettings` (contract); all field types
         // accept any bit pattern.
         let s = unsafe { settings.read() };
-        let engine = match Plan::from_c(&s).and_then(|p| p.fixed_engine()) {
-            Ok(e) => e,
+        let (plan, engine) = match Plan::from_c(&s).and_then(|p| Ok((p.fixed_engine()?, p))) {
+            Ok((e, p)) => (p, e),
             Err(status) => return status,
         };
         let est = storage.cast::<InertiaEstimator>();
         // SAFETY: `storage` is non-null, aligned and at least `size_of::<InertiaEstimator>()`
         // bytes long (checked above) and valid for writes (contract); `write` does not
         // read or drop what was there.
-        unsafe { est.write(InertiaEstimator::new(engine, false)) };
+        unsafe { est.write(InertiaEstimator::new(engine, false, &plan)) };
         // SAFETY: `out` is valid for writes (contract).
         unsafe { out.write(est) };
         InertiaStatus::Ok

@@ -1,25 +1,18 @@
-//! `inertia estimate`: arguments → pipeline settings → the library's pipeline over the
-//! file → the library's report.
+//! `inertia estimate`: arguments → pipeline settings → the library's [`Run`] over the
+//! file's samples → the library's report. The run policy is the library's; here are only
+//! the file, its lines and the options' names.
 
 use crate::args::EstimateArgs;
 use crate::config::{self, settings_error, InertiaFile};
 use crate::error::{input, internal, read_failed, telemetry, CliError};
 use crate::history::HistoryFile;
 use crate::output::{is_stdio, to_stdout};
-use inertia::discrete::RowError;
-use inertia::estimator::EstimatorError;
-use inertia::pipeline::report::{InputSummary, Report};
-use inertia::pipeline::{self, Pipeline, PipelineConfig, PipelineError};
+use inertia::fix::{Fix, Fixes};
+use inertia::pipeline::{Run, RunError, RECENT};
 use inertia::telemetry::csv::TelemetryReader;
 use inertia::telemetry::read_ahead::ReadAhead;
-use inertia::text::Num;
 use std::collections::VecDeque;
 use std::io::{IsTerminal, Read};
-
-/// How many recent samples' lines are kept to name the line of an error.
-const RECENT: usize = 8;
-
-use inertia::pipeline::MAX_RESAMPLE_FACTOR;
 
 /// The telemetry: a file, or standard input for `-`.
 fn open(path: &std::path::Path) -> Result<(Box<dyn Read + Send>, String), CliError> {
@@ -30,42 +23,38 @@ fn open(path: &std::path::Path) -> Result<(Box<dyn Read + Send>, String), CliErr
     Ok((Box::new(f), path.display().to_string()))
 }
 
-/// Settings that the first step of the data shows to be meaningless: a memory shorter
-/// than the step, or resampling to more than [`MAX_RESAMPLE_FACTOR`] samples per step.
-fn check_against_step(config: &PipelineConfig, dt: f64, at: &str) -> Result<(), CliError> {
-    if let Some(m) = config.memory_s() {
-        let step = config.resample_s().unwrap_or(dt);
-        if m < step {
-            return Err(input(format!(
-                "--memory {}: shorter than the sample period {} s ({at}); the memory must span several samples",
-                Num(m),
-                Num(step)
-            )));
-        }
-    }
-    if let Some(r) = config.resample_s() {
-        if dt / r > MAX_RESAMPLE_FACTOR {
-            return Err(input(format!(
-                "--resample {}: {} resampled samples per input step of {} s ({at}); at most {}",
-                Num(r),
-                Num((dt / r).round()),
-                Num(dt),
-                Num(MAX_RESAMPLE_FACTOR)
-            )));
-        }
-    }
-    Ok(())
+/// How the command line names a fix ([`inertia::fix`]): as its options.
+pub fn option_names(fix: Fix) -> Option<&'static str> {
+    Some(match fix {
+        Fix::Jpl => "--jpl",
+        Fix::ScalarFirst => "--scalar-first",
+        Fix::ScalarLast => "drop --scalar-first",
+        Fix::NegateRho => "--negate-rho",
+        Fix::KeepGlitches => "--glitches keep",
+        Fix::Memory => "--memory",
+        Fix::Resample => "--resample",
+        Fix::GyroNoise => "--gyro-noise",
+        Fix::PriorSigma => "--prior-sigma",
+        Fix::Products => "--products",
+        _ => return None,
+    })
 }
 
-/// The line of the sample that ends a step too large for |φ| < 1, among the recent
-/// `(time, line)` pairs: the reader may be ahead of the estimator (resampling reads the
-/// next samples first, and the half-rate shadow's step ends at a later sample).
-fn step_end_line(e: &PipelineError, recent: &VecDeque<(f64, u64)>) -> Option<u64> {
-    let end = e.step_end_s()?;
-    recent
-        .iter()
-        .find(|(t, _)| PipelineError::ends_step(*t, end))
-        .map(|&(_, line)| line)
+/// A run's error as the command line prints it: `file:line:`, the message, the options
+/// that fix it.
+fn run_error(e: &RunError, file: &str, line: Option<u64>, q_columns: &str) -> CliError {
+    let at = line.map_or_else(|| format!("{file}:"), |l| format!("{file}:{l}:"));
+    let columns = if e.is_step_too_large() {
+        format!(" columns `{q_columns}`:")
+    } else {
+        String::new()
+    };
+    let fixes = Fixes {
+        fixes: e.fixes(),
+        names: option_names,
+        label: "option",
+    };
+    input(format!("{at}{columns} {e}{fixes}"))
 }
 
 /// Run the command.
@@ -83,40 +72,12 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let (source, name) = open(&a.file)?;
     let reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
     let file = reader.file().to_string();
-    let entry = config.estimator();
-    if entry.capabilities.needs_gyro && !reader.has_gyro() {
-        return Err(input(format!(
-            "{file}:1: the {} estimator needs gyro-rate columns w_x,w_y,w_z",
-            entry.name
-        )));
-    }
     let q_columns = reader.quaternion_columns();
+    let mut run = Run::new(config, a.batch).map_err(settings_error)?;
+    run.check_columns(reader.has_gyro())
+        .map_err(|e| run_error(&e, &file, Some(1), &q_columns))?;
     // Parsing overlaps the estimator.
     let mut reader = ReadAhead::new(reader);
-    // An error of the estimator, tied to the line of the sample that caused it.
-    let data_error = |e: PipelineError, line: Option<u64>| {
-        let at = line.map_or_else(|| format!("{file}:"), |l| format!("{file}:{l}:"));
-        match e {
-            PipelineError::Estimator {
-                source: EstimatorError::Solve(s),
-                ..
-            } => input(format!("{at} the solver failed on these data: {s}")),
-            PipelineError::Estimator {
-                source:
-                    EstimatorError::Row {
-                        source: r @ RowError::StepTooLarge { .. },
-                        ..
-                    },
-                ..
-            } => input(format!("{at} columns `{q_columns}`: {r}")),
-            PipelineError::Estimator {
-                source: EstimatorError::Row { source, .. },
-                ..
-            } => input(format!("{at} {source}")),
-            PipelineError::Estimator { source, .. } => input(format!("{at} {source}")),
-            other => input(format!("{at} {other}")),
-        }
-    };
     let size = if is_stdio(&a.file) {
         0
     } else {
@@ -130,70 +91,48 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         );
         p
     });
-    let mut first_times = [f64::NAN; 2];
-    let (report, samples) = if a.batch {
-        let mut all = Vec::new();
-        let mut lines = Vec::new();
-        while let Some(item) = reader.next() {
-            all.push(item.map_err(telemetry)?);
-            lines.push(reader.last_line());
-        }
-        for (t, s) in first_times.iter_mut().zip(&all) {
-            *t = s.t_s;
-        }
-        let out = pipeline::batch(&all, &config).map_err(|e| {
-            let line = match &e {
-                PipelineError::Estimator {
-                    source: EstimatorError::Row { sample, .. },
-                    ..
-                }
-                | PipelineError::AttitudeGlitch { sample, .. } => lines.get(*sample).copied(),
-                _ => None,
-            };
-            data_error(e, line)
-        })?;
-        if let Some(h) = history.as_mut() {
-            h.write(&out.estimate)?;
-        }
-        (Some(Report::of_batch(&out, &config, all.len())), all.len())
-    } else {
-        let mut p = Pipeline::from_config(config).map_err(settings_error)?;
-        let mut write_error = None;
-        let mut recent = VecDeque::with_capacity(RECENT);
-        while let Some(item) = reader.next() {
-            let s = item.map_err(telemetry)?;
-            if recent.len() == RECENT {
-                recent.pop_front();
-            }
-            recent.push_back((s.t_s, reader.last_line()));
-            let n = p.input_samples();
-            if n < 2 {
-                first_times[n] = s.t_s;
-            }
-            if n == 1 {
-                let at = format!("{file}:{}", reader.last_line());
-                check_against_step(&config, first_times[1] - first_times[0], &at)?;
-            }
-            p.push_each(&s, |e| {
-                if let (Some(h), None) = (history.as_mut(), &write_error) {
-                    write_error = h.write(e).err();
-                }
-            })
-            .map_err(|e| {
-                let line = step_end_line(&e, &recent).unwrap_or(reader.last_line());
-                data_error(e, Some(line))
-            })?;
-            if let Some(e) = write_error.take() {
-                return Err(e);
-            }
-            if let Some(pb) = &progress {
-                if n.is_multiple_of(4096) {
-                    pb.set_position(reader.byte_position());
-                }
-            }
-        }
-        (Report::of_pipeline(&p), p.estimator_samples())
+    // The lines of the samples a run's error may name: every one in batch mode (the
+    // batch names any sample), the last `RECENT` streaming.
+    let mut lines = VecDeque::new();
+    let keep = if a.batch { usize::MAX } else { RECENT };
+    let line_of = |lines: &VecDeque<u64>, n: usize, e: &RunError| -> Option<u64> {
+        let first = n - lines.len();
+        e.sample
+            .and_then(|i| lines.get(i.checked_sub(first)?).copied())
     };
+    let mut write_error = None;
+    while let Some(item) = reader.next() {
+        let s = item.map_err(telemetry)?;
+        if lines.len() == keep {
+            lines.pop_front();
+        }
+        lines.push_back(reader.last_line());
+        let n = run.input_samples();
+        run.push(&s, |e| {
+            if let (Some(h), None) = (history.as_mut(), &write_error) {
+                write_error = h.write(e).err();
+            }
+        })
+        .map_err(|e| run_error(&e, &file, line_of(&lines, n + 1, &e), &q_columns))?;
+        if let Some(e) = write_error.take() {
+            return Err(e);
+        }
+        if let Some(pb) = &progress {
+            if n.is_multiple_of(4096) {
+                pb.set_position(reader.byte_position());
+            }
+        }
+    }
+    let n = run.input_samples();
+    run.finish(|e| {
+        if let (Some(h), None) = (history.as_mut(), &write_error) {
+            write_error = h.write(e).err();
+        }
+    })
+    .map_err(|e| run_error(&e, &file, line_of(&lines, n, &e), &q_columns))?;
+    if let Some(e) = write_error.take() {
+        return Err(e);
+    }
     if let Some(p) = progress {
         p.finish_and_clear();
     }
@@ -203,38 +142,14 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let stats = reader
         .finish()
         .ok_or_else(|| internal("the telemetry reader thread failed"))?;
-    let Some(report) = report else {
-        let need = if entry.capabilities.needs_gyro && !entry.capabilities.constraints {
-            2
-        } else {
-            inertia::estimator::MIN_SAMPLES
-        };
-        let resampled = if samples == stats.rows {
-            String::new()
-        } else {
-            format!(" ({} read, {samples} on the --resample grid)", stats.rows)
-        };
-        return Err(input(format!(
-            "{file}: too few samples for an estimate: the {} estimator needs at least {need}, got {samples}{resampled}",
-            entry.name,
-        )));
-    };
-    let report = report
-        .with_input(InputSummary {
-            file: file.clone(),
-            sample_period_s: config
-                .resample_s()
-                .unwrap_or(first_times[1] - first_times[0]),
-            renormalised: stats.renormalised,
-            sign_flips: stats.sign_flips,
-            min_step_s: stats.min_step_s,
-            max_step_s: stats.max_step_s,
-        })
+    let report = run
+        .report(&file, &stats)
+        .ok_or_else(|| internal("a finished run without an estimate"))?
         .with_truth(truth.as_ref());
     if a.json {
         let json = serde_json::to_string(&report).map_err(|e| internal(format!("JSON: {e}")))?;
         to_stdout(|w| writeln!(w, "{json}"))
     } else {
-        to_stdout(|w| write!(w, "{report}"))
+        to_stdout(|w| write!(w, "{}", report.text(option_names, "option")))
     }
 }

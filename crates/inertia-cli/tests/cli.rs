@@ -585,9 +585,10 @@ fn memory_tracks_a_changed_inertia() {
     assert!(without["inertia"].is_null());
     let reason = without["reason"].as_str().unwrap();
     assert!(
-        reason.contains("--memory") && reason.contains("times the rest"),
+        reason.contains("forget old data with a memory") && reason.contains("times the rest"),
         "{reason}"
     );
+    assert_eq!(without["fixes"], serde_json::json!(["memory"]), "{without}");
     assert!(without["residual_consistency"]["ratio"].as_f64().unwrap() > 300.0);
     let o = inertia(&["estimate", csv.to_str().unwrap(), "--memory", "-1"]);
     assert_eq!(o.status.code(), Some(2));
@@ -991,7 +992,8 @@ fn resources_are_bounded() {
     let o = inertia(&["estimate", ok, "--resample", "0.0001"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("--resample 0.0001: 1000 resampled samples per input step of 0.1 s"),
+        stderr(&o).contains("resampling to 0.0001 s would make 1000 samples of the step of 0.1 s")
+            && stderr(&o).contains("(option: --resample)"),
         "{}",
         stderr(&o)
     );
@@ -1005,7 +1007,8 @@ fn resources_are_bounded() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("--memory 0.01: shorter than the sample period 0.1 s"),
+        stderr(&o).contains("the memory 0.01 s is shorter than the sample period 0.1 s")
+            && stderr(&o).contains("(option: --memory)"),
         "{}",
         stderr(&o)
     );
@@ -1172,7 +1175,7 @@ fn messages_are_compact_and_true() {
     let o = inertia(&["estimate", csv.to_str().unwrap(), "--resample", "0.1"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("needs at least 4, got 2 (4 read, 2 on the --resample grid)"),
+        stderr(&o).contains("needs at least 4, got 2 (4 read, 2 on the resampling grid)"),
         "{}",
         stderr(&o)
     );
@@ -1815,4 +1818,40 @@ fn simulate_options_with_units_in_their_names_are_the_same_options() {
     assert_eq!(short.lines().count(), 62);
     let help = stdout(&inertia(&["simulate", "--help"]));
     assert!(help.contains("duration-s") && help.contains("disturbance-nm-rthz"));
+}
+
+/// Control characters in what a file holds (a terminal escape sequence in its header or
+/// a field) are printed escaped: the message is one line of text, never a command to the
+/// terminal.
+#[test]
+fn control_characters_in_a_file_are_printed_escaped() {
+    let d = tempfile::tempdir().unwrap();
+    let esc = "\u{1b}]0;retitled\u{7}";
+    for (name, f) in [
+        (
+            "header",
+            Box::new(move |l: &str| l.replace("rho_z", &format!("rho_z{esc}")))
+                as Box<dyn Fn(&str) -> String>,
+        ),
+        (
+            "duplicate",
+            Box::new(move |l: &str| format!("{l},{esc},{esc}")),
+        ),
+    ] {
+        let p = bad_file(d.path(), name, 1, &*f);
+        let o = inertia(&["estimate", p.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(
+            !e.trim_end_matches('\n').chars().any(char::is_control),
+            "{name}: {e:?}"
+        );
+        assert!(e.contains("\\u{1b}"), "{name}: the escape is shown: {e:?}");
+    }
+    let p = bad_file(d.path(), "field", 5, &|l| field(l, 1, &format!("0.1{esc}")));
+    let e = stderr(&inertia(&["estimate", p.to_str().unwrap()]));
+    assert!(
+        !e.trim_end_matches('\n').chars().any(char::is_control),
+        "{e:?}"
+    );
 }

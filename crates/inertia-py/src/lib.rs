@@ -190,7 +190,7 @@ fn result<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let json = serde_json::to_string(report)
         .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
-    let text = report.to_string();
+    let text = report.text(run::keyword_names, "keyword").to_string();
     let h = history.map(|h| history_columns(py, h)).transpose()?;
     Ok((json, text, h).into_pyobject(py)?.into_any())
 }

@@ -2,11 +2,11 @@
 //! `inertia::pipeline::Pipeline`, checked as the CSV reader checks rows.
 
 use crate::errors::Failure;
-use crate::run::check_against_step;
+use crate::run::Origin;
 use crate::samples::{Checker, Naming, Row};
 use crate::settings::{self, Convention, Kwargs};
-use inertia::pipeline::report::{InputSummary, Report};
-use inertia::pipeline::{Pipeline, PipelineConfig, PipelineError};
+use inertia::pipeline::report::Report;
+use inertia::pipeline::Run;
 use numpy::PyReadonlyArrayDyn;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -14,15 +14,8 @@ use pyo3::types::PyDict;
 use std::sync::Mutex;
 
 struct State {
-    pipeline: Pipeline,
-    config: PipelineConfig,
+    run: Run,
     checker: Checker,
-    /// Input samples accepted.
-    index: usize,
-    first_t: [f64; 2],
-    gyro: Option<bool>,
-    /// The error that stopped the estimator.
-    stopped: Option<String>,
 }
 
 /// A streaming estimator (the Python `inertia.Estimator` wraps it).
@@ -34,80 +27,21 @@ pub struct Stream {
 
 impl State {
     fn push(&mut self, row: &Row, conv: &Convention) -> Result<bool, Failure> {
-        if let Some(m) = &self.stopped {
-            return Err(Failure::Argument(format!(
-                "the estimator stopped on an earlier error ({m}); create a new Estimator"
-            )));
-        }
-        let i = self.index;
-        let has_w = row.w.is_some();
-        match self.gyro {
-            None => {
-                let entry = self.config.estimator();
-                if entry.capabilities.needs_gyro && !has_w {
-                    return Err(Failure::Argument(format!(
-                        "w: the {} estimator needs gyro rates (w_x,w_y,w_z)",
-                        entry.name
-                    )));
-                }
-            }
-            Some(g) if g != has_w => {
-                return Err(Failure::Argument(format!(
-                    "w: sample {i}: gyro rates {} here but {} for the earlier samples",
-                    if has_w { "given" } else { "missing" },
-                    if g { "given" } else { "missing" },
-                )))
-            }
-            Some(_) => {}
-        }
+        let i = self.run.input_samples();
         let s = self
             .checker
             .sample(row, i, conv, &Naming::Arrays)
             .map_err(|m| Failure::Data(m, None))?;
-        if i < 2 {
-            self.first_t[i] = s.t_s;
-        }
-        if i == 1 {
-            check_against_step(&self.config, s.t_s - self.first_t[0], "sample 1")?;
-        }
         let mut produced = false;
-        let r = self.pipeline.push_each(&s, |_| produced = true);
-        self.gyro = Some(has_w);
-        self.index += 1;
-        if let Err(e) = r {
-            let m = data_message(e, i);
-            self.stopped = Some(m.clone());
-            return Err(Failure::Data(m, None));
-        }
+        self.run
+            .push(&s, |_| produced = true)
+            .map_err(|e| Origin::arrays().run_error(&e))?;
         Ok(produced)
     }
 
     fn report(&self) -> Option<Report> {
-        let st = self.checker.stats;
-        Report::of_pipeline(&self.pipeline).map(|r| {
-            r.with_input(InputSummary {
-                file: "<stream>".into(),
-                sample_period_s: self
-                    .config
-                    .resample_s()
-                    .unwrap_or(self.first_t[1] - self.first_t[0]),
-                renormalised: st.renormalised,
-                sign_flips: st.sign_flips,
-                min_step_s: st.min_step_s,
-                max_step_s: st.max_step_s,
-            })
-        })
+        self.run.report("<stream>", &self.checker.stats)
     }
-}
-
-fn data_message(e: PipelineError, i: usize) -> String {
-    crate::run::python_options(match e {
-        PipelineError::Estimator {
-            source: inertia::estimator::EstimatorError::Solve(s),
-            ..
-        } => format!("sample {i}: the solver failed on these data: {s}"),
-        other => format!("sample {i}: {other}"),
-    })
 }
 
 impl Stream {
@@ -130,16 +64,11 @@ impl Stream {
         let config = pipeline_settings
             .validate()
             .map_err(settings::settings_error)?;
-        let pipeline = Pipeline::from_config(config).map_err(settings::settings_error)?;
+        let run = Run::new(config, false).map_err(settings::settings_error)?;
         Ok(Self {
             state: Mutex::new(State {
-                pipeline,
-                config,
+                run,
                 checker: Checker::default(),
-                index: 0,
-                first_t: [f64::NAN; 2],
-                gyro: None,
-                stopped: None,
             }),
             conv,
         })
@@ -195,7 +124,7 @@ impl Stream {
         st.report()
             .map(|r| {
                 serde_json::to_string(&r)
-                    .map(|j| (j, r.to_string()))
+                    .map(|j| (j, r.text(crate::run::keyword_names, "keyword").to_string()))
                     .map_err(|e| PyRuntimeError::new_err(e.to_string()))
             })
             .transpose()
@@ -204,12 +133,12 @@ impl Stream {
     /// Input samples accepted so far.
     #[getter]
     fn samples(&self) -> PyResult<usize> {
-        Ok(self.lock()?.index)
+        Ok(self.lock()?.run.input_samples())
     }
 
     /// The estimator's name.
     #[getter]
     fn estimator(&self) -> PyResult<&'static str> {
-        Ok(self.lock()?.config.estimator().name)
+        Ok(self.lock()?.run.config().estimator().name)
     }
 }

@@ -91,6 +91,7 @@ pub mod discrete_momentum;
 pub mod dynamics;
 mod eigen3;
 pub mod estimator;
+pub mod fix;
 mod givens;
 mod householder;
 mod math;

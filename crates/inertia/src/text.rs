@@ -139,7 +139,12 @@ impl fmt::Display for Clipped<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (head, whole) = prefix(self.text, self.max_chars);
         for c in head.chars() {
-            f.write_char(if c == '\n' || c == '\r' { ' ' } else { c })?;
+            match c {
+                '\n' | '\r' => f.write_char(' ')?,
+                // A terminal escape sequence in a file's text is shown, not obeyed.
+                c if c.is_control() => write!(f, "{}", c.escape_default())?,
+                c => f.write_char(c)?,
+            }
         }
         if !whole {
             write!(f, "… ({} bytes)", self.text.len())?;

@@ -158,7 +158,7 @@ fn settings_reach_the_estimator() {
 }
 
 /// A wheel momentum of the opposite sign stops both engines at the same sample, with the
-/// same status and message (naming `--negate-rho`).
+/// same status and message (naming the fix in C's terms: negate `rho_nms`).
 #[test]
 fn a_reversed_wheel_momentum_stops_both_engines_alike() {
     let run = Scenario::slew().simulate(&Common::paper()).unwrap();
@@ -186,6 +186,36 @@ fn a_reversed_wheel_momentum_stops_both_engines_alike() {
         }
         assert_eq!(stops[0], stops[1]);
         assert_eq!(stops[0].1, InertiaStatus::Data);
-        assert!(stops[0].2.contains("--negate-rho"), "{}", stops[0].2);
+        assert!(
+            stops[0].2.contains("(in C: negate rho_nms") && !stops[0].2.contains("--"),
+            "{}",
+            stops[0].2
+        );
+    }
+}
+
+/// A memory shorter than the sample period is refused at the second sample by both engines,
+/// as the command line and Python refuse it (`inertia::pipeline::check_first_step`).
+#[test]
+fn a_memory_shorter_than_the_step_is_refused_by_both_engines() {
+    let run = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let settings = InertiaSettings {
+        memory_s: 0.01,
+        ..variational()
+    };
+    let mut storage = Box::new(Storage([0; 1 << 16]));
+    for est in [new(&settings), init(&mut storage, &settings)] {
+        assert_eq!(push(est, &c_sample(&run.samples[0])), InertiaStatus::Ok);
+        assert_eq!(
+            push(est, &c_sample(&run.samples[1])),
+            InertiaStatus::InvalidSetting
+        );
+        let m = last_error();
+        assert!(
+            m.contains("the memory 0.01 s is shorter than the sample period")
+                && m.contains("memory_s"),
+            "{m}"
+        );
+        free(est);
     }
 }

@@ -22,6 +22,7 @@
 //! is [`Observability::NotObservable`] and no answer is given.
 
 use super::qr::RecursiveQr;
+use crate::fix::Fix;
 
 /// Default largest acceptable condition number `σ_1/σ_6` of `R`. Past it, noise in the
 /// weakest direction is amplified a million-fold relative to the strongest.
@@ -149,6 +150,23 @@ pub enum Unobservable {
     },
 }
 
+impl Unobservable {
+    /// The settings its message recommends changing ([`crate::fix`]), in its order.
+    #[must_use]
+    pub fn fixes(&self) -> &'static [Fix] {
+        match self {
+            Unobservable::AtFloor {
+                mirror_determined: true,
+                ..
+            } => &[Fix::NegateRho],
+            Unobservable::Inconsistent { .. } => &[Fix::Memory],
+            Unobservable::DensityOverstated { .. } => &[Fix::GyroNoise],
+            Unobservable::PriorConflict { .. } => &[Fix::PriorSigma, Fix::Products],
+            _ => &[],
+        }
+    }
+}
+
 impl core::fmt::Display for Unobservable {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
@@ -194,7 +212,7 @@ impl core::fmt::Display for Unobservable {
                     "the answer rests on the J ⪰ εI floor (smallest principal moment {min_moment_kg_m2:.2e} kg m²): the data do not support a positive-definite J"
                 )?;
                 if *mirror_determined {
-                    f.write_str("; its negation would be determined: rho (or tau) has the opposite sign of this library's convention (negate it: --negate-rho), or the quaternions are conjugated (docs/conventions.md §1, §3)")?;
+                    f.write_str("; its negation would be determined: rho (or tau) has the opposite sign of this library's convention (negate it), or the quaternions are conjugated (docs/conventions.md §1, §3)")?;
                 } else if *unconstrained_negative {
                     f.write_str("; the unconstrained J is negative definite, the signature of a reversed sign of rho or tau or of a wrong quaternion convention (docs/conventions.md §1, §3)")?;
                 }
@@ -214,17 +232,17 @@ impl core::fmt::Display for Unobservable {
                 t_end_s,
             } => write!(
                 f,
-                "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {} the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or use --memory for a J that changes",
+                "the residuals between t = {t_start_s:.1} s and {t_end_s:.1} s are {} the rest's variance: the model did not hold there (a glitch in the attitude or the wheel telemetry, a change of J, an unmodelled torque); remove that span, or forget old data with a memory for a J that changes",
                 crate::text::Times(*ratio)
             ),
             Unobservable::DensityOverstated { ratio } => write!(
                 f,
-                "the residuals are {} the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (--gyro-noise is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)",
+                "the residuals are {} the variance the stated gyro noise density alone implies: the density is overstated and the compensation built on it over-corrects (the gyro noise density is the rate-noise density in deg/s/√Hz, the angle random walk in deg/√h divided by 60)",
                 crate::text::Times(*ratio)
             ),
             Unobservable::PriorConflict { chi2, rows } => write!(
                 f,
-                "the data contradict the prior: disagreement χ² = {} on {rows} prior elements (threshold {}); the prior is wrong by more than its σ (check --prior-sigma and the products-of-inertia convention, --products)",
+                "the data contradict the prior: disagreement χ² = {} on {rows} prior elements (threshold {}); the prior is wrong by more than its σ (check the prior's σ and its products-of-inertia convention)",
                 crate::text::Num(*chi2),
                 super::prior::RESIDUAL_VARIANCE_ALLOWANCE
                     * super::prior::CHI2_999[(*rows).clamp(1, 6) - 1]

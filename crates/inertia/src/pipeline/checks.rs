@@ -75,6 +75,7 @@ pub(crate) fn convention_error(check: &ConventionCheck) -> Result<(), PipelineEr
             fixed,
         } => Err(PipelineError::AttitudeConvention {
             fix: reading.fix(),
+            fixes: reading.fixes(),
             as_read,
             fixed,
             steps: check.steps(),
@@ -119,14 +120,14 @@ impl core::fmt::Display for ReversedMessage<'_> {
         if let Some(s) = self.sample {
             write!(f, "input sample {s}: ")?;
         }
-        f.write_str("the data fit a negative-definite J whose negation would be determined: the wheel momentum rho has the opposite sign of this library's convention (the rotors' own momentum in body axes, docs/conventions.md §1; negate it: --negate-rho)")?;
+        f.write_str("the data fit a negative-definite J whose negation would be determined: the wheel momentum rho has the opposite sign of this library's convention (the rotors' own momentum in body axes, docs/conventions.md §1; negate it)")?;
         if *self.tau_given {
             f.write_str(", or the known torque tau has")?;
         }
         match self.quaternions {
             Verdict::Consistent(_) => Ok(()),
-            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (--jpl): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
-            _ => f.write_str(", or the quaternions are conjugated (--jpl): the attitude disagrees with the gyro rates too"),
+            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (read them as JPL): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
+            _ => f.write_str(", or the quaternions are conjugated (read them as JPL): the attitude disagrees with the gyro rates too"),
         }
     }
 }

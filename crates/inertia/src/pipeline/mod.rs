@@ -48,6 +48,7 @@ mod checks;
 mod discrete_momentum;
 mod momentum;
 pub mod registry;
+mod run;
 mod sdp;
 mod settings;
 mod standing;
@@ -60,6 +61,7 @@ pub mod report;
 
 pub use checks::AttitudeChecks;
 pub use registry::{BatchOutput, Capabilities, Estimator};
+pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
 pub use sdp::Constrained;
 pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
@@ -67,6 +69,7 @@ use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
+use crate::fix::Fix;
 use crate::sample::{check_range, OutOfRange, Sample};
 use crate::telemetry::convention::{ConventionCheck, Verdict};
 use crate::telemetry::glitch::{Glitch, GlitchCheck, GlitchPolicy};
@@ -137,8 +140,10 @@ pub enum PipelineError {
     /// columns agrees ([`crate::telemetry::convention`]).
     #[error("the attitude quaternions disagree with the gyro rates (median relative mismatch {as_read:.2} over {steps} steps; {fixed:.2e} when read differently): {fix}")]
     AttitudeConvention {
-        /// The fix, naming the option.
+        /// The fix, in words.
         fix: &'static str,
+        /// The fix, typed ([`Self::fixes`]).
+        fixes: &'static [Fix],
         /// Median relative mismatch as read.
         as_read: f64,
         /// Median relative mismatch with the fix.
@@ -166,7 +171,7 @@ pub enum PipelineError {
     },
     /// One step of the attitude jumps against the gyro ([`crate::telemetry::glitch`]),
     /// and the policy is [`GlitchPolicy::Stop`].
-    #[error("{glitch} (the step ends at this line; --glitches keep estimates anyway)")]
+    #[error("{glitch} (the step ends at this line; keep glitches to estimate anyway)")]
     AttitudeGlitch {
         /// 0-based index of the input sample that ends the step.
         sample: usize,
@@ -205,6 +210,21 @@ pub enum PipelineError {
 }
 
 impl PipelineError {
+    /// The settings its message recommends changing ([`crate::fix`]), in its order.
+    #[must_use]
+    pub fn fixes(&self) -> &'static [Fix] {
+        match self {
+            PipelineError::AttitudeConvention { fixes, .. } => fixes,
+            PipelineError::ReversedMomentum { quaternions, .. } => match quaternions {
+                Verdict::Consistent(_) => &[Fix::NegateRho],
+                _ => &[Fix::NegateRho, Fix::Jpl],
+            },
+            PipelineError::AttitudeGlitch { .. } => &[Fix::KeepGlitches],
+            PipelineError::ResampleTooFine { .. } => &[Fix::Resample],
+            _ => &[],
+        }
+    }
+
     pub(crate) fn from_argument(a: InvalidArgument) -> Self {
         PipelineError::InvalidSetting {
             field: a.name,
@@ -480,21 +500,7 @@ impl Pipeline {
 /// Estimate from all samples at once (eq. 57) with the configured estimator, which must
 /// have a batch form. Memory and resampling do not apply.
 pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
-    let entry = config.estimator;
-    for (setting, set) in [
-        ("memory_s", config.memory_s.is_some()),
-        ("resample_s", config.resample_s.is_some()),
-    ] {
-        if set {
-            return Err(PipelineError::NotApplicable {
-                setting,
-                estimator: "batch",
-            });
-        }
-    }
-    let run = entry.batch.ok_or(PipelineError::NoBatch {
-        estimator: entry.name,
-    })?;
+    let run = batch_applies(config)?;
     let mut check = ConventionCheck::default();
     let mut glitches = GlitchCheck::default();
     let mut tau_given = false;
@@ -512,4 +518,24 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     let out = run(samples, config)?;
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
+}
+
+/// The configured estimator's batch form, where the settings allow one: it must have one,
+/// and memory and resampling do not apply.
+pub(crate) fn batch_applies(config: &PipelineConfig) -> Result<registry::BatchFn, PipelineError> {
+    let entry = config.estimator;
+    for (setting, set) in [
+        ("memory_s", config.memory_s.is_some()),
+        ("resample_s", config.resample_s.is_some()),
+    ] {
+        if set {
+            return Err(PipelineError::NotApplicable {
+                setting,
+                estimator: "batch",
+            });
+        }
+    }
+    entry.batch.ok_or(PipelineError::NoBatch {
+        estimator: entry.name,
+    })
 }

@@ -102,6 +102,20 @@ pub struct Capabilities {
     pub row_model: bool,
 }
 
+impl Capabilities {
+    /// The fewest input samples for one estimate: two for an estimator of gyro rates alone
+    /// (one momentum difference), else [`crate::estimator::MIN_SAMPLES`] (two 3-row blocks
+    /// over three nodes).
+    #[must_use]
+    pub const fn min_samples(&self) -> usize {
+        if self.needs_gyro && !self.constraints {
+            2
+        } else {
+            crate::estimator::MIN_SAMPLES
+        }
+    }
+}
+
 /// Build a streaming estimator from a validated configuration.
 pub type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
 /// Estimate from all samples at once.

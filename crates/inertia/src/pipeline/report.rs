@@ -24,6 +24,7 @@ use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;
 use crate::estimator::Estimate;
+use crate::fix::{Fix, FixNames, Fixes};
 use crate::solver::SolveStatus;
 use crate::telemetry::glitch::{Glitch, GlitchCheck};
 use crate::tensor::{principal, relative_frobenius_error, COMPONENT_NAMES};
@@ -87,6 +88,8 @@ pub struct Report {
     pub status: &'static str,
     /// Why the data fall short, when they do.
     pub reason: Option<String>,
+    /// The settings the reason recommends changing ([`crate::fix`]).
+    pub fixes: std::vec::Vec<Fix>,
     /// `σ_1/σ_6` of `R` when determined.
     pub condition: Option<f64>,
     /// J, kg m², rows.
@@ -177,6 +180,11 @@ impl Report {
             t: estimate.t_s,
             status: estimate.observability.code(),
             reason: estimate.observability.reason().map(|r| r.to_string()),
+            fixes: estimate
+                .observability
+                .reason()
+                .map(|r| r.fixes().to_vec())
+                .unwrap_or_default(),
             condition: estimate.observability.condition(),
             inertia: m.as_ref().map(rows),
             j: estimate.j().map(|j| core::array::from_fn(|k| j[k])),
@@ -318,9 +326,41 @@ impl Report {
     }
 }
 
+/// A report as text, with its fixes in one front end's names ([`Report::text`]).
+pub struct ReportText<'a> {
+    report: &'a Report,
+    names: FixNames,
+    label: &'static str,
+}
+
+impl Report {
+    /// The text, naming the fixes of its status with `names` as `label`s (`option`,
+    /// `keyword`); `Display` names them with the library's settings.
+    #[must_use]
+    pub fn text(&self, names: FixNames, label: &'static str) -> ReportText<'_> {
+        ReportText {
+            report: self,
+            names,
+            label,
+        }
+    }
+}
+
 impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.text(crate::fix::library_names, "setting").fmt(f)
+    }
+}
+
+impl fmt::Display for ReportText<'_> {
     fn fmt(&self, s: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if let Some(i) = &self.input {
+        let fixes = Fixes {
+            fixes: &self.report.fixes,
+            names: self.names,
+            label: self.label,
+        };
+        let r = self.report;
+        if let Some(i) = &r.input {
             let steps = if (i.max_step_s - i.min_step_s) <= 1e-9 * i.max_step_s {
                 std::format!("h = {} s", Num(i.sample_period_s))
             } else {
@@ -330,40 +370,40 @@ impl fmt::Display for Report {
                 s,
                 "{}: {}, {steps} ({} renormalised, {}, {})",
                 i.file,
-                Counted(self.samples, "sample"),
+                Counted(r.samples, "sample"),
                 i.renormalised,
                 Counted(i.sign_flips, "sign flip"),
-                Counted(self.gaps, "gap")
+                Counted(r.gaps, "gap")
             )?;
         }
         writeln!(
             s,
             "estimator: {} ({}), solver: {}, constraints: {}, t = {} s",
-            self.estimator,
-            if self.batch { "batch" } else { "recursive" },
-            self.solver,
-            self.constraints,
-            Num(self.t)
+            r.estimator,
+            if r.batch { "batch" } else { "recursive" },
+            r.solver,
+            r.constraints,
+            Num(r.t)
         )?;
-        if let Some(m) = &self.row_model {
+        if let Some(m) = &r.row_model {
             writeln!(s, "rows: {m}")?;
         }
-        if self.attitude_is_gyro_integral == Some(true) {
+        if r.attitude_is_gyro_integral == Some(true) {
             writeln!(
                 s,
                 "rotation: the attitude is the gyro's own integral (their answers agree within {} σ), so its rows are the gyro's and are folded once",
                 super::twins::TWIN_Z
             )?;
         }
-        writeln!(s, "status: {}", self.observability)?;
-        let (Some(m), Some(j)) = (self.inertia, self.j) else {
+        writeln!(s, "status: {}{fixes}", r.observability)?;
+        let (Some(m), Some(j)) = (r.inertia, r.j) else {
             return writeln!(s, "no estimate: the data cannot determine J");
         };
         writeln!(s, "J [kg m²] =")?;
         for r in m {
             writeln!(s, "  [ {:>12.6} {:>12.6} {:>12.6} ]", r[0], r[1], r[2])?;
         }
-        if let Some(sig) = self.sigma {
+        if let Some(sig) = r.sigma {
             writeln!(
                 s,
                 "elements, ± one standard deviation (noise and discretisation bias) [kg m²]:"
@@ -372,8 +412,8 @@ impl fmt::Display for Report {
                 writeln!(s, "  {name} = {:>12.6} ± {:.2e}", j[k], sig[k])?;
             }
         }
-        if let Some(pm) = self.principal_moments {
-            match self.principal_moments_sigma {
+        if let Some(pm) = r.principal_moments {
+            match r.principal_moments_sigma {
                 Some(ps) => writeln!(
                     s,
                     "principal moments [kg m²]: {:.6} ± {:.1e}  {:.6} ± {:.1e}  {:.6} ± {:.1e}",
@@ -393,13 +433,13 @@ impl fmt::Display for Report {
                 )?;
             }
         }
-        if let Some(ax) = self.principal_axes {
+        if let Some(ax) = r.principal_axes {
             writeln!(s, "principal axes (columns, body axes):")?;
             for r in ax {
                 writeln!(s, "  [ {:>9.5} {:>9.5} {:>9.5} ]", r[0], r[1], r[2])?;
             }
         }
-        if let Some(g) = &self.glitches {
+        if let Some(g) = &r.glitches {
             writeln!(
                 s,
                 "attitude glitches kept: {} step{} where the attitude jumped against the gyro",
@@ -410,16 +450,16 @@ impl fmt::Display for Report {
                 writeln!(s, "  {x}")?;
             }
         }
-        if !self.active_bounds.is_empty() {
+        if !r.active_bounds.is_empty() {
             let list: std::vec::Vec<String> =
-                self.active_bounds.iter().map(ToString::to_string).collect();
+                r.active_bounds.iter().map(ToString::to_string).collect();
             writeln!(
                 s,
                 "active bounds (they, not the data, hold the answer there): {}",
                 list.join(", ")
             )?;
         }
-        if let Some(p) = &self.prior {
+        if let Some(p) = &r.prior {
             let shares: std::vec::Vec<String> = COMPONENT_NAMES
                 .iter()
                 .zip(&p.data_share)
@@ -441,8 +481,8 @@ impl fmt::Display for Report {
                 p.threshold()
             )?;
         }
-        if let Some(t) = self.torque_bias_nm {
-            let test = self
+        if let Some(t) = r.torque_bias_nm {
+            let test = r
                 .torque_test
                 .map(|t| format!(" (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2})", t.chi2))
                 .unwrap_or_default();
@@ -451,7 +491,7 @@ impl fmt::Display for Report {
                 "unknown constant torque (body) [N m]: [{:.3e}, {:.3e}, {:.3e}]{test}",
                 t[0], t[1], t[2]
             )?;
-        } else if let Some(t) = self.torque_test.filter(|t| t.held_at_zero) {
+        } else if let Some(t) = r.torque_test.filter(|t| t.held_at_zero) {
             writeln!(
                 s,
                 "unknown constant torque: held at zero, the data give no evidence of one \
@@ -459,7 +499,7 @@ impl fmt::Display for Report {
                 t.chi2
             )?;
         }
-        match self.drift_weighted {
+        match r.drift_weighted {
             Some(true) => writeln!(
                 s,
                 "attitude drift: the rows are weighted for it (generalised least squares)"
@@ -470,23 +510,23 @@ impl fmt::Display for Report {
             )?,
             None => {}
         }
-        if let Some(e) = self.relative_error {
+        if let Some(e) = r.relative_error {
             writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;
         }
-        if let Some(w) = self.residual_consistency {
+        if let Some(w) = r.residual_consistency {
             writeln!(
                 s,
                 "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
                 w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
             )?;
         }
-        if let Some(r) = self.gyro_density_ratio {
+        if let Some(r) = r.gyro_density_ratio {
             writeln!(
                 s,
                 "residuals: {r:.2} times the variance the stated gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
             )?;
         }
-        if let Some(x) = &self.excitation {
+        if let Some(x) = &r.excitation {
             let mut line = String::from("excitation: singular values of R");
             for v in x.singular_values {
                 let _ = write!(line, " {v:.2e}");

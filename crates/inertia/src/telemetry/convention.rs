@@ -11,6 +11,7 @@
 //! option that fixes the file. Fixed size, no allocation.
 
 use crate::attitude::Quaternion;
+use crate::fix::Fix;
 use crate::sample::Sample;
 use nalgebra::Vector3;
 
@@ -26,16 +27,16 @@ pub const FIT: f64 = 0.25;
 pub enum Reading {
     /// As given.
     AsRead,
-    /// Conjugated: inertial → body (JPL / Shuster), fixed by `--jpl`.
+    /// Conjugated: inertial → body (JPL / Shuster), [`Fix::Jpl`].
     Conjugated,
-    /// The columns are scalar first, fixed by `--scalar-first`.
+    /// The columns are scalar first ([`Fix::ScalarFirst`]).
     ScalarFirst,
-    /// Both, fixed by `--scalar-first --jpl`.
+    /// Both ([`Fix::ScalarFirst`], [`Fix::Jpl`]).
     ScalarFirstConjugated,
-    /// The columns are scalar last but were read as scalar first (`--scalar-first` given
-    /// for a scalar-last file), fixed by dropping `--scalar-first`.
+    /// The columns are scalar last but were read as scalar first (a scalar-first reading
+    /// asked for a scalar-last file: [`Fix::ScalarLast`]).
     ScalarLast,
-    /// The same, conjugated: fixed by dropping `--scalar-first` and giving `--jpl`.
+    /// The same, conjugated ([`Fix::ScalarLast`], [`Fix::Jpl`]).
     ScalarLastConjugated,
     /// The gyro rates have the opposite sign.
     GyroNegated,
@@ -52,29 +53,42 @@ impl Reading {
         Reading::GyroNegated,
     ];
 
-    /// The fix, in words (naming the command-line option where there is one).
+    /// The fix, in words (no front end's option: [`Self::fixes`] carries it typed).
     #[must_use]
     pub fn fix(&self) -> &'static str {
         match self {
             Reading::AsRead => "none needed",
             Reading::Conjugated => {
-                "the quaternions look conjugated (inertial → body, JPL/Shuster): use --jpl"
+                "the quaternions look conjugated (inertial → body, JPL/Shuster): read them as JPL"
             }
             Reading::ScalarFirst => {
-                "the quaternion columns look scalar first ([w, x, y, z]): use --scalar-first"
+                "the quaternion columns look scalar first ([w, x, y, z]): read them scalar first"
             }
             Reading::ScalarFirstConjugated => {
-                "the quaternions look scalar first and conjugated: use --scalar-first --jpl"
+                "the quaternions look scalar first and conjugated: read them scalar first and as JPL"
             }
             Reading::ScalarLast => {
-                "the quaternion columns look scalar last ([x, y, z, w]) but were read as scalar first: drop --scalar-first"
+                "the quaternion columns look scalar last ([x, y, z, w]) but were read as scalar first: read them scalar last"
             }
             Reading::ScalarLastConjugated => {
-                "the quaternions look scalar last and conjugated: drop --scalar-first and use --jpl"
+                "the quaternions look scalar last and conjugated: read them scalar last and as JPL"
             }
             Reading::GyroNegated => {
                 "the gyro rates look negated relative to the attitude: check the sign of w_x, w_y, w_z"
             }
+        }
+    }
+
+    /// The settings that read the columns this way.
+    #[must_use]
+    pub fn fixes(&self) -> &'static [Fix] {
+        match self {
+            Reading::AsRead | Reading::GyroNegated => &[],
+            Reading::Conjugated => &[Fix::Jpl],
+            Reading::ScalarFirst => &[Fix::ScalarFirst],
+            Reading::ScalarFirstConjugated => &[Fix::ScalarFirst, Fix::Jpl],
+            Reading::ScalarLast => &[Fix::ScalarLast],
+            Reading::ScalarLastConjugated => &[Fix::ScalarLast, Fix::Jpl],
         }
     }
 

@@ -200,7 +200,11 @@ fn an_overstated_gyro_density_is_caught() {
                     Observability::NotObservable(Unobservable::DensityOverstated { .. })
                 ));
                 let reason = e.observability.reason().unwrap().to_string();
-                assert!(reason.contains("--gyro-noise") && reason.contains("60"));
+                assert!(reason.contains("gyro noise density") && reason.contains("60"));
+                assert_eq!(
+                    e.observability.reason().unwrap().fixes(),
+                    [inertia::fix::Fix::GyroNoise]
+                );
             }
             // The batch run makes the same test on its reduction of the same rows.
             let config = PipelineSettings {

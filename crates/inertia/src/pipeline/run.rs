@@ -1,0 +1,485 @@
+//! The run every front end shares: the policy between the samples a front end has read
+//! and the [`Pipeline`] (or the batch estimate, eq. 57), so that the command line, Python
+//! and C refuse the same data with the same typed error ([`RunError`]).
+//!
+//! ```text
+//! samples ─▶ Run::push ─▶ [time order, gyro columns, memory and resampling against the
+//!                          first step] ─▶ Pipeline::push_each (streaming) or kept (batch)
+//!          Run::finish ─▶ [batch estimate] ─▶ at least the estimator's minimum samples
+//! ```
+//!
+//! * A sample's index is its 0-based position in the input; a front end maps it to its
+//!   file line or array row. An error is tied to the sample that caused it: for a step too
+//!   large for the rows, the sample that ends the step, among the last [`RECENT`].
+//! * A sample refused before it reaches the estimator (time order, gyro columns, a memory
+//!   shorter than the step) leaves the run as it was; after an error of the pipeline or the
+//!   estimator the run is stopped, and every later push is refused
+//!   ([`RunErrorKind::Stopped`]).
+//! * The messages describe the fix in words; [`RunError::fixes`] carries it typed, for each
+//!   front end to name in its own vocabulary ([`crate::fix`]).
+
+use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError, MAX_RESAMPLE_FACTOR};
+use crate::estimator::Estimate;
+use crate::fix::Fix;
+use crate::sample::Sample;
+use crate::text::Num;
+use std::collections::VecDeque;
+use std::vec::Vec;
+
+/// How many recent samples a run keeps to find the sample that ends a step.
+pub const RECENT: usize = 8;
+
+/// Why a run cannot go on, and at which input sample.
+///
+/// Its message names no place (a front end puts its file line or array row first) and no
+/// front end's option ([`Self::fixes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunError {
+    /// 0-based index of the input sample at fault (`None`: the whole input).
+    pub sample: Option<usize>,
+    /// What is wrong.
+    pub kind: RunErrorKind,
+}
+
+/// What is wrong with a run's input or settings.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunErrorKind {
+    /// The estimator needs gyro rates and the input has none.
+    #[error("the {estimator} estimator needs gyro rates (w_x,w_y,w_z)")]
+    NeedsGyro {
+        /// The estimator.
+        estimator: &'static str,
+    },
+    /// Gyro rates given for some samples and not for others.
+    #[error("gyro rates {} here but {} for the earlier samples: give them for every sample or none", given(*.given_here), given(!*.given_here))]
+    GyroChanged {
+        /// Whether this sample has them.
+        given_here: bool,
+    },
+    /// Time does not increase.
+    #[error("time {} s does not increase (previous sample: {} s)", Num(*.t_s), Num(*.previous_s))]
+    TimeNotIncreasing {
+        /// This sample's time, s.
+        t_s: f64,
+        /// The previous sample's, s.
+        previous_s: f64,
+    },
+    /// A memory shorter than the sample period forgets each sample before the next.
+    #[error("the memory {} s is shorter than the sample period {} s; the memory must span several samples", Num(*.memory_s), Num(*.step_s))]
+    MemoryShorterThanStep {
+        /// The memory time constant, s.
+        memory_s: f64,
+        /// The sample period (the resampling period where resampling), s.
+        step_s: f64,
+    },
+    /// The input ended before the estimator could make one estimate.
+    #[error("too few samples for an estimate: the {estimator} estimator needs at least {need}, got {got}{}", resampled(*.got, *.read))]
+    TooFewSamples {
+        /// The estimator.
+        estimator: &'static str,
+        /// Its minimum ([`super::Capabilities::min_samples`]).
+        need: usize,
+        /// Samples it saw (after resampling).
+        got: usize,
+        /// Input samples read.
+        read: usize,
+    },
+    /// An earlier error stopped the run.
+    #[error("the run stopped on an earlier error ({0}); start a new one")]
+    Stopped(std::string::String),
+    /// The pipeline or the estimator stopped.
+    #[error(transparent)]
+    Pipeline(PipelineError),
+}
+
+fn given(yes: bool) -> &'static str {
+    if yes {
+        "given"
+    } else {
+        "missing"
+    }
+}
+
+fn resampled(got: usize, read: usize) -> std::string::String {
+    if got == read {
+        std::string::String::new()
+    } else {
+        std::format!(" ({read} read, {got} on the resampling grid)")
+    }
+}
+
+impl core::fmt::Display for RunError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        use crate::estimator::EstimatorError;
+        match &self.kind {
+            // The place is the front end's to name: not the pipeline's "input sample i: ".
+            RunErrorKind::Pipeline(PipelineError::Estimator { source, .. }) => match source {
+                EstimatorError::Solve(s) => write!(f, "the solver failed on these data: {s}"),
+                other => write!(f, "{other}"),
+            },
+            RunErrorKind::Pipeline(PipelineError::ReversedMomentum {
+                tau_given,
+                quaternions,
+                ..
+            }) => write!(
+                f,
+                "{}",
+                super::checks::ReversedMessage {
+                    sample: &None,
+                    tau_given,
+                    quaternions,
+                }
+            ),
+            RunErrorKind::Pipeline(PipelineError::OutOfRange { source, .. }) => {
+                write!(f, "{source}")
+            }
+            RunErrorKind::Pipeline(PipelineError::ResampleTooFine {
+                step_s, period_s, ..
+            }) => write!(
+                f,
+                "resampling to {} s would make {} samples of the step of {} s (at most {})",
+                Num(*period_s),
+                Num((*step_s / *period_s).round()),
+                Num(*step_s),
+                Num(MAX_RESAMPLE_FACTOR)
+            ),
+            other => write!(f, "{other}"),
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
+impl RunError {
+    /// Whether a step of the attitude was too large for the rows (`|φ| ≥ 1`): a front end
+    /// names its quaternion columns.
+    #[must_use]
+    pub fn is_step_too_large(&self) -> bool {
+        self.pipeline()
+            .and_then(PipelineError::step_end_s)
+            .is_some()
+    }
+
+    fn at(sample: usize, kind: RunErrorKind) -> Self {
+        Self {
+            sample: Some(sample),
+            kind,
+        }
+    }
+
+    /// The settings its message recommends changing ([`crate::fix`]).
+    #[must_use]
+    pub fn fixes(&self) -> &'static [Fix] {
+        match &self.kind {
+            RunErrorKind::MemoryShorterThanStep { .. } => &[Fix::Memory],
+            RunErrorKind::Pipeline(e) => e.fixes(),
+            _ => &[],
+        }
+    }
+
+    /// The pipeline's error, where the pipeline or the estimator stopped.
+    #[must_use]
+    pub fn pipeline(&self) -> Option<&PipelineError> {
+        match &self.kind {
+            RunErrorKind::Pipeline(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// A setting that the first step `dt` (s) of the data shows to be meaningless: a memory
+/// shorter than the sample period (`resample_s` where resampling, else `dt`). Resampling
+/// to more than [`MAX_RESAMPLE_FACTOR`] samples per step the pipeline refuses at every
+/// step. For engines that hold no [`Run`] (the C API's caller storage).
+pub fn check_first_step(
+    memory_s: Option<f64>,
+    resample_s: Option<f64>,
+    dt: f64,
+) -> Result<(), RunErrorKind> {
+    if let Some(m) = memory_s {
+        let step = resample_s.unwrap_or(dt);
+        if m < step {
+            return Err(RunErrorKind::MemoryShorterThanStep {
+                memory_s: m,
+                step_s: step,
+            });
+        }
+    }
+    Ok(())
+}
+
+enum Mode {
+    Streaming(std::boxed::Box<Pipeline>),
+    Batch {
+        samples: Vec<Sample>,
+        out: Option<std::boxed::Box<BatchOutput>>,
+    },
+}
+
+/// One run over a sequence of samples, streaming or batch.
+pub struct Run {
+    config: PipelineConfig,
+    mode: Mode,
+    /// Input samples accepted.
+    input: usize,
+    first_t_s: [f64; 2],
+    gyro: Option<bool>,
+    /// `(time, index)` of the last [`RECENT`] samples.
+    recent: VecDeque<(f64, usize)>,
+    stopped: Option<std::string::String>,
+}
+
+impl core::fmt::Debug for Run {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Run")
+            .field("config", &self.config)
+            .field("input", &self.input)
+            .field("stopped", &self.stopped)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Run {
+    /// A run of `config`'s estimator: streaming, or over all samples at once (`batch`,
+    /// which the estimator must have, without memory or resampling).
+    pub fn new(config: PipelineConfig, batch: bool) -> Result<Self, PipelineError> {
+        let mode = if batch {
+            super::batch_applies(&config)?;
+            Mode::Batch {
+                samples: Vec::new(),
+                out: None,
+            }
+        } else {
+            Mode::Streaming(std::boxed::Box::new(Pipeline::from_config(config)?))
+        };
+        Ok(Self {
+            config,
+            mode,
+            input: 0,
+            first_t_s: [f64::NAN; 2],
+            gyro: None,
+            recent: VecDeque::with_capacity(RECENT),
+            stopped: None,
+        })
+    }
+
+    /// Where the input's columns are known before its samples (a file's header): refuse
+    /// at once an input without the gyro rates the estimator needs.
+    pub fn check_columns(&self, has_gyro: bool) -> Result<(), RunError> {
+        let entry = self.config.estimator();
+        if entry.capabilities.needs_gyro && !has_gyro {
+            return Err(RunError {
+                sample: None,
+                kind: RunErrorKind::NeedsGyro {
+                    estimator: entry.name,
+                },
+            });
+        }
+        Ok(())
+    }
+
+    /// Feed input sample [`Self::input_samples`]; `on_estimate` receives every estimate it
+    /// produced, in time order (none in batch mode before [`Self::finish`]).
+    pub fn push(&mut self, s: &Sample, on_estimate: impl FnMut(&Estimate)) -> Result<(), RunError> {
+        let index = self.input;
+        if let Some(m) = &self.stopped {
+            return Err(RunError::at(index, RunErrorKind::Stopped(m.clone())));
+        }
+        let r = self.accept(index, s, on_estimate);
+        // A sample refused before it reached the estimator leaves the run as it was; one
+        // the pipeline stopped on ends it.
+        if let Err(
+            e @ RunError {
+                kind: RunErrorKind::Pipeline(_),
+                ..
+            },
+        ) = &r
+        {
+            self.stopped = Some(std::string::ToString::to_string(e));
+        }
+        r
+    }
+
+    fn accept(
+        &mut self,
+        index: usize,
+        s: &Sample,
+        on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), RunError> {
+        let has_w = s.omega_rad_s.is_some();
+        match self.gyro {
+            None => self.check_columns(has_w).map_err(|e| RunError {
+                sample: Some(index),
+                ..e
+            })?,
+            Some(g) if g != has_w => {
+                return Err(RunError::at(
+                    index,
+                    RunErrorKind::GyroChanged { given_here: has_w },
+                ))
+            }
+            Some(_) => {}
+        }
+        if let Some(&(previous_s, _)) = self.recent.back() {
+            if !(s.t_s > previous_s) {
+                return Err(RunError::at(
+                    index,
+                    RunErrorKind::TimeNotIncreasing {
+                        t_s: s.t_s,
+                        previous_s,
+                    },
+                ));
+            }
+        }
+        if index < 2 {
+            self.first_t_s[index] = s.t_s;
+        }
+        if index == 1 {
+            check_first_step(
+                self.config.memory_s(),
+                self.config.resample_s(),
+                self.first_t_s[1] - self.first_t_s[0],
+            )
+            .map_err(|kind| RunError::at(index, kind))?;
+        }
+        self.gyro = Some(has_w);
+        if self.recent.len() == RECENT {
+            self.recent.pop_front();
+        }
+        self.recent.push_back((s.t_s, index));
+        self.input += 1;
+        match &mut self.mode {
+            Mode::Batch { samples, .. } => {
+                samples.push(*s);
+                Ok(())
+            }
+            Mode::Streaming(p) => p.push_each(s, on_estimate).map_err(|e| {
+                let at = e
+                    .step_end_s()
+                    .and_then(|end| {
+                        self.recent
+                            .iter()
+                            .find(|(t, _)| PipelineError::ends_step(*t, end))
+                    })
+                    .map_or(index, |&(_, i)| i);
+                RunError::at(at, RunErrorKind::Pipeline(e))
+            }),
+        }
+    }
+
+    /// End of input: the batch estimate (batch mode; `on_estimate` receives it), and an
+    /// error where the input was too short for one estimate.
+    pub fn finish(&mut self, mut on_estimate: impl FnMut(&Estimate)) -> Result<(), RunError> {
+        if let Some(m) = &self.stopped {
+            return Err(RunError {
+                sample: None,
+                kind: RunErrorKind::Stopped(m.clone()),
+            });
+        }
+        let entry = self.config.estimator();
+        let too_few = |got: usize, read: usize| RunError {
+            sample: None,
+            kind: RunErrorKind::TooFewSamples {
+                estimator: entry.name,
+                need: entry.capabilities.min_samples(),
+                got,
+                read,
+            },
+        };
+        match &mut self.mode {
+            Mode::Streaming(p) => match p.last() {
+                Some(_) => Ok(()),
+                None => Err(too_few(p.estimator_samples(), self.input)),
+            },
+            Mode::Batch { samples, out } => {
+                if out.is_some() {
+                    return Ok(());
+                }
+                if samples.len() < entry.capabilities.min_samples() {
+                    return Err(too_few(samples.len(), samples.len()));
+                }
+                let o = batch(samples, &self.config).map_err(|e| {
+                    let sample = match &e {
+                        PipelineError::Estimator {
+                            source: crate::estimator::EstimatorError::Row { sample, .. },
+                            ..
+                        }
+                        | PipelineError::AttitudeGlitch { sample, .. } => Some(*sample),
+                        _ => None,
+                    };
+                    RunError {
+                        sample,
+                        kind: RunErrorKind::Pipeline(e),
+                    }
+                })?;
+                on_estimate(&o.estimate);
+                *out = Some(std::boxed::Box::new(o));
+                Ok(())
+            }
+        }
+    }
+
+    /// Input samples accepted.
+    #[must_use]
+    pub fn input_samples(&self) -> usize {
+        self.input
+    }
+
+    /// The configuration.
+    #[must_use]
+    pub fn config(&self) -> &PipelineConfig {
+        &self.config
+    }
+
+    /// The sample period, s: the resampling period where resampling, else the first step.
+    #[must_use]
+    pub fn sample_period_s(&self) -> f64 {
+        self.config
+            .resample_s()
+            .unwrap_or(self.first_t_s[1] - self.first_t_s[0])
+    }
+
+    /// The newest estimate.
+    #[must_use]
+    pub fn last(&self) -> Option<&Estimate> {
+        match &self.mode {
+            Mode::Streaming(p) => p.last(),
+            Mode::Batch { out, .. } => out.as_ref().map(|o| &o.estimate),
+        }
+    }
+
+    /// The streaming pipeline (`None` in batch mode).
+    #[must_use]
+    pub fn pipeline(&self) -> Option<&Pipeline> {
+        match &self.mode {
+            Mode::Streaming(p) => Some(p),
+            Mode::Batch { .. } => None,
+        }
+    }
+
+    /// The report of the newest estimate (`None` before one), with the input summarised
+    /// as `file` with the reader's counts `stats`.
+    #[cfg(all(feature = "serde", feature = "csv"))]
+    #[must_use]
+    pub fn report(
+        &self,
+        file: &str,
+        stats: &crate::telemetry::csv::ReadStats,
+    ) -> Option<super::report::Report> {
+        let report = match &self.mode {
+            Mode::Streaming(p) => super::report::Report::of_pipeline(p)?,
+            Mode::Batch { samples, out } => {
+                super::report::Report::of_batch(out.as_ref()?, &self.config, samples.len())
+            }
+        };
+        Some(report.with_input(super::report::InputSummary {
+            file: file.into(),
+            sample_period_s: self.sample_period_s(),
+            renormalised: stats.renormalised,
+            sign_flips: stats.sign_flips,
+            min_step_s: stats.min_step_s,
+            max_step_s: stats.max_step_s,
+        }))
+    }
+}
