@@ -45,13 +45,10 @@
 //! ```
 
 mod checks;
-mod discrete_momentum;
 mod momentum;
 pub mod registry;
 mod sdp;
 mod settings;
-mod standing;
-mod twins;
 
 #[cfg(feature = "csv")]
 pub mod history;

@@ -352,7 +352,7 @@ impl fmt::Display for Report {
             writeln!(
                 s,
                 "rotation: the attitude is the gyro's own integral (their answers agree within {} σ), so its rows are the gyro's and are folded once",
-                super::twins::TWIN_Z
+                crate::estimators::discrete_momentum::twins::TWIN_Z
             )?;
         }
         writeln!(s, "status: {}", self.observability)?;

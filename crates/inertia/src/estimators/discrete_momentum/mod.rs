@@ -17,13 +17,15 @@
 //! half-rate shadow of the first candidate, the spread of indistinguishable candidates,
 //! and the cross-check of the rotation sources ([`reconcile`]). A candidate that has fitted
 //! markedly worse than the best for long is ruled out and no longer folded
-//! ([`super::standing`]).
+//! ([`standing`]).
 
-use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
-use super::settings::PipelineConfig;
-use super::standing::{Standing, RULE_OUT_AFTER};
-use super::twins::{self, Twins};
-use super::PipelineError;
+mod standing;
+pub(crate) mod twins;
+
+use crate::pipeline::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
+use crate::pipeline::{PipelineConfig, PipelineError};
+use standing::{Standing, RULE_OUT_AFTER};
+use twins::Twins;
 use crate::constraints::Constraints;
 use crate::eigen3::symmetric_eigen3;
 use crate::estimator::attitude_drift::AttitudeDrift;
@@ -280,7 +282,7 @@ fn own_solution(
 /// A reduced state's unconstrained answer ([`own_solution`]) and its least-squares σ
 /// ([`twins::least_squares_sigma`]) from the same rows: with prior knowledge stacked on
 /// for both, so that a strong prior does not leave a σ of the data alone beside an answer
-/// the prior holds ([`super::twins`]).
+/// the prior holds ([`twins`]).
 fn own_answer(
     qr: &RecursiveQr,
     gyro: Option<f64>,
@@ -448,9 +450,9 @@ struct DiscreteMomentum {
     from_s: f64,
     /// Which candidates the data have not ruled out.
     standing: Standing,
-    /// Row blocks beyond the limit that rule a candidate out ([`super::standing`]).
+    /// Row blocks beyond the limit that rule a candidate out ([`standing`]).
     rule_out_after: usize,
-    /// Whether the attitude is the gyro's integral ([`super::twins`]).
+    /// Whether the attitude is the gyro's integral ([`twins`]).
     twins: Twins,
     chosen: usize,
     since_solve: usize,
@@ -995,7 +997,7 @@ impl DiscreteMomentum {
         }
     }
 
-    /// Rule out the candidates the data have ruled out ([`super::standing`]). The first
+    /// Rule out the candidates the data have ruled out ([`standing`]). The first
     /// keeps folding without its jackknife: the discretisation bias compares it with the
     /// shadow whichever candidate is chosen.
     fn rule_out(&mut self) {
@@ -1011,7 +1013,7 @@ impl DiscreteMomentum {
         }
     }
 
-    /// Compare the candidates that differ only in the rotation source ([`super::twins`]);
+    /// Compare the candidates that differ only in the rotation source ([`twins`]);
     /// once they are found to be one measurement, rule out the attitude's.
     fn check_twins(&mut self) {
         let gyro = self.config.gyro_noise_rad_s_rthz;
@@ -1439,7 +1441,7 @@ fn run_batch(samples: &[Sample], c: &PipelineConfig) -> Result<BatchOutput, Pipe
 }
 
 /// The batch form of the test for an attitude that is the gyro's own integral
-/// ([`super::twins`]): over a record of at least [`RULE_OUT_AFTER`] row blocks (the
+/// ([`twins`]): over a record of at least [`RULE_OUT_AFTER`] row blocks (the
 /// recursive test's horizon), the pairs of candidates that differ only in the rotation
 /// source are compared once, on the whole record; within [`twins::TWIN_Z`], the
 /// attitude's candidates are left out. `Some(verdict)` where the test was made, `None`
