@@ -13,7 +13,7 @@
 //! would have stayed beyond the limit; a model that fitted markedly worse over that long
 //! is taken not to come back.
 
-use super::COMPARABLE_FIT;
+use super::cross_check::COMPARABLE_FIT;
 use std::vec::Vec;
 
 /// Consecutive row blocks beyond the limit after which a candidate is ruled out.

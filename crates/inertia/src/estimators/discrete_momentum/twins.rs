@@ -160,8 +160,8 @@ pub(crate) fn ratio(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use super::super::standing::RULE_OUT_AFTER;
+    use super::*;
     use nalgebra::{Matrix6, Vector6};
 
     #[test]
