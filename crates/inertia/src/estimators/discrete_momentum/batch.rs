@@ -1,45 +1,48 @@
 //! The discrete momentum estimator over a whole record at once (`--batch`): every
-//! candidate reduced in one pass, chosen as the recursive path chooses, with the same σ and
-//! status checks.
+//! candidate reduced in one pass, chosen as the recursive path chooses ([`pick`]), its σ
+//! and status given by the same sequence ([`finish`]).
 
 use super::candidates::{candidates, chained_siblings};
-use super::cross_check::{reconcile, COMPARABLE_FIT};
+use super::cross_check::COMPARABLE_FIT;
+use super::finish::{finish, Evidence, Finished};
 use super::select::{alternatives_from_s, in_running, pick};
-use super::sigma::{
-    discretisation_bias, double_step, model_spread, own_answer, quadrature, scale_from_prior,
-    sibling_jackknife,
-};
+use super::sigma::{discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife};
 use super::standing::RULE_OUT_AFTER;
 use super::twins;
 use super::DISCRETE_MOMENTUM;
-use crate::eigen3::symmetric_eigen3;
-use crate::estimator::audit::{audit, reversed_at_floor};
-use crate::estimator::consistency;
+use crate::estimator::consistency::{self, ResidualSegments};
 use crate::estimator::discrete_momentum::{reduce_batch, torque_tested, BatchReduction};
 use crate::estimator::excitation::diagnose;
 use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::observability::Observability;
 use crate::estimator::prior;
-use crate::estimator::uncertainty::{noise_sigma, with_bias};
+use crate::estimator::qr::RecursiveQr;
+use crate::estimator::uncertainty::noise_sigma;
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::pipeline::registry::{self, BatchOutput};
 use crate::pipeline::{PipelineConfig, PipelineError};
 use crate::sample::Sample;
-use crate::tensor::matrix_from_j;
+use crate::solver::Backend;
+use crate::tensor::InertiaVector;
+use std::boxed::Box;
 use std::vec::Vec;
 
-pub(super) fn run_batch(
-    samples: &[Sample],
-    c: &PipelineConfig,
-) -> Result<BatchOutput, PipelineError> {
-    let wrap = |source| PipelineError::Estimator {
+/// A failed row or solve, with the sample it concerns where there is one.
+fn wrap(source: EstimatorError) -> PipelineError {
+    PipelineError::Estimator {
         sample: match source {
             EstimatorError::Row { sample, .. } => Some(sample),
             _ => None,
         },
         source,
-    };
+    }
+}
+
+pub(super) fn run_batch(
+    samples: &[Sample],
+    c: &PipelineConfig,
+) -> Result<BatchOutput, PipelineError> {
     // The drift weighting needs an estimate of J before each row is folded: recursive
     // runs only.
     if c.attitude_drift_deg_rth.is_some() {
@@ -76,13 +79,64 @@ pub(super) fn run_batch(
             estimator: DISCRETE_MOMENTUM.name,
         });
     };
-    let qr = &batch.qr;
     let (tested, torque_test) = torque_tested(batch.qr, batch.without_torque);
-    let mut backend = registry::build_backend(c.backend);
-    let t_s = samples.last().map_or(0.0, |s| s.t_s);
-    // One candidate's own answer and noise σ (for the whole record as one chain, at
-    // least its chained siblings' jackknife σ: [`chained_siblings`]).
-    let mut own = |i: usize| -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+    let mut run = BatchRun {
+        samples,
+        config: c,
+        reduced: &reduced,
+        chosen,
+        from_s,
+        tested,
+        // The chosen rows with the prior's: what the audit judges.
+        augmented: prior::augment(&tested, &c.constraints).0,
+        backend: registry::build_backend(c.backend),
+        t_s: samples.last().map_or(0.0, |s| s.t_s),
+        others: Vec::new(),
+    };
+    let (mut estimate, noise) = run.own(chosen)?;
+    // (The span test needs the recursive residuals, which a batch reduction does not
+    // form.)
+    let gyro_density_ratio = match finish(&mut estimate, noise, &mut run)? {
+        Finished::Checked { density_ratio } => density_ratio,
+        Finished::Reversed => None,
+    };
+    Ok(BatchOutput {
+        gyro_density_ratio,
+        estimate,
+        excitation: Some(diagnose(&tested, &c.observability)),
+        gaps: batch.gaps,
+        row_model: Some(*rows),
+        torque_test,
+        attitude_is_gyro_integral,
+    })
+}
+
+/// The batch run's candidates once one is chosen, as the σ and the status of its answer
+/// see them ([`finish`]).
+struct BatchRun<'a> {
+    samples: &'a [Sample],
+    config: &'a PipelineConfig,
+    /// Every candidate's rows and their reduction.
+    reduced: &'a [(MomentumRowSettings, BatchReduction)],
+    chosen: usize,
+    /// The shortest chain of an alternative ([`alternatives_from_s`]).
+    from_s: f64,
+    /// The chosen candidate's rows, torque-tested ([`torque_tested`]).
+    tested: RecursiveQr,
+    /// The same with the prior's rows.
+    augmented: RecursiveQr,
+    backend: Box<dyn Backend + Send>,
+    /// The answers' time stamp: the last sample's.
+    t_s: f64,
+    /// The other candidates' answers for the cross-check.
+    others: Vec<(InertiaVector, [f64; 6])>,
+}
+
+impl BatchRun<'_> {
+    /// Candidate `i`'s own answer and noise σ (for the whole record as one chain, at least
+    /// its chained siblings' jackknife σ: [`chained_siblings`]).
+    fn own(&mut self, i: usize) -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+        let (reduced, c) = (self.reduced, self.config);
         let (rows, b) = &reduced[i];
         let sibling = sibling_jackknife(
             chained_siblings(
@@ -97,9 +151,9 @@ pub(super) fn run_batch(
         let (tested, _) = torque_tested(b.qr, b.without_torque);
         let e = batch::solve_reduced(
             &tested,
-            t_s,
+            self.t_s,
             &c.constraints,
-            &mut *backend,
+            &mut *self.backend,
             &c.observability,
             c.gyro_noise_rad_s_rthz,
         )
@@ -122,96 +176,86 @@ pub(super) fn run_batch(
                 .map(|ls| robust_sigma(&prior::zero_fixed(ls, &c.constraints), jackknife.as_ref()))
         });
         Ok((e, noise))
-    };
-    let (mut estimate, noise) = own(chosen)?;
-    // The chosen rows with the prior's: what the audit judges.
-    let augmented = prior::augment(&tested, &c.constraints).0;
-    if c.uncertainty {
-        if let (Some(j), Some(noise)) = (estimate.j(), noise) {
-            let others = reduced
-                .iter()
-                .enumerate()
-                .filter(|&(i, (r, _))| i != chosen && in_running(r, from_s))
-                .map(|(_, (_, b))| b.qr);
-            let spread = model_spread(&tested, others, c.gyro_noise_rad_s_rthz, &c.constraints);
-            // As in the recursive path: the first candidate on every other sample.
-            let half: Vec<Sample> = samples
-                .chunks_exact(2)
-                .map(|p| double_step(&p[0], &p[1]))
-                .collect();
-            let discretisation = match (reduced.first(), c.gyro_noise_rad_s_rthz) {
-                (Some((first, full)), gyro) => match reduce_batch(&half, first) {
-                    Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &c.constraints),
-                    Err(_) => [0.0; 6],
-                },
-                _ => [0.0; 6],
-            };
-            let bias = quadrature(&spread, &discretisation);
-            estimate.uncertainty = Some(with_bias(&noise, &bias, &j));
-        }
-        // As in the recursive path: a reversed ρ is told before the cross-check.
-        let reversed = estimate.j().is_some_and(|j| {
-            reversed_at_floor(
-                &estimate,
-                &augmented,
-                c.constraints.set().epsilon_kg_m2,
-                c.observability.max_relative_sigma,
-                &symmetric_eigen3(&matrix_from_j(&j)).0,
-            )
-        });
-        if !reversed && matches!(estimate.observability, Observability::Determined { .. }) {
-            let mut others = Vec::new();
-            for (i, (r, b)) in reduced.iter().enumerate() {
-                if i == chosen
-                    || !in_running(r, from_s)
-                    || !(b.qr.residual_variance() <= COMPARABLE_FIT * qr.residual_variance())
-                {
-                    continue;
-                }
-                if let (e, Some(sigma)) = own(i)? {
-                    if let (Observability::Determined { .. }, Some(jb)) = (e.observability, e.j()) {
-                        others.push((jb, sigma));
-                    }
-                }
-            }
-            if let Some(j) = estimate.j() {
-                let eig = symmetric_eigen3(&matrix_from_j(&j));
-                reconcile(
-                    &mut estimate,
-                    &eig,
-                    &others,
-                    c.observability.max_relative_sigma,
-                );
-            }
+    }
+}
+
+impl Evidence for BatchRun<'_> {
+    type Error = PipelineError;
+
+    fn config(&self) -> &PipelineConfig {
+        self.config
+    }
+
+    fn solved(&self) -> &RecursiveQr {
+        &self.augmented
+    }
+
+    fn data(&self) -> &RecursiveQr {
+        &self.tested
+    }
+
+    fn model_spread(&self) -> [f64; 6] {
+        let others = self
+            .reduced
+            .iter()
+            .enumerate()
+            .filter(|&(i, (r, _))| i != self.chosen && in_running(r, self.from_s))
+            .map(|(_, (_, b))| b.qr);
+        model_spread(
+            &self.tested,
+            others,
+            self.config.gyro_noise_rad_s_rthz,
+            &self.config.constraints,
+        )
+    }
+
+    fn discretisation_bias(&self) -> [f64; 6] {
+        // The first candidate on every other sample, as the recursive path's shadow.
+        let half: Vec<Sample> = self
+            .samples
+            .chunks_exact(2)
+            .map(|p| double_step(&p[0], &p[1]))
+            .collect();
+        match (self.reduced.first(), self.config.gyro_noise_rad_s_rthz) {
+            (Some((first, full)), gyro) => match reduce_batch(&half, first) {
+                Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &self.config.constraints),
+                Err(_) => [0.0; 6],
+            },
+            _ => [0.0; 6],
         }
     }
-    audit(
-        &mut estimate,
-        &augmented,
-        c.constraints.set().epsilon_kg_m2,
-        c.observability.max_relative_sigma,
-    );
-    scale_from_prior(&mut estimate, &tested, &c.constraints);
-    // The residuals against the stated gyro density, as in the recursive path: the gyro
-    // rotation's rows are the ones the density describes. (The span test needs the
-    // recursive residuals, which a batch reduction does not form.)
-    let gyro_density_ratio = match (c.gyro_noise_rad_s_rthz, estimate.j()) {
-        (Some(g), Some(j)) => reduced
+
+    fn cross_check(&mut self, _: &Estimate) -> Result<&[(InertiaVector, [f64; 6])], PipelineError> {
+        let reduced = self.reduced;
+        let best_variance = reduced[self.chosen].1.qr.residual_variance();
+        self.others.clear();
+        for (i, (r, b)) in reduced.iter().enumerate() {
+            if i == self.chosen
+                || !in_running(r, self.from_s)
+                || !(b.qr.residual_variance() <= COMPARABLE_FIT * best_variance)
+            {
+                continue;
+            }
+            if let (e, Some(sigma)) = self.own(i)? {
+                if let (Observability::Determined { .. }, Some(jb)) = (e.observability, e.j()) {
+                    self.others.push((jb, sigma));
+                }
+            }
+        }
+        Ok(&self.others)
+    }
+
+    fn density_ratio(&self, j: &InertiaVector, g: f64) -> Option<f64> {
+        // The gyro rotation's rows are the ones the density describes.
+        self.reduced
             .iter()
             .find(|(rows, _)| rows.rotation == RotationSource::Gyro)
-            .and_then(|(_, b)| consistency::gyro_density_ratio(&b.qr, &j, g)),
-        _ => None,
-    };
-    consistency::check(&mut estimate, None, gyro_density_ratio);
-    Ok(BatchOutput {
-        gyro_density_ratio,
-        estimate,
-        excitation: Some(diagnose(&tested, &c.observability)),
-        gaps: batch.gaps,
-        row_model: Some(*rows),
-        torque_test,
-        attitude_is_gyro_integral,
-    })
+            .and_then(|(_, b)| consistency::gyro_density_ratio(&b.qr, j, g))
+    }
+
+    fn residuals(&mut self, _: &Estimate) -> Option<&ResidualSegments> {
+        None
+    }
 }
 
 /// The batch form of the test for an attitude that is the gyro's own integral

@@ -146,22 +146,23 @@ pub(super) fn disagreement_beyond(
 }
 
 impl DiscreteMomentum {
-    /// Withdraw a determined answer that another candidate's own answer contradicts
-    /// beyond both σ ([`DISAGREE_Z`]); the other candidates' answers are refreshed every
-    /// [`CROSS_CHECK_EVERY`] row blocks, or every [`CROSS_CHECK_SHARE`]th of the record so
-    /// far if that is more and there is no forgetting ([`cross_check_every`]).
+    /// The other candidates' own answers `(ĵ, noise σ)` that a determined answer `e` is
+    /// [`reconcile`]d with ([`DISAGREE_Z`]): those still in the running that fit
+    /// comparably ([`COMPARABLE_FIT`]); none for an answer without σ or a single
+    /// candidate. The answers are refreshed every [`CROSS_CHECK_EVERY`] row blocks, or
+    /// every [`CROSS_CHECK_SHARE`]th of the record so far if that is more and there is no
+    /// forgetting ([`cross_check_every`]).
     pub(super) fn cross_check(
         &mut self,
-        e: &mut Estimate,
-        eig: &Eigen,
+        e: &Estimate,
         t_s: f64,
-    ) -> Result<(), EstimatorError> {
+    ) -> Result<&[(InertiaVector, [f64; 6])], EstimatorError> {
         if self.candidates.len() < 2 || !matches!(e.observability, Observability::Determined { .. })
         {
-            return Ok(());
+            return Ok(&[]);
         }
         let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
-            return Ok(());
+            return Ok(&[]);
         };
         self.checks.resize(self.candidates.len(), None);
         let best_variance = self
@@ -218,12 +219,6 @@ impl DiscreteMomentum {
                 self.others.push(answer);
             }
         }
-        reconcile(
-            e,
-            eig,
-            &self.others,
-            self.config.observability.max_relative_sigma,
-        );
-        Ok(())
+        Ok(&self.others)
     }
 }

@@ -22,6 +22,7 @@
 mod batch;
 mod candidates;
 mod cross_check;
+mod finish;
 mod replay;
 mod select;
 mod sigma;
@@ -30,30 +31,26 @@ mod standing;
 mod tests;
 pub(crate) mod twins;
 
-use crate::eigen3::symmetric_eigen3;
 use crate::estimator::attitude_drift::AttitudeDrift;
-use crate::estimator::audit::{audit_at, reversed_at_floor};
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::discrete_momentum::{
     DiscreteMomentumEstimator, MomentumEstimatorSettings, TorqueTest,
 };
 use crate::estimator::excitation::{diagnose, Excitation};
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
-use crate::estimator::uncertainty::with_bias_at;
+use crate::estimator::qr::RecursiveQr;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::registry::{self, Capabilities, Estimator, EstimatorEntry};
 use crate::pipeline::{PipelineConfig, PipelineError};
 use crate::sample::Sample;
-use crate::tensor::{matrix_from_j, InertiaVector};
+use crate::tensor::InertiaVector;
 use candidates::{candidates, chained_siblings, settings, shared_sources, Candidate, SharedSource};
 use cross_check::CrossCheck;
+use finish::{finish, Evidence, Finished};
 use nalgebra::Vector3;
 use replay::{unweighted_is_better, REPLAY_CAP};
 use select::{alternatives_from_s, in_running, pick};
-use sigma::{
-    candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer, quadrature,
-    scale_from_prior, NO_EIGEN,
-};
+use sigma::{candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer};
 use standing::{Standing, RULE_OUT_AFTER};
 use std::boxed::Box;
 use std::vec::Vec;
@@ -313,106 +310,16 @@ impl DiscreteMomentum {
         }
         self.since_solve = 0;
         let mut e = c.solve_now(s.t_s)?;
-        // The eigenpairs of Ĵ, once for σ's principal moments, the cross-check and the
-        // audit (a withdrawn answer has none, and none of them runs).
-        let eig = e
-            .j()
-            .map_or(NO_EIGEN, |j| symmetric_eigen3(&matrix_from_j(&j)));
-        let best = *c.reduced();
         let noise =
             candidate_noise_sigma(&mut self.candidates, self.chosen, self.config.max_chain_s);
-        if self.config.uncertainty {
-            if let (Some(_), Some(noise)) = (e.j(), noise) {
-                let others = self
-                    .candidates
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, c)| {
-                        i != self.chosen
-                            && self.standing.live(i)
-                            && in_running(c.row_settings(), self.from_s)
-                    })
-                    .map(|(_, c)| c.qr().reduced());
-                let spread = model_spread(
-                    &best,
-                    others,
-                    self.config.gyro_noise_rad_s_rthz,
-                    &self.config.constraints,
-                );
-                let discretisation = match (self.candidates.first(), self.shadow.as_deref()) {
-                    (Some(first), Some(shadow)) => discretisation_bias(
-                        &first.qr().reduced(),
-                        &shadow.qr().reduced(),
-                        self.config.gyro_noise_rad_s_rthz,
-                        &self.config.constraints,
-                    ),
-                    _ => [0.0; 6],
-                };
-                let bias = quadrature(&spread, &discretisation);
-                e.uncertainty = Some(with_bias_at(&noise, &bias, &eig));
-            }
-        }
-        // An answer on the floor whose negation would be determined (a reversed ρ: the
-        // pipeline stops there) is told as that, before the cross-check, which would
-        // withdraw it as the rotation sources' disagreement.
-        let (epsilon, max_relative_sigma) = (
-            self.config.constraints.set().epsilon_kg_m2,
-            self.config.observability.max_relative_sigma,
-        );
-        if let Some(c) = self.candidates.get(self.chosen) {
-            if reversed_at_floor(&e, c.solved(), epsilon, max_relative_sigma, &eig.0) {
-                audit_at(
-                    &mut e,
-                    c.solved(),
-                    epsilon,
-                    max_relative_sigma,
-                    Some(&eig.0),
-                );
-                return Ok(Some(e));
-            }
-        }
-        self.cross_check(&mut e, &eig, s.t_s)?;
-        let Some(c) = self.candidates.get(self.chosen) else {
-            return Ok(Some(e));
+        let mut evidence = Streaming {
+            run: self,
+            t_s: s.t_s,
+            record,
         };
-        audit_at(
-            &mut e,
-            c.solved(),
-            self.config.constraints.set().epsilon_kg_m2,
-            self.config.observability.max_relative_sigma,
-            Some(&eig.0),
-        );
-        scale_from_prior(&mut e, c.reduced(), &self.config.constraints);
-        // The density describes the gyro: its rows are the ones to compare with it (with
-        // an attitude better than the gyro, the attitude's rows are quieter).
-        // Under forgetting the counts are discounted and the test is not made.
-        let described = self
-            .candidates
-            .iter()
-            .enumerate()
-            .find(|&(i, c)| {
-                (i == 0 || self.standing.live(i))
-                    && c.row_settings().rotation == RotationSource::Gyro
-            })
-            .map(|(_, c)| c);
-        self.density_ratio = match (self.config.gyro_noise_rad_s_rthz, e.j(), described) {
-            (Some(g), Some(j), Some(d)) if record => {
-                consistency::gyro_density_ratio(&d.qr().reduced(), &j, g)
-            }
-            _ => None,
-        };
-        // The answer as the data gave it, withdrawn or not, is the reference of the spans
-        // that start after it.
-        if let (Some(j), Some(sigma)) = (e.j(), e.sigma_kg_m2()) {
-            for r in &mut self.residuals {
-                r.note(&j, &sigma);
-            }
+        if let Finished::Checked { density_ratio } = finish(&mut e, noise, &mut evidence)? {
+            self.density_ratio = density_ratio;
         }
-        consistency::check(
-            &mut e,
-            self.residuals.get(self.chosen).filter(|_| record),
-            self.density_ratio,
-        );
         Ok(Some(e))
     }
 
@@ -579,5 +486,109 @@ impl Estimator for DiscreteMomentum {
         self.config
             .attitude_drift_deg_rth
             .map(|_| matches!(self.unweighted, Some((_, false))))
+    }
+}
+
+/// The streaming run at a solve, as the σ and the status of its answer see it
+/// ([`finish`]).
+struct Streaming<'a> {
+    run: &'a mut DiscreteMomentum,
+    /// The solve's time stamp (the cross-check's own solves).
+    t_s: f64,
+    /// Whether the residuals are recorded (no forgetting).
+    record: bool,
+}
+
+impl Streaming<'_> {
+    fn chosen(&self) -> &Candidate {
+        &self.run.candidates[self.run.chosen]
+    }
+}
+
+impl Evidence for Streaming<'_> {
+    type Error = EstimatorError;
+
+    fn config(&self) -> &PipelineConfig {
+        &self.run.config
+    }
+
+    fn solved(&self) -> &RecursiveQr {
+        self.chosen().solved()
+    }
+
+    fn data(&self) -> &RecursiveQr {
+        self.chosen().reduced()
+    }
+
+    fn model_spread(&self) -> [f64; 6] {
+        let run = &*self.run;
+        let others = run
+            .candidates
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| {
+                i != run.chosen && run.standing.live(i) && in_running(c.row_settings(), run.from_s)
+            })
+            .map(|(_, c)| c.qr().reduced());
+        model_spread(
+            self.chosen().reduced(),
+            others,
+            run.config.gyro_noise_rad_s_rthz,
+            &run.config.constraints,
+        )
+    }
+
+    fn discretisation_bias(&self) -> [f64; 6] {
+        let run = &*self.run;
+        match (run.candidates.first(), run.shadow.as_deref()) {
+            (Some(first), Some(shadow)) => discretisation_bias(
+                &first.qr().reduced(),
+                &shadow.qr().reduced(),
+                run.config.gyro_noise_rad_s_rthz,
+                &run.config.constraints,
+            ),
+            _ => [0.0; 6],
+        }
+    }
+
+    fn cross_check(
+        &mut self,
+        e: &Estimate,
+    ) -> Result<&[(InertiaVector, [f64; 6])], EstimatorError> {
+        self.run.cross_check(e, self.t_s)
+    }
+
+    fn density_ratio(&self, j: &InertiaVector, g: f64) -> Option<f64> {
+        // The density describes the gyro: its rows are the ones to compare with it (with
+        // an attitude better than the gyro, the attitude's rows are quieter).
+        // Under forgetting the counts are discounted and the test is not made.
+        let run = &*self.run;
+        let described = run
+            .candidates
+            .iter()
+            .enumerate()
+            .find(|&(i, c)| {
+                (i == 0 || run.standing.live(i))
+                    && c.row_settings().rotation == RotationSource::Gyro
+            })
+            .map(|(_, c)| c);
+        match described {
+            Some(d) if self.record => consistency::gyro_density_ratio(&d.qr().reduced(), j, g),
+            _ => None,
+        }
+    }
+
+    fn residuals(&mut self, e: &Estimate) -> Option<&ResidualSegments> {
+        // The answer as the data gave it, withdrawn or not, is the reference of the spans
+        // that start after it.
+        if let (Some(j), Some(sigma)) = (e.j(), e.sigma_kg_m2()) {
+            for r in &mut self.run.residuals {
+                r.note(&j, &sigma);
+            }
+        }
+        self.run
+            .residuals
+            .get(self.run.chosen)
+            .filter(|_| self.record)
     }
 }
