@@ -48,7 +48,6 @@ use candidates::{candidates, chained_siblings, settings, shared_sources, Candida
 use cross_check::CrossCheck;
 use finish::{finish, Evidence, Finished};
 use nalgebra::Vector3;
-use replay::{unweighted_is_better, REPLAY_CAP};
 use select::{alternatives_from_s, in_running, pick};
 use sigma::{candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer};
 use standing::{Standing, RULE_OUT_AFTER};
@@ -114,12 +113,12 @@ struct DiscreteMomentum {
     drift: Option<AttitudeDrift>,
     /// With a drift to weight for and no answer yet: the samples so far, refolded with
     /// the weights once the first answer gives `Ĵ` ([`DiscreteMomentum::replayed`]);
-    /// `None` otherwise, and past [`REPLAY_CAP`] samples.
+    /// `None` otherwise, and past [`replay::REPLAY_CAP`] samples.
     replay: Option<Vec<Sample>>,
     /// Once the rows are weighted for a drift: the same run unweighted, kept beside it
     /// (weighting a drift that the rows' discretisation bias outweighs costs accuracy),
     /// and whether its answer was the one given at the last solve
-    /// ([`unweighted_is_better`]).
+    /// ([`replay::unweighted_is_better`]).
     unweighted: Option<(Box<DiscreteMomentum>, bool)>,
 }
 
@@ -210,6 +209,21 @@ impl DiscreteMomentum {
         if self.candidates.is_empty() {
             self.start(s)?;
         }
+        let folded = self.fold(s)?;
+        self.feed_shadow(s);
+        self.samples += 1;
+        if !folded || !self.count_block() {
+            return Ok(None);
+        }
+        self.pick_candidate();
+        self.solve(s.t_s)
+    }
+
+    /// Sample `s` through the row sources still wanted (a source whose candidates are all
+    /// ruled out is no longer fed; the first candidate always is, for the discretisation
+    /// bias), each new row folded into their candidates and, without forgetting, into
+    /// their residual records. Whether a row block was completed.
+    fn fold(&mut self, s: &Sample) -> Result<bool, EstimatorError> {
         let mut folded = false;
         let record = self.config.memory_s.is_none();
         self.residuals
@@ -257,6 +271,11 @@ impl DiscreteMomentum {
                 }
             }
         }
+        Ok(folded)
+    }
+
+    /// Sample `s` to the first candidate's half-rate shadow ([`sigma::discretisation_bias`]).
+    fn feed_shadow(&mut self, s: &Sample) {
         if let Some(shadow) = self.shadow.as_mut() {
             // Every other sample, its gyro rate averaged over the double step: fed one
             // sample late, when the second rate is known.
@@ -271,10 +290,11 @@ impl DiscreteMomentum {
                 }
             }
         }
-        self.samples += 1;
-        if !folded {
-            return Ok(None);
-        }
+    }
+
+    /// Count a completed row block: rule candidates out ([`standing`], [`twins`]), age the
+    /// cross-check's answers. Whether a solve is due (`solve_every`).
+    fn count_block(&mut self) -> bool {
         self.rule_out();
         self.blocks += 1;
         if self.twins.due(self.blocks) {
@@ -284,9 +304,12 @@ impl DiscreteMomentum {
             k.age += 1;
         }
         self.since_solve += 1;
-        if self.since_solve < self.config.solve_every {
-            return Ok(None);
-        }
+        self.since_solve >= self.config.solve_every
+    }
+
+    /// Choose the candidate to solve ([`pick`]) and the alternatives to it
+    /// ([`alternatives_from_s`]).
+    fn pick_candidate(&mut self) {
         self.fits.clear();
         for (i, c) in self.candidates.iter().enumerate() {
             self.fits.push(self.fit(i, c));
@@ -302,6 +325,12 @@ impl DiscreteMomentum {
         self.from_s = self.rows.get(chosen).map_or(from_s, |r| {
             alternatives_from_s(r, from_s, self.config.max_chain_s)
         });
+    }
+
+    /// Solve the chosen candidate at `t_s`, once it has rows for all six unknowns, and give
+    /// the answer its σ and status ([`finish()`]).
+    fn solve(&mut self, t_s: f64) -> Result<Option<Estimate>, EstimatorError> {
+        let record = self.config.memory_s.is_none();
         let Some(c) = self.candidates.get_mut(self.chosen) else {
             return Ok(None);
         };
@@ -309,12 +338,12 @@ impl DiscreteMomentum {
             return Ok(None);
         }
         self.since_solve = 0;
-        let mut e = c.solve_now(s.t_s)?;
+        let mut e = c.solve_now(t_s)?;
         let noise =
             candidate_noise_sigma(&mut self.candidates, self.chosen, self.config.max_chain_s);
         let mut evidence = Streaming {
             run: self,
-            t_s: s.t_s,
+            t_s,
             record,
         };
         if let Finished::Checked { density_ratio } = finish(&mut e, noise, &mut evidence)? {
@@ -389,55 +418,13 @@ impl DiscreteMomentum {
 
 impl Estimator for DiscreteMomentum {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
-        if let Some(buffer) = self.replay.as_mut() {
-            if buffer.len() < REPLAY_CAP {
-                buffer.push(*s);
-            } else {
-                self.replay = None;
-            }
-        }
+        self.keep_for_replay(s);
         let e = self.push_sample(s)?;
         let twin = match self.unweighted.as_mut() {
             Some((t, _)) => t.push_sample(s)?,
             None => None,
         };
-        let (mut e, mut twin) = (e, twin);
-        let drift = match (
-            self.config.attitude_drift_deg_rth,
-            self.config.gyro_noise_rad_s_rthz,
-            e.as_ref().and_then(Estimate::j),
-        ) {
-            (Some(a), Some(g), Some(j)) => AttitudeDrift::new(a, g.to_degrees(), j),
-            _ => None,
-        };
-        if let Some(d) = drift {
-            if self.unweighted.is_some() {
-                // Weighted already: the latest answer's Ĵ for the rows to come.
-                self.set_drift(Some(d));
-            } else if let Some(samples) = self.replay.take() {
-                // The first answer: the run refolded from its first sample with the
-                // rows weighted, the run so far going on unweighted beside it. Should
-                // the refold fail where the unweighted run did not, the run stays
-                // unweighted.
-                if let Ok((fresh, last)) = self.replayed(&samples, d) {
-                    let old = core::mem::replace(self, fresh);
-                    self.unweighted = Some((Box::new(old), false));
-                    (e, twin) = (last, e);
-                }
-            }
-            // Past [`REPLAY_CAP`] samples before the first answer the rows stay
-            // unweighted: weighting only the rows to come is worse than none.
-        }
-        // The unweighted answer where its discretisation and model bias outweigh its
-        // noise ([`unweighted_is_better`]).
-        if let (Some((_, twin_given)), Some(t)) = (self.unweighted.as_mut(), twin) {
-            let take_twin = unweighted_is_better(&t);
-            *twin_given = take_twin;
-            if take_twin {
-                e = Some(t);
-            }
-        }
-        Ok(e)
+        Ok(self.weigh_for_drift(e, twin))
     }
 
     fn gaps(&self) -> usize {
@@ -490,7 +477,7 @@ impl Estimator for DiscreteMomentum {
 }
 
 /// The streaming run at a solve, as the σ and the status of its answer see it
-/// ([`finish`]).
+/// ([`finish()`]).
 struct Streaming<'a> {
     run: &'a mut DiscreteMomentum,
     /// The solve's time stamp (the cross-check's own solves).

@@ -9,6 +9,7 @@ use super::DiscreteMomentum;
 use crate::estimator::attitude_drift::AttitudeDrift;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::sample::Sample;
+use std::boxed::Box;
 
 /// Whether the unweighted rows' answer `e` is to be given rather than the rows
 /// weighted for an attitude drift: where its bias σ (discretisation and model spread)
@@ -70,5 +71,66 @@ impl DiscreteMomentum {
         if let Some(shadow) = self.shadow.as_deref_mut() {
             shadow.set_drift(drift);
         }
+    }
+
+    /// Keep sample `s` for the replay while the first answer is awaited, up to
+    /// [`REPLAY_CAP`] samples.
+    pub(super) fn keep_for_replay(&mut self, s: &Sample) {
+        if let Some(buffer) = self.replay.as_mut() {
+            if buffer.len() < REPLAY_CAP {
+                buffer.push(*s);
+            } else {
+                self.replay = None;
+            }
+        }
+    }
+
+    /// The answer to give, from this run's answer `e` and the unweighted twin's `twin` at
+    /// the same sample: at the first answer, with a drift to weight for, the run is
+    /// replayed with the rows weighted ([`Self::replayed`]) and goes on as the unweighted
+    /// twin; later answers update the weights ([`Self::set_drift`]); the twin's answer is
+    /// given where [`unweighted_is_better`].
+    pub(super) fn weigh_for_drift(
+        &mut self,
+        e: Option<Estimate>,
+        twin: Option<Estimate>,
+    ) -> Option<Estimate> {
+        let (mut e, mut twin) = (e, twin);
+        let drift = match (
+            self.config.attitude_drift_deg_rth,
+            self.config.gyro_noise_rad_s_rthz,
+            e.as_ref().and_then(Estimate::j),
+        ) {
+            (Some(a), Some(g), Some(j)) => AttitudeDrift::new(a, g.to_degrees(), j),
+            _ => None,
+        };
+        if let Some(d) = drift {
+            if self.unweighted.is_some() {
+                // Weighted already: the latest answer's Ĵ for the rows to come.
+                self.set_drift(Some(d));
+            } else if let Some(samples) = self.replay.take() {
+                // The first answer: the run refolded from its first sample with the
+                // rows weighted, the run so far going on unweighted beside it. Should
+                // the refold fail where the unweighted run did not, the run stays
+                // unweighted.
+                if let Ok((fresh, last)) = self.replayed(&samples, d) {
+                    let old = core::mem::replace(self, fresh);
+                    self.unweighted = Some((Box::new(old), false));
+                    (e, twin) = (last, e);
+                }
+            }
+            // Past [`REPLAY_CAP`] samples before the first answer the rows stay
+            // unweighted: weighting only the rows to come is worse than none.
+        }
+        // The unweighted answer where its discretisation and model bias outweigh its
+        // noise ([`unweighted_is_better`]).
+        if let (Some((_, twin_given)), Some(t)) = (self.unweighted.as_mut(), twin) {
+            let take_twin = unweighted_is_better(&t);
+            *twin_given = take_twin;
+            if take_twin {
+                e = Some(t);
+            }
+        }
+        e
     }
 }
