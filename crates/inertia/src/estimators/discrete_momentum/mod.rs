@@ -1,23 +1,39 @@
-//! The discrete momentum estimator ([`crate::estimator::discrete_momentum`]) in the
+//! The discrete momentum estimator ([`crate::estimator::discrete_momentum`]: the paper's
+//! rows, eqs. 46–54, telescoped into a discrete conservation of angular momentum) in the
 //! pipeline, with the row model chosen from the data.
 //!
 //! The wheel momentum between samples is estimated with `j` by default
-//! ([`crate::estimator::momentum_rows::Stencil::Adaptive`]). Where the settings leave a choice open (the rotation source
-//! when the telemetry has gyro rates, and the chain length: `--chain`, a quarter and 4×
-//! as long, and the whole record as one chain, whose σ comes from its chained siblings'
-//! jackknife: [`chained_siblings`]), every candidate row model folds every sample (the
-//! candidates that differ only in the chain length from one shared row source), and each
-//! solve uses the candidate [`pick`] picks: first by fit ([`select::choose`]: of those whose
-//! residual variance `ρ²/(rows − unknowns)` the data cannot tell from the smallest, the
-//! one with the longest chains; a noisier rotation source, or chains long enough for an
-//! attitude drift to show, leave larger residuals), then by steadiness ([`select::steadier`]: the
-//! same rows in longer chains whose jackknife σ is clearly smaller).
-//! The σ of the answer is assembled here from the chosen candidate's noise σ
+//! ([`crate::estimator::momentum_rows::Stencil::Adaptive`]). Where the settings leave a
+//! choice open (the rotation source when the telemetry has gyro rates, and the chain
+//! length: `--chain`, a quarter and 4× as long, and the whole record as one chain, whose
+//! σ comes from its chained siblings' jackknife: [`chained_siblings`]), every candidate
+//! row model folds every sample (the candidates that differ only in the chain length from
+//! one shared row source), and each solve uses the candidate [`pick`] picks: first by fit
+//! ([`select::choose`]: of those whose residual variance `ρ²/(rows − unknowns)` the data
+//! cannot tell from the smallest, the one with the longest chains; a noisier rotation
+//! source, or chains long enough for an attitude drift to show, leave larger residuals),
+//! then by steadiness ([`select::steadier`]: the same rows in longer chains whose
+//! jackknife σ is clearly smaller). The σ of the answer is the chosen candidate's noise σ
 //! ([`crate::estimator::jackknife`]) and three bias terms: the discretisation bias from a
 //! half-rate shadow of the first candidate, the spread of indistinguishable candidates,
-//! and the cross-check of the rotation sources ([`cross_check::reconcile`]). A candidate that has fitted
-//! markedly worse than the best for long is ruled out and no longer folded
-//! ([`standing`]).
+//! and the cross-check of the rotation sources ([`cross_check::reconcile`]). A candidate
+//! that has fitted markedly worse than the best for long is ruled out and no longer
+//! folded ([`standing`]).
+//!
+//! One job per file:
+//!
+//! * here: the registry entry [`DISCRETE_MOMENTUM`], the estimator's state and its push,
+//!   sample by sample: fold ([`DiscreteMomentum::fold`]), count the row block, pick,
+//!   solve;
+//! * [`candidates`](mod@candidates): the candidate row models, their settings and shared row sources;
+//! * [`select`]: which candidate answers;
+//! * [`sigma`]: the parts of σ;
+//! * [`cross_check`]: the candidates' answers against each other;
+//! * [`finish`](mod@finish): σ and status of an answer, one sequence for the recursive path and
+//!   [`batch`] (the whole record at once);
+//! * [`replay`]: the attitude drift weighting's refold and its unweighted twin;
+//! * [`standing`] and [`twins`]: which candidates stop being folded;
+//! * `tests`: the unit tests.
 
 mod batch;
 mod candidates;
