@@ -6,7 +6,7 @@
 //! defaults (physical constraint set, uncertainty, audit). A third measurement takes the
 //! same slew for 600 s and times the samples after 400 s: by then (3000 row blocks) the
 //! gyro-propagated attitude has been found to be the gyro's own integral and only the
-//! four gyro candidates are folded (`pipeline/twins.rs`).
+//! four gyro candidates are folded (`estimators/discrete_momentum/twins.rs`).
 //!
 //! A `Pipeline` cannot be cloned, so each measurement builds one, feeds it the first
 //! 200 s (400 s) untimed, and times the samples after that (the estimate is determined

@@ -91,6 +91,8 @@ pub mod discrete_momentum;
 pub mod dynamics;
 mod eigen3;
 pub mod estimator;
+#[cfg(feature = "std")]
+mod estimators;
 pub mod fix;
 mod givens;
 mod householder;

@@ -48,7 +48,7 @@ impl AttitudeChecks {
     }
 
     /// Check estimate `e` of input sample `index`: stop where it shows a wheel momentum
-    /// of the opposite sign ([`reversed_momentum`]).
+    /// of the opposite sign ([`PipelineError::ReversedMomentum`]).
     pub fn estimate(&self, index: usize, e: &Estimate) -> Result<(), PipelineError> {
         reversed_momentum(e, Some(index), self.tau_given, || self.convention.verdict())
     }

@@ -45,14 +45,11 @@
 //! ```
 
 mod checks;
-mod discrete_momentum;
 mod momentum;
 pub mod registry;
 mod run;
 mod sdp;
 mod settings;
-mod standing;
-mod twins;
 
 #[cfg(feature = "csv")]
 pub mod history;

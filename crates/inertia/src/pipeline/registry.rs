@@ -157,7 +157,7 @@ pub struct BackendEntry {
 /// Every estimator, the default first.
 pub static ESTIMATORS: &[EstimatorEntry] = &[
     super::sdp::VARIATIONAL,
-    super::discrete_momentum::DISCRETE_MOMENTUM,
+    crate::estimators::discrete_momentum::DISCRETE_MOMENTUM,
     super::sdp::FINITE_DIFFERENCE,
     super::momentum::MOMENTUM,
 ];

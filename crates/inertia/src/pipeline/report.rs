@@ -392,7 +392,7 @@ impl fmt::Display for ReportText<'_> {
             writeln!(
                 s,
                 "rotation: the attitude is the gyro's own integral (their answers agree within {} σ), so its rows are the gyro's and are folded once",
-                super::twins::TWIN_Z
+                crate::estimators::discrete_momentum::twins::TWIN_Z
             )?;
         }
         writeln!(s, "status: {}{fixes}", r.observability)?;

@@ -53,7 +53,7 @@ pub struct PipelineSettings {
     /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
     /// a quarter and 4× as long and the whole record as one chain are folded too, and each
     /// solve takes the longest that fits as well, or a longer one that is clearly
-    /// steadier (`pipeline::discrete_momentum`). Default
+    /// steadier (`estimators/discrete_momentum/select.rs`). Default
     /// [`DEFAULT_MAX_CHAIN_S`]; `None`: chains end only at gaps.
     pub max_chain_s: Option<f64>,
     /// Angle random walk of the attitude solution, deg/√h (discrete momentum estimator):

@@ -1,5 +1,5 @@
 //! Which candidate row models of the discrete momentum pipeline
-//! ([`super::discrete_momentum`]) the data have ruled out, so that they stop costing a
+//! ([`super`]) the data have ruled out, so that they stop costing a
 //! fold per sample.
 //!
 //! A candidate whose residual variance is beyond `v_min · max(COMPARABLE_FIT, 1 +
@@ -13,7 +13,7 @@
 //! would have stayed beyond the limit; a model that fitted markedly worse over that long
 //! is taken not to come back.
 
-use super::discrete_momentum::COMPARABLE_FIT;
+use super::cross_check::COMPARABLE_FIT;
 use std::vec::Vec;
 
 /// Consecutive row blocks beyond the limit after which a candidate is ruled out.

@@ -4,7 +4,7 @@
 //! ([`crate::estimator::momentum_rows`], "Rotation source") carry the same noise, and
 //! their answers differ only by the two integrations' rounding and coning terms. Folding
 //! both then doubles the work for nothing, and their cross-check
-//! ([`super::discrete_momentum`]) cannot fail: it is not a check.
+//! ([`super`]) cannot fail: it is not a check.
 //!
 //! The test is made on the answers, in the units that matter: every
 //! [`TWIN_CHECK_EVERY`] row blocks from [`TWIN_FROM`] on, each pair of candidates that
@@ -160,8 +160,8 @@ pub(crate) fn ratio(
 
 #[cfg(test)]
 mod tests {
+    use super::super::standing::RULE_OUT_AFTER;
     use super::*;
-    use crate::pipeline::standing::RULE_OUT_AFTER;
     use nalgebra::{Matrix6, Vector6};
 
     #[test]

@@ -1,0 +1,286 @@
+//! The discrete momentum estimator over a whole record at once (`--batch`): every
+//! candidate reduced in one pass, chosen as the recursive path chooses ([`pick`]), its σ
+//! and status given by the same sequence ([`finish`]).
+
+use super::candidates::{candidates, chained_siblings};
+use super::cross_check::COMPARABLE_FIT;
+use super::finish::{finish, Evidence, Finished};
+use super::select::{alternatives_from_s, in_running, pick};
+use super::sigma::{discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife};
+use super::standing::RULE_OUT_AFTER;
+use super::twins;
+use super::DISCRETE_MOMENTUM;
+use crate::estimator::consistency::{self, ResidualSegments};
+use crate::estimator::discrete_momentum::{reduce_batch, torque_tested, BatchReduction};
+use crate::estimator::excitation::diagnose;
+use crate::estimator::jackknife::robust_sigma;
+use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
+use crate::estimator::observability::Observability;
+use crate::estimator::prior;
+use crate::estimator::qr::RecursiveQr;
+use crate::estimator::uncertainty::noise_sigma;
+use crate::estimator::{batch, Estimate, EstimatorError};
+use crate::pipeline::registry::{self, BatchOutput};
+use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::sample::Sample;
+use crate::solver::Backend;
+use crate::tensor::InertiaVector;
+use std::boxed::Box;
+use std::vec::Vec;
+
+/// A failed row or solve, with the sample it concerns where there is one.
+fn wrap(source: EstimatorError) -> PipelineError {
+    PipelineError::Estimator {
+        sample: match source {
+            EstimatorError::Row { sample, .. } => Some(sample),
+            _ => None,
+        },
+        source,
+    }
+}
+
+pub(super) fn run_batch(
+    samples: &[Sample],
+    c: &PipelineConfig,
+) -> Result<BatchOutput, PipelineError> {
+    // The drift weighting needs an estimate of J before each row is folded: recursive
+    // runs only.
+    if c.attitude_drift_deg_rth.is_some() {
+        return Err(PipelineError::NotApplicable {
+            setting: "attitude_drift_deg_rth",
+            estimator: "discrete-momentum batch",
+        });
+    }
+    let has_gyro = samples.first().is_some_and(|s| s.omega_rad_s.is_some());
+    let mut reduced: Vec<(MomentumRowSettings, BatchReduction)> = Vec::new();
+    for rows in candidates(c, has_gyro) {
+        reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
+    }
+    let attitude_is_gyro_integral = drop_batch_twins(&mut reduced, c);
+    let fits: Vec<(f64, f64, Option<f64>)> = reduced
+        .iter()
+        .map(|(rows, b)| {
+            (
+                b.qr.residual_variance(),
+                b.qr.residual_dof(),
+                rows.max_chain_s,
+            )
+        })
+        .collect();
+    let rows: Vec<MomentumRowSettings> = reduced.iter().map(|(r, _)| *r).collect();
+    let (chosen, from_s) = pick(&fits, &rows, |i| {
+        reduced.get(i).and_then(|(_, b)| b.jackknife_sigma_kg_m2)
+    });
+    let from_s = rows
+        .get(chosen)
+        .map_or(from_s, |r| alternatives_from_s(r, from_s, c.max_chain_s));
+    let Some((rows, batch)) = reduced.get(chosen) else {
+        return Err(PipelineError::NoBatch {
+            estimator: DISCRETE_MOMENTUM.name,
+        });
+    };
+    let (tested, torque_test) = torque_tested(batch.qr, batch.without_torque);
+    let mut run = BatchRun {
+        samples,
+        config: c,
+        reduced: &reduced,
+        chosen,
+        from_s,
+        tested,
+        // The chosen rows with the prior's: what the audit judges.
+        augmented: prior::augment(&tested, &c.constraints).0,
+        backend: registry::build_backend(c.backend),
+        t_s: samples.last().map_or(0.0, |s| s.t_s),
+        others: Vec::new(),
+    };
+    let (mut estimate, noise) = run.own(chosen)?;
+    // (The span test needs the recursive residuals, which a batch reduction does not
+    // form.)
+    let gyro_density_ratio = match finish(&mut estimate, noise, &mut run)? {
+        Finished::Checked { density_ratio } => density_ratio,
+        Finished::Reversed => None,
+    };
+    Ok(BatchOutput {
+        gyro_density_ratio,
+        estimate,
+        excitation: Some(diagnose(&tested, &c.observability)),
+        gaps: batch.gaps,
+        row_model: Some(*rows),
+        torque_test,
+        attitude_is_gyro_integral,
+    })
+}
+
+/// The batch run's candidates once one is chosen, as the σ and the status of its answer
+/// see them ([`finish`]).
+struct BatchRun<'a> {
+    samples: &'a [Sample],
+    config: &'a PipelineConfig,
+    /// Every candidate's rows and their reduction.
+    reduced: &'a [(MomentumRowSettings, BatchReduction)],
+    chosen: usize,
+    /// The shortest chain of an alternative ([`alternatives_from_s`]).
+    from_s: f64,
+    /// The chosen candidate's rows, torque-tested ([`torque_tested`]).
+    tested: RecursiveQr,
+    /// The same with the prior's rows.
+    augmented: RecursiveQr,
+    backend: Box<dyn Backend + Send>,
+    /// The answers' time stamp: the last sample's.
+    t_s: f64,
+    /// The other candidates' answers for the cross-check.
+    others: Vec<(InertiaVector, [f64; 6])>,
+}
+
+impl BatchRun<'_> {
+    /// Candidate `i`'s own answer and noise σ (for the whole record as one chain, at least
+    /// its chained siblings' jackknife σ: [`chained_siblings`]).
+    fn own(&mut self, i: usize) -> Result<(Estimate, Option<[f64; 6]>), PipelineError> {
+        let (reduced, c) = (self.reduced, self.config);
+        let (rows, b) = &reduced[i];
+        let sibling = sibling_jackknife(
+            chained_siblings(
+                rows,
+                reduced.iter().map(|(r, _)| r),
+                c.max_chain_s.unwrap_or(0.0),
+            )
+            .map(|k| reduced[k].1.jackknife_sigma_kg_m2),
+        );
+        // As the recursive solve does: the torque held at zero where the data give no
+        // evidence of one.
+        let (tested, _) = torque_tested(b.qr, b.without_torque);
+        let e = batch::solve_reduced(
+            &tested,
+            self.t_s,
+            &c.constraints,
+            &mut *self.backend,
+            &c.observability,
+            c.gyro_noise_rad_s_rthz,
+        )
+        .map_err(wrap)?;
+        // With prior knowledge, σ is the least-squares one of the data and the prior
+        // together, or the data's own jackknife σ where that is larger (the batch
+        // jackknife's delete-one solves carry no prior: conservative).
+        let (solved, _) = prior::augment(&tested, &c.constraints);
+        let jackknife = sibling_jackknife([b.jackknife_sigma_kg_m2, sibling].into_iter());
+        let svd = nalgebra::SVD::try_new(
+            solved.r,
+            false,
+            true,
+            f64::EPSILON,
+            crate::math::MAX_DECOMPOSITION_ITERATIONS,
+        );
+        let noise = svd.and_then(|svd| {
+            let v_t = svd.v_t?;
+            noise_sigma(&solved, &svd.singular_values, &v_t.transpose())
+                .map(|ls| robust_sigma(&prior::zero_fixed(ls, &c.constraints), jackknife.as_ref()))
+        });
+        Ok((e, noise))
+    }
+}
+
+impl Evidence for BatchRun<'_> {
+    type Error = PipelineError;
+
+    fn config(&self) -> &PipelineConfig {
+        self.config
+    }
+
+    fn solved(&self) -> &RecursiveQr {
+        &self.augmented
+    }
+
+    fn data(&self) -> &RecursiveQr {
+        &self.tested
+    }
+
+    fn model_spread(&self) -> [f64; 6] {
+        let others = self
+            .reduced
+            .iter()
+            .enumerate()
+            .filter(|&(i, (r, _))| i != self.chosen && in_running(r, self.from_s))
+            .map(|(_, (_, b))| b.qr);
+        model_spread(
+            &self.tested,
+            others,
+            self.config.gyro_noise_rad_s_rthz,
+            &self.config.constraints,
+        )
+    }
+
+    fn discretisation_bias(&self) -> [f64; 6] {
+        // The first candidate on every other sample, as the recursive path's shadow.
+        let half: Vec<Sample> = self
+            .samples
+            .chunks_exact(2)
+            .map(|p| double_step(&p[0], &p[1]))
+            .collect();
+        match (self.reduced.first(), self.config.gyro_noise_rad_s_rthz) {
+            (Some((first, full)), gyro) => match reduce_batch(&half, first) {
+                Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &self.config.constraints),
+                Err(_) => [0.0; 6],
+            },
+            _ => [0.0; 6],
+        }
+    }
+
+    fn cross_check(&mut self, _: &Estimate) -> Result<&[(InertiaVector, [f64; 6])], PipelineError> {
+        let reduced = self.reduced;
+        let best_variance = reduced[self.chosen].1.qr.residual_variance();
+        self.others.clear();
+        for (i, (r, b)) in reduced.iter().enumerate() {
+            if i == self.chosen
+                || !in_running(r, self.from_s)
+                || !(b.qr.residual_variance() <= COMPARABLE_FIT * best_variance)
+            {
+                continue;
+            }
+            if let (e, Some(sigma)) = self.own(i)? {
+                if let (Observability::Determined { .. }, Some(jb)) = (e.observability, e.j()) {
+                    self.others.push((jb, sigma));
+                }
+            }
+        }
+        Ok(&self.others)
+    }
+
+    fn density_ratio(&self, j: &InertiaVector, g: f64) -> Option<f64> {
+        // The gyro rotation's rows are the ones the density describes.
+        self.reduced
+            .iter()
+            .find(|(rows, _)| rows.rotation == RotationSource::Gyro)
+            .and_then(|(_, b)| consistency::gyro_density_ratio(&b.qr, j, g))
+    }
+
+    fn residuals(&mut self, _: &Estimate) -> Option<&ResidualSegments> {
+        None
+    }
+}
+
+/// The batch form of the test for an attitude that is the gyro's own integral
+/// ([`twins`]): over a record of at least [`RULE_OUT_AFTER`] row blocks (the
+/// recursive test's horizon), the pairs of candidates that differ only in the rotation
+/// source are compared once, on the whole record; within [`twins::TWIN_Z`], the
+/// attitude's candidates are left out. `Some(verdict)` where the test was made, `None`
+/// for a shorter record or without both sources.
+pub(super) fn drop_batch_twins(
+    reduced: &mut Vec<(MomentumRowSettings, BatchReduction)>,
+    c: &PipelineConfig,
+) -> Option<bool> {
+    let rows: Vec<MomentumRowSettings> = reduced.iter().map(|(r, _)| *r).collect();
+    let pairs = twins::pairs(&rows, |_| true);
+    let blocks = reduced.first().map_or(0, |(_, b)| b.qr.rows / 3);
+    if pairs.clone().next().is_none() || blocks < RULE_OUT_AFTER {
+        return None;
+    }
+    let worst = twins::worst(pairs, |i| {
+        own_answer(&reduced[i].1.qr, c.gyro_noise_rad_s_rthz, &c.constraints)
+    });
+    // Every attitude candidate has a twin where the verdict is `Same` ([`twins::worst`]).
+    let same = worst.is_some_and(|z| z <= twins::TWIN_Z);
+    if same {
+        reduced.retain(|(r, _)| r.rotation != RotationSource::Attitude);
+    }
+    Some(same)
+}

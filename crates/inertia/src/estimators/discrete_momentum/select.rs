@@ -1,0 +1,138 @@
+//! Which candidate answers: the best fit ([`choose`]), unless the same rows in longer chains
+//! are clearly steadier ([`steadier`]); [`pick`] combines the two, and the chains still in
+//! the running are the alternatives for the model spread and the cross-check
+//! ([`in_running`], [`alternatives_from_s`]).
+
+use super::sigma::frobenius;
+use crate::estimator::momentum_rows::MomentumRowSettings;
+
+/// How many times smaller a longer chain's jackknife σ must be than that of the chain
+/// [`choose`] picked for it to take its place ([`steadier`]): the
+/// jackknife σ of 8 groups has a relative standard error of about 0.27, so this is about
+/// two of them.
+pub(super) const STEADIER: f64 = 1.5;
+
+/// The candidate to solve, from `(residual variance, residual degrees of freedom, chain
+/// length)` per candidate: of those whose residual variance is within `1 + 3√(2/ν)` of
+/// the smallest (`ν` its degrees of freedom: the data cannot tell them apart), the one
+/// with the longest chains (more of the momentum's history ties `j` down), then the
+/// smallest variance. Chains that a drifting attitude or a varying torque would spoil
+/// fit worse, and lose. `0` when no variance is finite.
+pub(super) fn choose(
+    candidates: impl Iterator<Item = (f64, f64, Option<f64>)> + Clone,
+    from_s: f64,
+) -> usize {
+    let length = |c: Option<f64>| c.unwrap_or(f64::INFINITY);
+    let candidates = candidates.map(|(v, d, c)| {
+        if length(c) >= from_s {
+            (v, d, c)
+        } else {
+            (f64::INFINITY, d, c)
+        }
+    });
+    let (mut v_min, mut dof) = (f64::INFINITY, 0.0);
+    for (v, d, _) in candidates.clone() {
+        if v < v_min {
+            (v_min, dof) = (v, d);
+        }
+    }
+    if !v_min.is_finite() || !(dof > 0.0) {
+        return 0;
+    }
+    let limit = v_min * (1.0 + 3.0 * (2.0 / dof).sqrt());
+    let mut out: Option<(usize, f64, f64)> = None;
+    for (i, (v, _, chain)) in candidates.enumerate() {
+        if !(v <= limit) {
+            continue;
+        }
+        let better = match out {
+            None => true,
+            Some((_, l, vb)) => length(chain) > l || (length(chain) == l && v < vb),
+        };
+        if better {
+            out = Some((i, length(chain), v));
+        }
+    }
+    out.map_or(0, |o| o.0)
+}
+
+/// The candidate to use and the shortest chain still in the running: [`choose`]'s pick
+/// by fit, unless [`steadier`] finds the same rows in longer chains clearly steadier;
+/// then [`choose`]'s pick among the chains at least that long (where the data cannot
+/// tell a longer chain, or the whole record, from it, the longer one), and the shorter
+/// chains are out of the running (not alternatives for the model spread or the
+/// cross-check either). `fits` as for [`choose`]; `jackknife(i)`, candidate `i`'s
+/// jackknife σ (`None`: none, or ruled out).
+pub(super) fn pick(
+    fits: &[(f64, f64, Option<f64>)],
+    rows: &[MomentumRowSettings],
+    mut jackknife: impl FnMut(usize) -> Option<[f64; 6]>,
+) -> (usize, f64) {
+    let fitted = choose(fits.iter().copied(), 0.0);
+    let steady = steadier(fitted, rows, &mut jackknife);
+    if steady == fitted {
+        return (fitted, 0.0);
+    }
+    let from_s = rows
+        .get(steady)
+        .and_then(|r| r.max_chain_s)
+        .unwrap_or(f64::INFINITY);
+    (choose(fits.iter().copied(), from_s), from_s)
+}
+
+/// Whether a candidate with these rows is still in the running ([`pick`]).
+pub(super) fn in_running(rows: &MomentumRowSettings, from_s: f64) -> bool {
+    rows.max_chain_s.unwrap_or(f64::INFINITY) >= from_s
+}
+
+/// The shortest chain that is an alternative to the chosen candidate for the model spread
+/// and the cross-check: in the running ([`pick`]), and no shorter than `--chain` (`chain_s`)
+/// unless the chosen one is. The shortest chains (`--chain`/[`super::candidates::SHORT_CHAIN_DIVISOR`]) are
+/// there for drifts that only they remove; where they are not chosen, the scatter of their
+/// answers, with four times the initial momenta, is their noise, not a model
+/// uncertainty of the chosen answer.
+pub(super) fn alternatives_from_s(
+    chosen: &MomentumRowSettings,
+    from_s: f64,
+    chain_s: Option<f64>,
+) -> f64 {
+    let length = chosen.max_chain_s.unwrap_or(f64::INFINITY);
+    from_s.max(length.min(chain_s.unwrap_or(0.0)))
+}
+
+/// The candidate to use instead of `fitted`: one with the same rows in longer chains
+/// whose jackknife σ is [`STEADIER`] times smaller, the smallest such. Shorter chains fit
+/// better wherever the rows' errors drift (the fit test sees the drift), but each chain's
+/// initial momenta cost information: where the scatter of the answer across chains,
+/// which includes the drift's effect on it, is clearly smaller for longer chains, the
+/// drift costs less than the extra unknowns. `fitted` itself when it is the whole record
+/// or has no jackknife σ.
+pub(super) fn steadier(
+    fitted: usize,
+    rows: &[MomentumRowSettings],
+    jackknife: &mut impl FnMut(usize) -> Option<[f64; 6]>,
+) -> usize {
+    let Some(r0) = rows.get(fitted) else {
+        return fitted;
+    };
+    let Some(length) = r0.max_chain_s else {
+        return fitted;
+    };
+    let Some(s0) = jackknife(fitted) else {
+        return fitted;
+    };
+    let mut best = (fitted, frobenius(&s0) / STEADIER);
+    for (i, r) in rows.iter().enumerate() {
+        let longer = r.max_chain_s.is_some_and(|l| l > length);
+        if !longer || r.rows_only() != r0.rows_only() {
+            continue;
+        }
+        if let Some(s) = jackknife(i) {
+            let s = frobenius(&s);
+            if s < best.1 {
+                best = (i, s);
+            }
+        }
+    }
+    best.0
+}
