@@ -565,6 +565,8 @@ impl Plan {
             rotation_source: self.rotation_source,
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
+            // Not in the C settings yet: the fixed-size engine has no inertial torque.
+            inertial_torque: inertia::pipeline::InertialTorque::Off,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,

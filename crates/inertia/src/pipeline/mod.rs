@@ -60,7 +60,7 @@ pub use checks::AttitudeChecks;
 pub use registry::{BatchOutput, Capabilities, Estimator};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
 pub use sdp::Constrained;
-pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
+pub use settings::{InertialTorque, PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
@@ -105,6 +105,16 @@ pub enum PipelineError {
         /// Its value.
         value: f64,
         /// What it must be.
+        expected: &'static str,
+    },
+    /// A setting named a value it does not have.
+    #[error("setting `{setting}`: unknown value `{}` (known: {expected})", crate::text::Clipped::new(.value))]
+    UnknownChoice {
+        /// The setting.
+        setting: &'static str,
+        /// The value given.
+        value: String,
+        /// The values it has.
         expected: &'static str,
     },
     /// A setting that needs another one.
