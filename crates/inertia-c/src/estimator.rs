@@ -1,7 +1,7 @@
 //! The estimator handle: creation on the heap or in caller storage, push, reading the
 //! estimate, reset and free.
 
-use crate::engine::{self, Engine};
+use crate::engine::Engine;
 use crate::estimate::InertiaEstimate;
 use crate::message;
 use crate::settings::{InertiaSettings, Plan};
@@ -9,11 +9,11 @@ use crate::status::{fail, fixes, guard, guard_or, null, pipeline_fail, InertiaSt
 use core::ffi::{c_char, c_void};
 use core::fmt::Write as _;
 use core::mem::{align_of, size_of};
+use inertia::error_kind::ErrorKind;
 use inertia::estimator::Estimate;
 use inertia::fix::Fix;
 use inertia::pipeline::{check_first_step, Pipeline};
-use inertia::sample::{check_range, Sample};
-use nalgebra::Vector3;
+use inertia::telemetry::gate::{Field, Gate, RawSample, SampleError};
 
 /// One telemetry sample at time `t_s` (README "Estimating your own telemetry").
 #[repr(C)]
@@ -42,8 +42,10 @@ pub struct InertiaEstimator {
     /// storage.
     pub(crate) heap: bool,
     pub(crate) stopped: bool,
-    pub(crate) has_w: Option<bool>,
-    pub(crate) last_t_s: Option<f64>,
+    /// The library's sample gate (no heap): values, time order, gyro rates all-or-none.
+    pub(crate) gate: Gate,
+    /// The first sample's time, s.
+    pub(crate) t0_s: Option<f64>,
     pub(crate) samples: u64,
     pub(crate) last: Option<Estimate>,
     /// The memory and resampling settings, for the library's check of the first step
@@ -58,8 +60,8 @@ impl InertiaEstimator {
             engine,
             heap,
             stopped: false,
-            has_w: None,
-            last_t_s: None,
+            gate: Gate::default(),
+            t0_s: None,
             samples: 0,
             last: None,
             memory_s: plan.memory_s,
@@ -69,82 +71,61 @@ impl InertiaEstimator {
 
     fn push(&mut self, s: &InertiaSample) -> InertiaStatus {
         if self.stopped {
-            return fail(
+            let status = fail(
                 InertiaStatus::Stopped,
                 format_args!("the estimator stopped on an earlier error: reset it"),
             );
-        }
-        let t = [s.t_s];
-        let values = t
-            .iter()
-            .chain(&s.q)
-            .chain(&s.rho_nms)
-            .chain(&s.tau_nm)
-            .chain(if s.has_w != 0 { &s.w_rad_s[..] } else { &[] });
-        if let Some(v) = values.copied().find(|v| !v.is_finite()) {
-            return fail(
-                InertiaStatus::NotFinite,
-                format_args!(
-                    "sample {}: a value is {v}: every value must be finite",
-                    self.samples
-                ),
-            );
+            message::set_kind(Some(ErrorKind::Stopped), Some(self.samples));
+            return status;
         }
         let has_w = s.has_w != 0;
-        if self.has_w.is_some_and(|h| h != has_w) {
-            return fail(
-                InertiaStatus::Data,
-                format_args!(
-                    "sample {}: has_w = {} where the earlier samples had {}: gyro rates must be given for every sample or none",
-                    self.samples,
-                    u8::from(has_w),
-                    u8::from(!has_w)
-                ),
-            );
-        }
         if !has_w && self.engine.needs_gyro() {
-            return fail(
+            let status = fail(
                 InertiaStatus::Data,
                 format_args!("this estimator needs gyro rates (has_w) in every sample"),
             );
+            message::set_kind(Some(ErrorKind::NeedsGyro), Some(self.samples));
+            return status;
         }
-        if let (Some(t0), 1) = (self.last_t_s, self.samples) {
+        // The library's sample gate; a refused sample leaves it (and this estimator) as
+        // it was. `InertiaSample::q` is scalar last, Hamilton: the gate's default.
+        let before = self.gate;
+        let sample = match self.gate.check(&RawSample {
+            t_s: s.t_s,
+            q: s.q,
+            rho_nms: s.rho_nms,
+            tau_nm: Some(s.tau_nm),
+            w_rad_s: has_w.then_some(s.w_rad_s),
+        }) {
+            Ok(sample) => sample,
+            Err(e) => {
+                let status = match e {
+                    SampleError::NotFinite { .. } => InertiaStatus::NotFinite,
+                    SampleError::OutOfRange { .. } | SampleError::NonUnitQuaternion { .. } => {
+                        InertiaStatus::OutOfRange
+                    }
+                    _ => InertiaStatus::Data,
+                };
+                let status = fail(
+                    status,
+                    format_args!("sample {}: {}: {e}", self.samples, field_name(e.field())),
+                );
+                message::set_kind(Some(e.error_kind()), Some(self.samples));
+                return status;
+            }
+        };
+        if let (Some(t0), 1) = (self.t0_s, self.samples) {
             if let Err(e) = check_first_step(self.memory_s, self.resample_s, s.t_s - t0) {
-                return fail(
+                self.gate = before;
+                let status = fail(
                     InertiaStatus::InvalidSetting,
                     format_args!("sample 1: {e}{}", fixes(&[Fix::Memory])),
                 );
+                message::set_kind(Some(ErrorKind::MemoryShorterThanStep), Some(1));
+                return status;
             }
         }
-        if let Some(t0) = self.last_t_s {
-            if !(s.t_s > t0) {
-                return fail(
-                    InertiaStatus::Data,
-                    format_args!(
-                        "sample {}: time {} s does not increase (previous {} s)",
-                        self.samples,
-                        inertia::text::Num(s.t_s),
-                        inertia::text::Num(t0)
-                    ),
-                );
-            }
-        }
-        let mut sample = Sample {
-            t_s: s.t_s,
-            q: inertia::attitude::Quaternion::from_xyzw(s.q),
-            rho_nms: Vector3::from(s.rho_nms),
-            tau_nm: Vector3::from(s.tau_nm),
-            omega_rad_s: has_w.then(|| Vector3::from(s.w_rad_s)),
-        };
-        if let Err(e) = check_range(&sample) {
-            return fail(
-                InertiaStatus::OutOfRange,
-                format_args!("sample {}: {e}", self.samples),
-            );
-        }
-        sample.q = engine::unit(s.q);
-        self.has_w = Some(has_w);
-        self.last_t_s = Some(s.t_s);
+        self.t0_s.get_or_insert(s.t_s);
         self.samples += 1;
         match self.engine.push(&sample) {
             Ok(Some(e)) => {
@@ -166,8 +147,8 @@ impl InertiaEstimator {
             return pipeline_fail(&e);
         }
         self.stopped = false;
-        self.has_w = None;
-        self.last_t_s = None;
+        self.gate = Gate::default();
+        self.t0_s = None;
         self.samples = 0;
         self.last = None;
         InertiaStatus::Ok
@@ -405,4 +386,20 @@ pub unsafe extern "C" fn inertia_estimator_free(est: *mut InertiaEstimator) {
         }
         InertiaStatus::Ok
     });
+}
+
+/// The `InertiaSample` field of a gate's [`Field`].
+fn field_name(f: Field) -> &'static str {
+    const Q: [&str; 4] = ["q[0]", "q[1]", "q[2]", "q[3]"];
+    const RHO: [&str; 3] = ["rho_nms[0]", "rho_nms[1]", "rho_nms[2]"];
+    const TAU: [&str; 3] = ["tau_nm[0]", "tau_nm[1]", "tau_nm[2]"];
+    const W: [&str; 3] = ["w_rad_s[0]", "w_rad_s[1]", "w_rad_s[2]"];
+    match f {
+        Field::Time => "t_s",
+        Field::Quaternion(k) => Q.get(k).copied().unwrap_or("q"),
+        Field::QuaternionNorm => "q",
+        Field::Rho(k) => RHO.get(k).copied().unwrap_or("rho_nms"),
+        Field::Tau(k) => TAU.get(k).copied().unwrap_or("tau_nm"),
+        Field::Rate(k) => W.get(k).copied().unwrap_or("w_rad_s"),
+    }
 }

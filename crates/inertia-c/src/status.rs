@@ -5,6 +5,7 @@
 use crate::message::{self, record};
 use core::ffi::c_char;
 use core::panic::AssertUnwindSafe;
+use inertia::error_kind::ErrorKind;
 use inertia::estimator::EstimatorError;
 use inertia::fix::{Fix, Fixes};
 use inertia::pipeline::PipelineError;
@@ -74,6 +75,16 @@ pub(crate) fn status_of(e: &PipelineError) -> InertiaStatus {
 /// Record a library error. `Estimator` errors are written here rather than by their
 /// `Display`, which formats the sample index into a `String`.
 pub(crate) fn pipeline_fail(e: &PipelineError) -> InertiaStatus {
+    let status = pipeline_message(e);
+    let sample = match e {
+        PipelineError::Estimator { sample, .. } => sample.map(|s| s as u64),
+        _ => None,
+    };
+    message::set_kind(Some(e.error_kind()), sample);
+    status
+}
+
+fn pipeline_message(e: &PipelineError) -> InertiaStatus {
     match e {
         PipelineError::Estimator {
             sample: Some(s),
@@ -189,10 +200,145 @@ pub extern "C" fn inertia_status_name(status: i32) -> *const c_char {
     s.as_ptr()
 }
 
+/// The kind of the last error (`inertia_last_error_kind`): the same kinds, with the same
+/// names, as the command line's JSON error (`"kind"`) and Python's `DataError.kind`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaErrorKind {
+    /// No error, or one of no particular kind (a NULL pointer, a bad setting field).
+    None = 0,
+    /// A value is NaN or infinite.
+    NotFinite = 1,
+    /// A value is outside the supported range.
+    OutOfRange = 2,
+    /// The quaternion's norm differs from 1 by more than 1e-3.
+    NonUnitQuaternion = 3,
+    /// Time does not increase.
+    TimeNotIncreasing = 4,
+    /// Gyro rates given for some samples and not for others.
+    GyroChanged = 5,
+    /// The estimator needs gyro rates.
+    NeedsGyro = 6,
+    /// A memory shorter than the sample period.
+    MemoryShorterThanStep = 7,
+    /// A setting is invalid or does not apply.
+    InvalidSetting = 8,
+    /// The data show the rotor momentum with the opposite sign.
+    ReversedMomentum = 9,
+    /// The quaternion convention disagrees with the gyro.
+    AttitudeConvention = 10,
+    /// The attitude jumps against the gyro.
+    AttitudeGlitch = 11,
+    /// A step or row the estimator cannot use.
+    Row = 12,
+    /// The solver failed.
+    Solver = 13,
+    /// An earlier error stopped the estimator.
+    Stopped = 14,
+    /// A kind this version of the header does not name.
+    Other = 15,
+}
+
+/// The C kinds, the library's, and their names (checked against the library's in tests).
+const KINDS: [(InertiaErrorKind, Option<ErrorKind>, &core::ffi::CStr); 16] = {
+    use ErrorKind as L;
+    use InertiaErrorKind as C;
+    [
+        (C::None, None, c"none"),
+        (C::NotFinite, Some(L::NotFinite), c"not_finite"),
+        (C::OutOfRange, Some(L::OutOfRange), c"out_of_range"),
+        (
+            C::NonUnitQuaternion,
+            Some(L::NonUnitQuaternion),
+            c"non_unit_quaternion",
+        ),
+        (
+            C::TimeNotIncreasing,
+            Some(L::TimeNotIncreasing),
+            c"time_not_increasing",
+        ),
+        (C::GyroChanged, Some(L::GyroChanged), c"gyro_changed"),
+        (C::NeedsGyro, Some(L::NeedsGyro), c"needs_gyro"),
+        (
+            C::MemoryShorterThanStep,
+            Some(L::MemoryShorterThanStep),
+            c"memory_shorter_than_step",
+        ),
+        (
+            C::InvalidSetting,
+            Some(L::InvalidSetting),
+            c"invalid_setting",
+        ),
+        (
+            C::ReversedMomentum,
+            Some(L::ReversedMomentum),
+            c"reversed_momentum",
+        ),
+        (
+            C::AttitudeConvention,
+            Some(L::AttitudeConvention),
+            c"attitude_convention",
+        ),
+        (
+            C::AttitudeGlitch,
+            Some(L::AttitudeGlitch),
+            c"attitude_glitch",
+        ),
+        (C::Row, Some(L::Row), c"row"),
+        (C::Solver, Some(L::Solver), c"solver"),
+        (C::Stopped, Some(L::Stopped), c"stopped"),
+        (C::Other, None, c"other"),
+    ]
+};
+
+/// The kind of the last error on this thread (`INERTIA_ERROR_KIND_NONE` when there was
+/// none, or it has no particular kind).
+#[no_mangle]
+pub extern "C" fn inertia_last_error_kind() -> InertiaErrorKind {
+    match message::last_kind().0 {
+        None => InertiaErrorKind::None,
+        Some(k) => KINDS
+            .iter()
+            .find(|(_, l, _)| *l == Some(k))
+            .map_or(InertiaErrorKind::Other, |(c, _, _)| *c),
+    }
+}
+
+/// The 0-based index of the sample the last error on this thread is about (counted since
+/// creation or the last reset), or -1 when it is about no one sample.
+#[no_mangle]
+pub extern "C" fn inertia_last_error_sample() -> i64 {
+    message::last_kind()
+        .1
+        .and_then(|s| i64::try_from(s).ok())
+        .unwrap_or(-1)
+}
+
+/// The name of an error kind (a static string, e.g. `"time_not_increasing"`, the name the
+/// command line and Python give it; `"other"` for a value that is none).
+#[no_mangle]
+pub extern "C" fn inertia_error_kind_name(kind: i32) -> *const c_char {
+    KINDS
+        .iter()
+        .find(|(c, _, _)| *c as i32 == kind)
+        .map_or(c"other", |(_, _, n)| n)
+        .as_ptr()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use core::fmt::Write as _;
+
+    #[test]
+    fn the_kinds_are_named_as_the_library_names_them() {
+        for (k, (c, l, name)) in KINDS.iter().enumerate() {
+            assert_eq!(*c as usize, k);
+            if let Some(l) = l {
+                assert_eq!(name.to_str().unwrap(), l.name());
+            }
+        }
+    }
 
     #[test]
     fn a_panic_becomes_a_status_and_a_message() {

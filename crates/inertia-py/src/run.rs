@@ -101,7 +101,12 @@ impl Origin {
                 } else {
                     String::new()
                 };
-                Failure::Data(format!("{at}{columns} {e}{fixes}"), line)
+                Failure::Data {
+                    message: format!("{at}{columns} {e}{fixes}"),
+                    line,
+                    kind: Some(e.error_kind()),
+                    sample: e.sample,
+                }
             }
         }
     }
