@@ -63,6 +63,13 @@ pub enum Failure {
     },
     /// A bad argument (`ValueError`).
     Argument(String),
+    /// A setting the data refuse (`ValueError` with `.kind` and `.sample`, as
+    /// [`data_error`]).
+    Refused {
+        message: String,
+        kind: ErrorKind,
+        sample: Option<usize>,
+    },
     /// An input that cannot be read.
     Io(String),
 }
@@ -77,6 +84,17 @@ impl Failure {
                 sample,
             } => data_error(py, message, line, kind, sample),
             Failure::Argument(m) => value_error(m),
+            Failure::Refused {
+                message,
+                kind,
+                sample,
+            } => {
+                let e = value_error(message);
+                let v = e.value(py);
+                let _ = v.setattr("kind", kind.name());
+                let _ = v.setattr("sample", sample);
+                e
+            }
             Failure::Io(m) => io_error(m),
         }
     }
