@@ -8,7 +8,7 @@
 use crate::errors::Failure;
 use crate::settings::Convention;
 use inertia::sample::Sample;
-use inertia::telemetry::gate::{Field, Gate, GateOptions, RawSample};
+use inertia::telemetry::gate::{Field, Gate, GateOptions, RawSample, SampleError};
 /// One row of raw values, in storage order.
 #[derive(Debug, Clone, Copy)]
 pub struct Row {
@@ -118,7 +118,11 @@ impl Checker {
             w_rad_s: row.w,
         };
         self.gate.check(&raw).map_err(|e| Failure::Data {
-            message: format!("{}: {e}", naming.field(e.field(), i)),
+            message: match e {
+                // The rates as a whole, not one axis.
+                SampleError::GyroChanged { .. } => format!("{}: {e}", naming.value(4, None, i)),
+                _ => format!("{}: {e}", naming.field(e.field(), i)),
+            },
             line: None,
             kind: Some(e.error_kind()),
             sample: Some(i),
