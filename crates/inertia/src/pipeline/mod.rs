@@ -232,6 +232,25 @@ impl PipelineError {
         }
     }
 
+    /// Its kind, as every front end reports it.
+    #[must_use]
+    pub fn error_kind(&self) -> crate::error_kind::ErrorKind {
+        use crate::error_kind::ErrorKind as K;
+        match self {
+            PipelineError::AttitudeConvention { .. } => K::AttitudeConvention,
+            PipelineError::ReversedMomentum { .. } => K::ReversedMomentum,
+            PipelineError::AttitudeGlitch { .. } => K::AttitudeGlitch,
+            PipelineError::OutOfRange { .. } => K::OutOfRange,
+            PipelineError::Estimator { source, .. } => match source {
+                EstimatorError::Solve(_) => K::Solver,
+                EstimatorError::TooFewSamples { .. } => K::TooFewSamples,
+                EstimatorError::Row { .. } => K::Row,
+                _ => K::InvalidSetting,
+            },
+            _ => K::InvalidSetting,
+        }
+    }
+
     pub(crate) fn from_argument(a: InvalidArgument) -> Self {
         PipelineError::InvalidSetting {
             field: a.name,
