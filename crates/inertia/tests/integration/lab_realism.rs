@@ -358,3 +358,37 @@ fn invalid_lab_settings_name_their_field() {
         }
     }
 }
+
+/// The equation-error baseline by name through the pipeline: on the noise-free throw
+/// with no lab effect it recovers J (relative Frobenius error below 1e-3) with a σ,
+/// and a memory, which it has none of, is refused naming the setting.
+#[test]
+fn equation_error_baseline_through_the_pipeline() {
+    use inertia::pipeline::{Pipeline, PipelineError, PipelineSettings};
+    let out = throw_with(&[]);
+    let settings = PipelineSettings {
+        estimator: "equation-error".into(),
+        solve_every: 100,
+        ..PipelineSettings::default()
+    };
+    let mut p = Pipeline::new(&settings).expect("valid settings");
+    for s in &out.samples {
+        p.push(s).expect("valid samples");
+    }
+    let e = p.last().expect("an estimate");
+    let j = e.inertia().expect("an answer");
+    let err = inertia::tensor::relative_frobenius_error(&j, &out.inertia_kg_m2);
+    assert!(err < 1e-3, "error {err}");
+    assert!(e.sigma_kg_m2().is_some());
+    let with_memory = PipelineSettings {
+        memory_s: Some(1.0),
+        ..settings
+    };
+    assert!(matches!(
+        Pipeline::new(&with_memory),
+        Err(PipelineError::InvalidSetting {
+            field: "memory_s",
+            ..
+        })
+    ));
+}
