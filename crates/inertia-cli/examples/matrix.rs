@@ -61,6 +61,12 @@
 //! Frobenius σ, with the number of determined answers. The last three columns repeat the
 //! discrete momentum estimator given the cell's gyro noise density (`gyro_noise_deg_s_rthz`,
 //! errors-in-variables compensation), as a user with the gyro's datasheet would.
+//!
+//! **Lab cells** (`matrix_lab/lab.rs`): the hand-thrown device of `Preset::throw()`, with
+//! all its lab effects, none, each alone and all but each, running the default estimator,
+//! the momentum RLS and the filtered equation-error baseline; their table follows the main
+//! one (cells whose label contains the filter; `throw` selects only them).
+//!
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
 //! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto` its
 //! `--inertial-torque` (unset: `off`). `DIGITS=1` prints the medians with
@@ -82,6 +88,9 @@ use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+#[path = "matrix_lab/lab.rs"]
+mod lab;
 
 /// The paper's gyro, deg/s/√Hz.
 const PAPER_GYRO: f64 = 1e-5;
@@ -635,9 +644,21 @@ fn main() {
                 .is_none_or(|f| c.label().to_lowercase().contains(f))
         })
         .collect();
-    if cells.is_empty() {
+    let lab_cells = lab::cells()
+        .iter()
+        .filter(|c| {
+            filter
+                .as_deref()
+                .is_none_or(|f| c.label.to_lowercase().contains(f))
+        })
+        .count();
+    if cells.is_empty() && lab_cells == 0 {
         eprintln!("no cell label contains {:?}", filter.unwrap_or_default());
         std::process::exit(2);
+    }
+    if cells.is_empty() {
+        lab::table(seeds, filter.as_deref());
+        return;
     }
     eprintln!(
         "{} cells × {seeds} seeds on {} threads",
@@ -730,6 +751,7 @@ fn main() {
         );
     }
     let busy: f64 = runs.iter().flat_map(|r| r.seconds).sum();
+    lab::table(seeds, filter.as_deref());
     println!();
     println!(
         "{} cells × {seeds} seeds per cell; wall time {} on {} threads ({:.2} thread-s in the runs).",

@@ -88,6 +88,11 @@ pub enum PresetArg {
     /// Three-axis microsatellite: FOG (ARW 0.02 deg/√h), star tracker 3″/3″/25″ at 10 Hz,
     /// MEKF attitude, 5 Hz wheel commands (900 s).
     Microsat,
+    /// A hand-thrown lab device (0.5 s free tumble, one flywheel spun up to 600 rad/s on
+    /// body z): MEMS gyro at 4 kHz vibrating at the rotor frequency, attitude integrated
+    /// from it, speed telemetry in 10 rpm steps held at 100 Hz, an aerodynamic torque
+    /// fixed in the inertial frame and air drag.
+    Throw,
 }
 
 /// Where the telemetered attitude comes from.
@@ -121,9 +126,10 @@ pub struct SimulateArgs {
     /// Duration, s [default: 300 for slew, 180 for spin, the preset's].
     #[arg(long, visible_alias = "duration-s", value_name = "S")]
     pub duration: Option<f64>,
-    /// Integration node period h, s: the telemetry period unless --telemetry-dt is given.
-    #[arg(long, visible_alias = "dt-s", value_name = "S", default_value_t = 0.1)]
-    pub dt: f64,
+    /// Integration node period h, s: the telemetry period unless --telemetry-dt is given
+    /// [default: 0.1, or the preset's].
+    #[arg(long, visible_alias = "dt-s", value_name = "S")]
+    pub dt: Option<f64>,
     /// Telemetry period, s: a whole multiple of --dt (write every n-th node; the gyro's
     /// delta angle covers the whole period), e.g. `--dt 0.1 --telemetry-dt 1`.
     #[arg(long, visible_alias = "telemetry-dt-s", value_name = "S")]
@@ -220,6 +226,25 @@ pub struct SimulateArgs {
     /// Constant unknown body-frame torque, N m, e.g. `1e-5:0:0` (not in tau_*).
     #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
     pub constant_torque_nm: Option<String>,
+    /// Constant unknown torque fixed in the inertial frame, N m (an aerodynamic force off
+    /// the centre of mass; not in tau_*) [default: 0, or the preset's].
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub inertial_torque_nm: Option<String>,
+    /// Air drag: an unknown torque −D·ω with this D, N m s [default: 0, or the preset's].
+    #[arg(long, value_name = "NMS")]
+    pub drag_nms: Option<f64>,
+    /// Gyro vibration at the rotor frequency (rotor speed |ρ|/rotor spin inertia):
+    /// amplitude per body axis, rad/s [default: 0, or the preset's].
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub gyro_vibration_rad_s: Option<String>,
+    /// Spin inertia of the rotor that carries ρ, kg m² (sets the vibration's frequency)
+    /// [default: 1, or the preset's].
+    #[arg(long, value_name = "KG_M2")]
+    pub rotor_spin_inertia_kg_m2: Option<f64>,
+    /// Wheel-speed telemetry rate, Hz, held between updates (a whole fraction of the
+    /// telemetry rate) [default: every sample, or the preset's].
+    #[arg(long, value_name = "HZ")]
+    pub wheel_hold_hz: Option<f64>,
     /// Output CSV file (the truth goes to the same name with `.truth.json`).
     #[arg(short = 'o', long, value_name = "FILE.csv")]
     pub output: PathBuf,

@@ -75,6 +75,7 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
             let p = match p {
                 PresetArg::SmallSat => Preset::small_sat(),
                 PresetArg::Microsat => Preset::microsat(),
+                PresetArg::Throw => Preset::throw(),
             };
             (p.scenario, p.common)
         }
@@ -89,8 +90,9 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
             )));
         }
     }
-    if !(a.dt.is_finite() && a.dt > 0.0) {
-        return Err(input(format!("--dt {}: must be finite and > 0", a.dt)));
+    let dt = a.dt.unwrap_or(common.dt_s);
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(input(format!("--dt {dt}: must be finite and > 0")));
     }
     let j0 = common.inertia_kg_m2;
     common.inertia_change = match (&a.inertia_step, &a.inertia_ramp) {
@@ -114,10 +116,13 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
         }
         (None, None) => None,
     };
-    common.dt_s = a.dt;
+    if a.dt.is_some() || a.preset.is_none() {
+        // Keep the integrator's substep near 5 ms whatever the node period (a preset
+        // keeps its own substeps at its own period).
+        common.substeps = ((dt / 0.005).round() as usize).max(1);
+    }
+    common.dt_s = dt;
     common.duration_s = a.duration;
-    // Keep the integrator's substep near 5 ms whatever the node period.
-    common.substeps = ((a.dt / 0.005).round() as usize).max(1);
     common.seed = a.seed;
     if let Some(d) = a.disturbance {
         common.disturbance_nm_rthz = d;
@@ -130,17 +135,17 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
     }
     let r = &mut common.realism;
     if let Some(t) = a.telemetry_dt {
-        let n = t / a.dt;
+        let n = t / dt;
         let every = n.round();
         if !(t.is_finite() && every >= 1.0 && (n - every).abs() <= 1e-9 * every) {
             return Err(input(format!(
                 "--telemetry-dt {t}: must be a whole multiple (>= 1) of --dt {}",
-                a.dt
+                dt
             )));
         }
         r.telemetry_every = every as usize;
     }
-    let period = a.dt * r.telemetry_every as f64;
+    let period = dt * r.telemetry_every as f64;
     let duration = a.duration.unwrap_or_else(|| sc.default_duration_s());
     if SimConfig::samples_for(duration, period) > MAX_SAMPLES {
         return Err(input(format!(
@@ -155,7 +160,7 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
     if steps > MAX_INTEGRATION_STEPS {
         return Err(input(format!(
             "--dt {} with a duration of {} s: {} integration steps ({samples} samples, {} nodes per sample, {} steps of at most 5 ms per node); at most {}",
-            Num(a.dt),
+            Num(dt),
             Num(duration),
             Num(steps),
             r.telemetry_every,
@@ -227,6 +232,21 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
     if let Some(v) = vector("--constant-torque-nm", &a.constant_torque_nm)? {
         r.environment.constant_torque_nm = v;
     }
+    if let Some(v) = vector("--inertial-torque-nm", &a.inertial_torque_nm)? {
+        r.environment.inertial_torque_nm = v;
+    }
+    if let Some(d) = a.drag_nms {
+        r.environment.damping_nms = d;
+    }
+    if let Some(v) = vector("--gyro-vibration-rad-s", &a.gyro_vibration_rad_s)? {
+        r.vibration.amplitude_rad_s = v;
+    }
+    if let Some(i) = a.rotor_spin_inertia_kg_m2 {
+        r.vibration.rotor_spin_inertia_kg_m2 = i;
+    }
+    if let Some(hz) = a.wheel_hold_hz {
+        r.wheels.hold_hz = Some(hz);
+    }
     Ok((sc, common))
 }
 
@@ -279,6 +299,7 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         a.preset.map_or(sc.name(), |p| match p {
             PresetArg::SmallSat => "small-sat",
             PresetArg::Microsat => "microsat",
+            PresetArg::Throw => "throw",
         }),
         Num(common.dt_s * common.realism.telemetry_every as f64),
     );

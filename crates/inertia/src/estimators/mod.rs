@@ -3,3 +3,4 @@
 //! file of its own beside it.
 
 pub(crate) mod discrete_momentum;
+pub(crate) mod equation_error;

@@ -160,6 +160,7 @@ pub static ESTIMATORS: &[EstimatorEntry] = &[
     crate::estimators::discrete_momentum::DISCRETE_MOMENTUM,
     super::sdp::FINITE_DIFFERENCE,
     super::momentum::MOMENTUM,
+    crate::estimators::equation_error::EQUATION_ERROR,
 ];
 
 /// Every solver backend, the default first.

@@ -1,5 +1,6 @@
-//! Unknown environmental torques: gravity gradient on a circular orbit and a constant
-//! body-frame disturbance. Neither is written to `tau_nm` (the known torque); the orbit
+//! Unknown environmental torques: gravity gradient on a circular orbit, a constant
+//! body-frame disturbance, a constant inertial-frame torque and linear air drag. None is
+//! written to `tau_nm` (the known torque); the orbit
 //! is returned with the run ([`super::SimOutput::orbit`]) so that a user can compute the
 //! gravity-gradient torque.
 //!
@@ -22,6 +23,16 @@
 //! `τ_gg = 3 μ/r³ r̂_B × (J r̂_B)` ([`gravity_gradient_torque_nm`]).
 //!
 //! **Constant disturbance:** [`Environment::constant_torque_nm`], N m in body axes.
+//!
+//! **Aerodynamic torque off the centre of mass** ([`Environment::inertial_torque_nm`]): a
+//! torque fixed in the inertial frame, `τ_B = C(q)ᵀ τ_I`. An aerodynamic force through a
+//! point off the centre of mass of a body flying through still air along a nearly
+//! straight path (a throw) points along the velocity, so its moment is approximately
+//! fixed in the inertial frame over a short record.
+//!
+//! **Air drag** ([`Environment::damping_nms`]): a torque opposing the body rate,
+//! `τ_B = −D ω` (D in N m s per rad, the linear term of the drag of a tumbling body at
+//! low rates).
 
 use super::SimError;
 use crate::attitude::Quaternion;
@@ -149,22 +160,41 @@ pub struct Environment {
     pub orbit: Option<Orbit>,
     /// Constant disturbance torque, N m, body axes.
     pub constant_torque_nm: Vector3<f64>,
+    /// Constant torque in the inertial frame, N m (module docs).
+    pub inertial_torque_nm: Vector3<f64>,
+    /// Linear drag coefficient D of the torque `−D ω`, N m s (≥ 0; 0 = none).
+    pub damping_nms: f64,
 }
 
 impl Environment {
     /// Whether any torque acts.
     #[must_use]
     pub fn is_active(&self) -> bool {
-        self.orbit.is_some() || self.constant_torque_nm != Vector3::zeros()
+        self.orbit.is_some()
+            || self.constant_torque_nm != Vector3::zeros()
+            || self.inertial_torque_nm != Vector3::zeros()
+            || self.damping_nms != 0.0
     }
 
-    /// The unknown torque at `t_s` on a body of inertia `j` at attitude `q`, N m.
+    /// The unknown torque at `t_s` on a body of inertia `j` at attitude `q` (body →
+    /// inertial) turning at `omega_rad_s` (body axes), N m, body axes.
     #[must_use]
-    pub fn torque_nm(&self, t_s: f64, q: &Quaternion, j: &Matrix3<f64>) -> Vector3<f64> {
+    pub fn torque_nm(
+        &self,
+        t_s: f64,
+        q: &Quaternion,
+        omega_rad_s: &Vector3<f64>,
+        j: &Matrix3<f64>,
+    ) -> Vector3<f64> {
         let gg = self
             .orbit
             .map_or_else(Vector3::zeros, |o| o.gravity_gradient_nm(t_s, q, j));
-        gg + self.constant_torque_nm
+        let inertial = if self.inertial_torque_nm == Vector3::zeros() {
+            Vector3::zeros()
+        } else {
+            q.conjugate().rotate(&self.inertial_torque_nm)
+        };
+        gg + self.constant_torque_nm + inertial - omega_rad_s * self.damping_nms
     }
 
     /// Check every field.
@@ -177,6 +207,20 @@ impl Environment {
                 field: "environment.constant_torque_nm",
                 value: self.constant_torque_nm.norm(),
                 why: "must be finite",
+            });
+        }
+        if !self.inertial_torque_nm.iter().all(|v| v.is_finite()) {
+            return Err(SimError::InvalidSetting {
+                field: "environment.inertial_torque_nm",
+                value: self.inertial_torque_nm.norm(),
+                why: "must be finite",
+            });
+        }
+        if !(self.damping_nms.is_finite() && self.damping_nms >= 0.0) {
+            return Err(SimError::InvalidSetting {
+                field: "environment.damping_nms",
+                value: self.damping_nms,
+                why: "must be finite and >= 0",
             });
         }
         Ok(())

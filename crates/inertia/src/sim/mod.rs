@@ -19,9 +19,11 @@
 //! bit): attitude from the truth, a star tracker ([`star_tracker`]) or a multiplicative EKF
 //! ([`mekf`]); gyro bias and bias instability ([`gyro`]); wheel commands held at a
 //! controller rate ([`commands`]); wheel telemetry skew, scale error, misalignment, noise
-//! and quantisation ([`wheels`]); gravity-gradient and constant unknown torques
-//! ([`environment`]); telemetry decimation; spacecraft presets ([`presets`]). The loop is
-//! in [`run`].
+//! and quantisation, wheel speeds held at their own rate ([`wheels`]); gyro vibration at
+//! the rotor frequency ([`vibration`]); gravity-gradient, constant body-frame and
+//! inertial-frame unknown torques and air drag ([`environment`]); telemetry decimation;
+//! spacecraft presets, among them a hand-thrown lab device ([`presets`]). The loop is in
+//! [`run`].
 //!
 //! Noise streams (ChaCha8 seeded with [`SimConfig::seed`]), one per source so that
 //! turning one effect on leaves the others' noise unchanged: 0 disturbance torque,
@@ -39,6 +41,7 @@ pub mod run;
 pub mod scenario;
 pub mod sensors;
 pub mod star_tracker;
+pub mod vibration;
 pub mod wheels;
 
 pub use commands::CommandHold;
@@ -48,6 +51,7 @@ pub use mekf::MekfSettings;
 pub use realism::{AttitudeSource, Realism};
 pub use run::simulate;
 pub use star_tracker::StarTracker;
+pub use vibration::RotorVibration;
 pub use wheels::WheelTelemetry;
 
 use crate::dynamics::GyrostatState;

@@ -17,12 +17,22 @@
 //! Both telemeter at 10 Hz (integration step 0.1 s, 20 RK4 substeps) and keep the white
 //! disturbance torque; no environmental torque is on by default (set
 //! [`super::Realism::environment`]).
+//!
+//! [`Preset::throw`] is a laboratory record instead: a small device thrown by hand,
+//! tumbling free for 0.5 s while one flywheel spins up ([`THROW`] lists its numbers). It
+//! is a [`Scenario::Spin`] (initial tumble, one raised-cosine wheel pulse) with the lab's
+//! sensors: a MEMS IMU at 4 kHz whose gyro vibrates at the rotor frequency, the attitude
+//! integrated from that gyro, the flywheel's speed telemetered quantised and held at
+//! 100 Hz, and air acting as a torque fixed in the inertial frame (aerodynamic force off
+//! the centre of mass) and a drag `−D ω`. Each effect can be switched off on the returned
+//! settings ([`Preset::throw_without`]).
 
 use super::control::Slew;
-use super::scenario::{Common, Scenario, SlewPlan};
+use super::control::WheelPulse;
+use super::scenario::{Common, Scenario, SlewPlan, SpinPlan};
 use super::{
-    AttitudeSource, CommandHold, GyroErrors, MekfSettings, Realism, SimError, SimOutput,
-    StarTracker, WheelTelemetry,
+    AttitudeSource, CommandHold, Environment, GyroErrors, MekfSettings, Realism, RotorVibration,
+    SimError, SimOutput, StarTracker, WheelTelemetry,
 };
 use crate::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use nalgebra::{Matrix3, Vector3};
@@ -50,7 +60,129 @@ fn slews(list: &[([f64; 3], f64, f64)], duration_s: f64) -> Vec<Slew> {
         .collect()
 }
 
+/// The numbers of [`Preset::throw`].
+///
+/// A 0.5 kg device of 12 × 8 × 5 cm (`m(b² + c²)/12` ≈ 3.7e-4, 7.0e-4, 8.7e-4 kg m², with
+/// small products) thrown tumbling at about 10 rad/s; a flywheel of spin inertia 5e-6
+/// kg m² on body z spun from rest to 600 rad/s (about 5700 rpm, 95 Hz) by a raised-cosine
+/// torque between 0.1 s and 0.3 s; a MEMS gyro of 0.01 deg/s/√Hz sampled at 4 kHz; the
+/// speed telemetered in steps of 10 rpm at 100 Hz; an aerodynamic force of about 0.05 N
+/// acting 5 mm off the centre of mass (2.7e-4 N m, fixed in the inertial frame); air drag
+/// D = 4e-6 N m s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThrowNumbers {
+    /// Spin inertia of the flywheel, kg m².
+    pub rotor_spin_inertia_kg_m2: f64,
+    /// Final flywheel speed, rad/s.
+    pub rotor_speed_rad_s: f64,
+    /// Gyro vibration amplitude across the rotor axis, rad/s.
+    pub vibration_rad_s: f64,
+    /// Speed telemetry step, rad/s.
+    pub speed_step_rad_s: f64,
+    /// Speed telemetry rate, Hz.
+    pub speed_hz: f64,
+    /// Aerodynamic torque fixed in the inertial frame, N m.
+    pub inertial_torque_nm: [f64; 3],
+    /// Air drag coefficient D, N m s.
+    pub damping_nms: f64,
+}
+
+/// The lab throw's numbers.
+pub const THROW: ThrowNumbers = ThrowNumbers {
+    rotor_spin_inertia_kg_m2: 5e-6,
+    rotor_speed_rad_s: 600.0,
+    vibration_rad_s: 0.02,
+    speed_step_rad_s: 10.0 * core::f64::consts::PI / 30.0,
+    speed_hz: 100.0,
+    inertial_torque_nm: [2e-4, -1.5e-4, 1e-4],
+    damping_nms: 4e-6,
+};
+
+/// A lab effect of [`Preset::throw`] that can be switched off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LabEffect {
+    /// The gyro's vibration at the rotor frequency.
+    Vibration,
+    /// Quantisation and hold of the speed telemetry.
+    SpeedTelemetry,
+    /// The aerodynamic torque fixed in the inertial frame.
+    InertialTorque,
+    /// The air drag `−D ω`.
+    Drag,
+}
+
 impl Preset {
+    /// The hand-thrown lab device (module docs, [`THROW`]).
+    #[must_use]
+    pub fn throw() -> Self {
+        let n = THROW;
+        let rho_max = n.rotor_spin_inertia_kg_m2 * n.rotor_speed_rad_s;
+        let plan = SpinPlan {
+            duration_s: 0.5,
+            initial_omega_rad_s: Vector3::new(5.0, -4.0, 7.0),
+            pulse: WheelPulse {
+                axis: Vector3::z(),
+                delta_rho_nms: rho_max,
+                start_s: 0.1,
+                duration_s: 0.2,
+            },
+        };
+        let realism = Realism {
+            attitude: AttitudeSource::GyroPropagated,
+            wheels: WheelTelemetry {
+                quantization_nms: n.rotor_spin_inertia_kg_m2 * n.speed_step_rad_s,
+                hold_hz: Some(n.speed_hz),
+                ..WheelTelemetry::default()
+            },
+            environment: Environment {
+                inertial_torque_nm: Vector3::from(n.inertial_torque_nm),
+                damping_nms: n.damping_nms,
+                ..Environment::default()
+            },
+            vibration: RotorVibration {
+                amplitude_rad_s: Vector3::new(n.vibration_rad_s, n.vibration_rad_s, 0.0),
+                phase_rad: Vector3::new(0.0, core::f64::consts::FRAC_PI_2, 0.0),
+                rotor_spin_inertia_kg_m2: n.rotor_spin_inertia_kg_m2,
+            },
+            ..Realism::default()
+        };
+        Self {
+            name: "throw",
+            scenario: Scenario::Spin(plan),
+            common: Common {
+                inertia_kg_m2: Matrix3::new(
+                    3.7e-4, 1.2e-5, -8e-6, //
+                    1.2e-5, 7.0e-4, 1.5e-5, //
+                    -8e-6, 1.5e-5, 8.7e-4,
+                ),
+                dt_s: 2.5e-4,
+                duration_s: None,
+                substeps: 2,
+                disturbance_nm_rthz: 0.0,
+                gyro_noise_deg_s_rthz: 0.01,
+                seed: 1,
+                inertia_change: None,
+                realism,
+            },
+        }
+    }
+
+    /// [`Preset::throw`] without the effects listed.
+    #[must_use]
+    pub fn throw_without(off: &[LabEffect]) -> Self {
+        let mut p = Self::throw();
+        let r = &mut p.common.realism;
+        for e in off {
+            match e {
+                LabEffect::Vibration => r.vibration = RotorVibration::default(),
+                LabEffect::SpeedTelemetry => r.wheels = WheelTelemetry::default(),
+                LabEffect::InertialTorque => r.environment.inertial_torque_nm = Vector3::zeros(),
+                LabEffect::Drag => r.environment.damping_nms = 0.0,
+            }
+        }
+        p
+    }
+
     /// The 12U-class small satellite (module docs).
     #[must_use]
     pub fn small_sat() -> Self {
@@ -182,6 +314,7 @@ impl Preset {
         match name {
             "small-sat" => Some(Self::small_sat()),
             "microsat" => Some(Self::microsat()),
+            "throw" => Some(Self::throw()),
             _ => None,
         }
     }

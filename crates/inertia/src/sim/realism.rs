@@ -9,6 +9,7 @@ use super::environment::Environment;
 use super::gyro::GyroErrors;
 use super::mekf::MekfSettings;
 use super::star_tracker::StarTracker;
+use super::vibration::RotorVibration;
 use super::wheels::WheelTelemetry;
 use super::SimError;
 
@@ -53,6 +54,8 @@ pub struct Realism {
     /// Telemetry decimation: write every n-th integration node (n ≥ 1), so the telemetry
     /// period is `n · dt_s`. The gyro's delta angle covers the whole telemetry step.
     pub telemetry_every: usize,
+    /// Gyro vibration at the rotor frequency ([`super::vibration`]).
+    pub vibration: RotorVibration,
 }
 
 impl Default for Realism {
@@ -66,6 +69,7 @@ impl Default for Realism {
             commands: None,
             environment: Environment::default(),
             telemetry_every: 1,
+            vibration: RotorVibration::default(),
         }
     }
 }
@@ -106,6 +110,7 @@ impl Realism {
             c.validate(dt_s)?;
         }
         self.environment.validate()?;
+        self.vibration.validate()?;
         if self.attitude == AttitudeSource::Mekf {
             if !self.star_tracker.noise_arcsec.iter().all(|v| *v > 0.0) {
                 return Err(SimError::InvalidSetting {

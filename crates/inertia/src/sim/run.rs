@@ -13,6 +13,7 @@ use super::gyro::Gyro;
 use super::mekf::Mekf;
 use super::sensors::{self, DEG};
 use super::star_tracker::StarTrackerNoise;
+use super::vibration::RotorAngle;
 use super::wheels::{RhoHistory, RhoSpan, WheelSensor};
 use super::{
     AttitudeSource, FilterSample, InertiaChange, InputLaw, SimConfig, SimError, SimOutput,
@@ -64,6 +65,10 @@ pub fn simulate(
     let skewed = skew != 0.0;
     let env = re.environment;
     let env_on = env.is_active();
+    let vibration = re.vibration;
+    let vibrating = vibration.is_active();
+    let mut rotor = RotorAngle::default();
+    let hold_every = re.wheels.hold_every(h_tel)?;
 
     let mut x = cfg.initial;
     x.q = x.q.normalize().unwrap_or(Quaternion::IDENTITY);
@@ -167,6 +172,7 @@ pub fn simulate(
         let end = t_b + h;
         let mut seg_start = t_b;
         let mut angle = Vector3::zeros();
+        let mut vib_angle = Vector3::zeros();
         let mut last_rd: Option<Vector3<f64>> = None;
         loop {
             if let Some((ticker, cmd)) = hold.as_mut() {
@@ -223,7 +229,7 @@ pub fn simulate(
                     };
                     let tau = known_torque.eval(tt, xx) + d - jdot * xx.omega_rad_s;
                     if env_on {
-                        (rd, tau + env.torque_nm(tt, &xx.q, &jm))
+                        (rd, tau + env.torque_nm(tt, &xx.q, &xx.omega_rad_s, &jm))
                     } else {
                         (rd, tau)
                     }
@@ -232,6 +238,9 @@ pub fn simulate(
                 let (next, da) = rk4_step(&jm, &jm_inv, t, sdt, &x, &f);
                 x = next;
                 angle += da;
+                if vibrating {
+                    vib_angle += rotor.substep(&vibration, &x_start.rho_nms, &x.rho_nms, sdt);
+                }
                 if skewed {
                     let (rd0, rd1) = match held {
                         Some(c) => (c, c),
@@ -260,7 +269,15 @@ pub fn simulate(
 
         // Sensors over the interval.
         let increment = x_b.q.conjugate().mul(&x.q);
-        let (noisy_increment, measured) = gyro.measure(&increment, &angle);
+        let (noisy_increment, measured) = if vibrating {
+            // The vibration is a sensor error: it enters the measured delta angle.
+            gyro.measure(
+                &increment.mul(&Quaternion::exp(&vib_angle)),
+                &(angle + vib_angle),
+            )
+        } else {
+            gyro.measure(&increment, &angle)
+        };
         q_meas = q_meas
             .mul(&noisy_increment)
             .normalize()
@@ -313,6 +330,15 @@ pub fn simulate(
         );
         for (s, r) in samples.iter_mut().zip(&rho_tel) {
             s.rho_nms = *r;
+        }
+    }
+    if hold_every > 1 {
+        // Zero-order hold of the wheel-speed telemetry (wheels module docs).
+        for chunk in samples.chunks_mut(hold_every) {
+            let held = chunk[0].rho_nms;
+            for s in chunk.iter_mut() {
+                s.rho_nms = held;
+            }
         }
     }
     Ok(SimOutput {

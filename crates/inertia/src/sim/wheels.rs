@@ -22,6 +22,10 @@
 //!   quantisation; noise stream: ChaCha8 seeded with the run's seed, stream 3.
 //! * `Q` ([`WheelTelemetry::quantization_nms`]): rounding to the nearest multiple of the
 //!   LSB q (N m s), error within ±q/2 per axis.
+//! * Hold ([`WheelTelemetry::hold_hz`]): the wheel speeds are telemetered at their own
+//!   rate, a whole fraction 1/m of the telemetry rate, and held in between (zero-order
+//!   hold): sample i carries the value measured at sample `m ⌊i/m⌋`, so ρ̃ is a staircase
+//!   with steps every m samples starting at the first.
 
 use super::sensors::{normal, DEG};
 use super::SimError;
@@ -46,6 +50,9 @@ pub struct WheelTelemetry {
     /// Misalignment between the true and the telemetered wheel momentum: a rotation
     /// vector, deg, body axes.
     pub misalignment_deg: Vector3<f64>,
+    /// Rate of the wheel-speed telemetry, Hz, held between its updates (`None`: every
+    /// telemetry sample); the telemetry period times this rate must be 1/m, m whole.
+    pub hold_hz: Option<f64>,
 }
 
 impl Default for WheelTelemetry {
@@ -56,6 +63,7 @@ impl Default for WheelTelemetry {
             skew_s: 0.0,
             scale_error: Vector3::zeros(),
             misalignment_deg: Vector3::zeros(),
+            hold_hz: None,
         }
     }
 }
@@ -72,6 +80,23 @@ impl WheelTelemetry {
     #[must_use]
     pub fn is_active(&self) -> bool {
         *self != Self::default()
+    }
+
+    /// The number m of telemetry samples per wheel-speed update (1 without a hold).
+    pub fn hold_every(&self, telemetry_dt_s: f64) -> Result<usize, SimError> {
+        let Some(rate) = self.hold_hz else {
+            return Ok(1);
+        };
+        let m = 1.0 / (rate * telemetry_dt_s);
+        let r = m.round();
+        if !(rate.is_finite() && rate > 0.0 && r >= 1.0 && (m - r).abs() <= 1e-6 * r) {
+            return Err(SimError::InvalidSetting {
+                field: "wheels.hold_hz",
+                value: rate,
+                why: "1/(hold_hz * telemetry period) must be a whole number >= 1",
+            });
+        }
+        Ok(r as usize)
     }
 
     /// Check every field; `telemetry_dt_s` bounds the skew.
@@ -112,6 +137,7 @@ impl WheelTelemetry {
                 "must be finite",
             );
         }
+        self.hold_every(telemetry_dt_s)?;
         Ok(())
     }
 }

@@ -16,6 +16,7 @@ mod discrete_momentum;
 mod dynamics;
 mod estimators;
 mod inertial_torque;
+mod lab_realism;
 mod numeric_range;
 mod pipeline;
 mod prior;
