@@ -92,6 +92,16 @@ use std::time::{Duration, Instant};
 #[path = "matrix_lab/lab.rs"]
 mod lab;
 
+/// The discrete momentum estimator's `--inertial-torque` from `INERTIAL_TORQUE`
+/// (unset or not a mode, or another estimator: the default).
+fn inertial_torque_from_env(estimator: &str) -> inertia::pipeline::InertialTorque {
+    std::env::var("INERTIAL_TORQUE")
+        .ok()
+        .filter(|_| estimator == "discrete-momentum")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_default()
+}
+
 /// The paper's gyro, deg/s/√Hz.
 const PAPER_GYRO: f64 = 1e-5;
 /// FOG angle random walk, deg/√h.
@@ -367,10 +377,7 @@ fn estimate(
             Some(_) => None,
             None => PipelineSettings::default().max_chain_s,
         },
-        inertial_torque: std::env::var("INERTIAL_TORQUE")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or_default(),
+        inertial_torque: inertial_torque_from_env(estimator),
         ..PipelineSettings::default()
     })
     .ok()?;

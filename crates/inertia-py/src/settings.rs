@@ -496,7 +496,9 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         },
         torque_bias: kw.bool("torque_bias", true)?,
         inertial_torque: match kw.choice("inertial_torque", &InertialTorque::NAMES)? {
-            Some(name) => name.parse().map_err(|e: PipelineError| value_error(e.to_string()))?,
+            Some(name) => name
+                .parse()
+                .map_err(|e: PipelineError| value_error(e.to_string()))?,
             None => InertialTorque::default(),
         },
         max_chain_s: (chain != 0.0).then_some(chain),

@@ -71,6 +71,7 @@ fn estimate(samples: &[Sample], name: &str) -> Option<Estimate> {
         estimator: name.into(),
         solve_every: 50,
         uncertainty: true,
+        inertial_torque: super::inertial_torque_from_env(name),
         ..PipelineSettings::default()
     })
     .ok()?;

@@ -412,7 +412,7 @@ pub fn reduce_batch(
     samples: &[Sample],
     settings: &MomentumRowSettings,
 ) -> Result<BatchReduction, EstimatorError> {
-    use super::jackknife::{jackknife_sigma, GROUPS};
+    use super::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
     use super::momentum_rows::{J, TORQUE};
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
@@ -463,13 +463,9 @@ pub fn reduce_batch(
         .chain(J..J + 6)
         .collect();
     let shared = shared_columns.len();
-    // Per chain: its rows free of its initial momenta, in the shared unknowns.
-    let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
-    let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
-    let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
-    let mut nuisance = settings.shared_nuisance() as f64;
-    for chain in &chains {
-        nuisance += settings.nuisance_per_chain() as f64;
+    // A chain's rows (those given) free of its initial momenta, in the shared unknowns:
+    // (rows of R, Qᵀy), and the chain's (rss, ‖y‖², scalar rows).
+    let reduce_chain = |chain: &[&AugmentedRow]| {
         // The initial momenta the chain uses, then (with an inertial torque) each one's
         // torque, whose column is the initial momentum's times the block's `s`
         // ([`super::momentum_rows`], "Inertial torque"), then the shared unknowns.
@@ -485,7 +481,7 @@ pub fn reduce_batch(
         let m = 3 * chain.len();
         let columns = anchors + shared;
         let a = DMatrix::from_fn(m, columns, |i, k| {
-            let row = &chain[i / 3];
+            let row = chain[i / 3];
             if k < used.len() {
                 row.a[(i % 3, used[k])]
             } else if k < anchors {
@@ -495,44 +491,53 @@ pub fn reduce_batch(
             }
         });
         let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);
-        rows += m;
         let (r, qty, energy) = factor(a, y);
-        y_energy += energy;
-        rss += (energy - qty.norm_squared()).max(0.0);
         let mut block = (Vec::new(), Vec::new());
         for i in anchors..columns {
             block.0.extend((anchors..columns).map(|k| r[(i, k)]));
             block.1.push(qty[i]);
         }
+        let rss = (energy - qty.norm_squared()).max(0.0);
+        (block, (rss, energy, m))
+    };
+    let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+    let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
+    let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
+    let mut nuisance = settings.shared_nuisance() as f64;
+    for chain in &chains {
+        nuisance += settings.nuisance_per_chain() as f64;
+        let (block, (r, e, m)) = reduce_chain(&chain.iter().collect::<Vec<_>>());
+        (rss, y_energy, rows) = (rss + r, y_energy + e, rows + m);
         blocks.push(block);
     }
-    // The stacked shared rows of the chains `keep` selects, without their first `drop`
-    // columns (the torque's, held at zero): (R, z, rss) in j.
-    let solve_shared = |keep: &dyn Fn(usize) -> bool, drop: usize| {
-        let (mut a, mut y) = (Vec::new(), Vec::new());
-        for (_, block) in blocks.iter().enumerate().filter(|(c, _)| keep(*c)) {
-            for row in block.0.chunks(shared) {
-                a.extend_from_slice(&row[drop..]);
-            }
-            y.extend_from_slice(&block.1);
-        }
-        let m = y.len();
-        let n = shared - drop;
-        let (r, qty, energy) = factor(DMatrix::from_row_slice(m, n, &a), DVector::from_vec(y));
-        let off = n - 6;
-        let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
-        let mut z = Vector6::from_fn(|i, _| qty[off + i]);
-        for i in 0..6 {
-            if rr[(i, i)] < 0.0 {
-                for k in 0..6 {
-                    rr[(i, k)] = -rr[(i, k)];
+    // The stacked shared rows of the chains' `blocks` that `keep` selects, without their
+    // first `drop` columns (the torque's, held at zero): (R, z, rss) in j.
+    let solve_shared =
+        |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop: usize| {
+            let (mut a, mut y) = (Vec::new(), Vec::new());
+            for (_, block) in blocks.iter().enumerate().filter(|(c, _)| keep(*c)) {
+                for row in block.0.chunks(shared) {
+                    a.extend_from_slice(&row[drop..]);
                 }
-                z[i] = -z[i];
+                y.extend_from_slice(&block.1);
             }
-        }
-        (rr, z, (energy - qty.norm_squared()).max(0.0))
-    };
-    let (rr, z, shared_rss) = solve_shared(&|_| true, 0);
+            let m = y.len();
+            let n = shared - drop;
+            let (r, qty, energy) = factor(DMatrix::from_row_slice(m, n, &a), DVector::from_vec(y));
+            let off = n - 6;
+            let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
+            let mut z = Vector6::from_fn(|i, _| qty[off + i]);
+            for i in 0..6 {
+                if rr[(i, i)] < 0.0 {
+                    for k in 0..6 {
+                        rr[(i, k)] = -rr[(i, k)];
+                    }
+                    z[i] = -z[i];
+                }
+            }
+            (rr, z, (energy - qty.norm_squared()).max(0.0))
+        };
+    let (rr, z, shared_rss) = solve_shared(&blocks, &|_| true, 0);
     // The torque's columns, when the rows use them: the same rows without them hold it
     // at zero ([`torque_tested`]), at the cost of the growth of ρ².
     let torque = if settings.torque_bias {
@@ -541,7 +546,7 @@ pub fn reduce_batch(
         0
     };
     let without_torque = (torque > 0).then(|| {
-        let (r, z, held_rss) = solve_shared(&|_| true, torque);
+        let (r, z, held_rss) = solve_shared(&blocks, &|_| true, torque);
         let growth = (held_rss - shared_rss).max(0.0);
         let qr = RecursiveQr {
             r,
@@ -556,13 +561,40 @@ pub fn reduce_batch(
         (qr, growth)
     });
     rss += shared_rss;
-    let used = chains.len().min(GROUPS);
-    let estimates: Option<Vec<_>> = (0..used)
-        .map(|g| {
-            let (r, z, _) = solve_shared(&|c| c % GROUPS != g, 0);
-            crate::solver::unconstrained_minimiser(&r, &z)
-        })
-        .collect();
+    // The jackknife's groups: the chains, or with fewer than MIN_GROUPS of them, time
+    // blocks ([`super::jackknife`], "Records of few chains"): each delete-one problem
+    // the raw rows of every other block, each chain's initial momenta fitted again —
+    // independent of the recursive path's innovations.
+    let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
+        (0..chains.len().min(GROUPS))
+            .map(|g| {
+                let (r, z, _) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
+                crate::solver::unconstrained_minimiser(&r, &z)
+            })
+            .collect()
+    } else {
+        let ids = time_blocks(chains.iter().map(Vec::len));
+        let count = ids.iter().flatten().max().map_or(0, |m| m + 1);
+        (0..count)
+            .map(|g| {
+                let without: Vec<(Vec<f64>, Vec<f64>)> = chains
+                    .iter()
+                    .zip(&ids)
+                    .map(|(chain, ids)| {
+                        let kept: Vec<&AugmentedRow> = chain
+                            .iter()
+                            .zip(ids)
+                            .filter(|(_, &id)| id != g)
+                            .map(|(r, _)| r)
+                            .collect();
+                        reduce_chain(&kept).0
+                    })
+                    .collect();
+                let (r, z, _) = solve_shared(&without, &|_| true, 0);
+                crate::solver::unconstrained_minimiser(&r, &z)
+            })
+            .collect()
+    };
     Ok(BatchReduction {
         qr: RecursiveQr {
             r: rr,
@@ -578,4 +610,55 @@ pub fn reduce_batch(
         jackknife_sigma_kg_m2: estimates.as_deref().and_then(jackknife_sigma),
         without_torque,
     })
+}
+
+/// The time block of each row block of the chains of the given lengths, as
+/// [`super::jackknife::ChainGroups`] forms them: [`super::jackknife::BLOCK_ROWS`] row
+/// blocks at first, a block also ending with its chain; once there are `2·GROUPS`,
+/// neighbours are merged in pairs and the blocks after them are twice as long.
+/// The last block is filed too.
+#[cfg(feature = "std")]
+fn time_blocks(chains: impl Iterator<Item = usize>) -> std::vec::Vec<std::vec::Vec<usize>> {
+    use super::jackknife::{BLOCK_ROWS, GROUPS};
+    use std::vec::Vec;
+    struct Blocks {
+        ids: Vec<Vec<usize>>,
+        closed: usize,
+        length: usize,
+        in_block: usize,
+    }
+    impl Blocks {
+        fn close(&mut self) {
+            (self.closed, self.in_block) = (self.closed + 1, 0);
+            if self.closed == 2 * GROUPS {
+                for id in self.ids.iter_mut().flatten() {
+                    *id /= 2;
+                }
+                (self.closed, self.length) = (GROUPS, 2 * self.length);
+            }
+        }
+    }
+    let mut b = Blocks {
+        ids: Vec::new(),
+        closed: 0,
+        length: BLOCK_ROWS,
+        in_block: 0,
+    };
+    for n in chains {
+        b.ids.push(Vec::with_capacity(n));
+        for _ in 0..n {
+            if b.in_block == b.length {
+                b.close();
+            }
+            let id = b.closed;
+            if let Some(chain) = b.ids.last_mut() {
+                chain.push(id);
+            }
+            b.in_block += 1;
+        }
+        if b.in_block > 0 {
+            b.close();
+        }
+    }
+    b.ids
 }

@@ -1,5 +1,6 @@
 //! A standard deviation that survives correlated row errors: the delete-a-group
-//! jackknife over the chains of the discrete momentum rows (beyond the paper).
+//! jackknife over the chains of the discrete momentum rows, or over time blocks of them
+//! in a record of few chains (beyond the paper).
 //!
 //! The least-squares σ of [`super::uncertainty`] assumes independent rows. The momentum
 //! rows of one chain share its initial momentum, and two error sources make them
@@ -25,7 +26,20 @@
 //! the data that includes the chain in progress; with fewer than [`MIN_GROUPS`] non-empty
 //! groups there is none. The noise σ reported is the larger of this and the
 //! least-squares σ, element by element. What it cannot see is a bias common to every
-//! chain (a wrong model of the wheels between samples, say). With exponential forgetting
+//! chain (a wrong model of the wheels between samples, say).
+//!
+//! **Records of few chains.** A record shorter than four chains (a short test such as a
+//! thrown device, or the first minutes of a long one) has no chain groups; its groups are
+//! then contiguous time blocks of its rows ([`BLOCK_ROWS`] row blocks at first, twice as
+//! long each time there are `2·`[`GROUPS`] of them, their neighbours merged in pairs, so
+//! that there are always between [`GROUPS`] and `2·GROUPS` blocks of a length that grows
+//! with the record: about a sixteenth to an eighth of it). A block ends at a chain's end
+//! too. Within a chain the rows are the whitened innovations of its initial momenta
+//! ([`super::augmented_qr`]), uncorrelated under the model and summing to the chain's
+//! information, so deleting a block's deletes its share of the information; errors
+//! correlated over less than a block (vibration, noise bursts, a drift over a fraction of
+//! the record) stay within it and widen the spread of the delete-one answers. Once there
+//! are four chains, the chains are the groups, as above. With exponential forgetting
 //! the groups' weights differ by orders of magnitude and the equal-weight formula does
 //! not hold, so the estimator keeps no groups then and the noise σ is the least-squares
 //! one.
@@ -40,6 +54,8 @@ use crate::tensor::InertiaVector;
 pub const GROUPS: usize = 8;
 /// Fewest non-empty groups for a jackknife σ.
 pub const MIN_GROUPS: usize = 4;
+/// Row blocks in a time block at first (module docs, "Records of few chains").
+pub const BLOCK_ROWS: usize = 16;
 
 /// `√((G − 1)/G · Σ (θ₍g₎ − θ̄)²)` per element from the delete-one-group estimates; `None`
 /// with fewer than [`MIN_GROUPS`] of them.
@@ -71,47 +87,97 @@ pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [
     })
 }
 
-/// The rows of the chain in progress and of the completed chains, by group: enough to
-/// compute the jackknife σ at any time without holding the rows. The chain in progress
-/// is kept as normal equations ([`super::normal_equations`]) and factored when it ends.
+/// The rows of the chain in progress and of the completed chains, by group, and the
+/// same rows in time blocks: enough to compute the jackknife σ at any time without
+/// holding the rows. The block in progress is kept as normal equations
+/// ([`super::normal_equations`]) and factored when it ends.
 #[derive(Debug, Clone)]
 pub struct ChainGroups {
-    chain: NormalEquations,
+    /// The time block in progress.
+    block: NormalEquations,
+    /// The chain in progress's completed blocks.
+    chain: SharedQr,
     groups: [SharedQr; GROUPS],
     chains: usize,
-    /// `(chains, σ)` at the last computation.
-    cached: Option<(usize, Option<[f64; 6]>)>,
+    /// The completed time blocks, oldest first, and how many there are.
+    blocks: [SharedQr; 2 * GROUPS],
+    closed: usize,
+    /// Row blocks in a time block now.
+    block_rows: usize,
+    /// Row blocks folded into the block in progress.
+    in_block: usize,
+    /// `(chains, blocks closed so far in all, σ)` at the last computation.
+    cached: Option<(usize, usize, Option<[f64; 6]>)>,
+    /// Blocks closed so far in all (the cache's key).
+    blocks_ever: usize,
 }
 
 impl Default for ChainGroups {
     fn default() -> Self {
         Self {
-            chain: NormalEquations::default(),
+            block: NormalEquations::default(),
+            chain: SharedQr::new(0),
             groups: [SharedQr::new(0); GROUPS],
             chains: 0,
+            blocks: [SharedQr::new(0); 2 * GROUPS],
+            closed: 0,
+            block_rows: BLOCK_ROWS,
+            in_block: 0,
             cached: None,
+            blocks_ever: 0,
         }
     }
 }
 
 impl ChainGroups {
-    /// The state of the chain in progress, to add its row blocks to along with the
-    /// estimator's ([`super::augmented_qr::AugmentedQr::add`]): it holds the rows of the
-    /// shared unknowns only, the initial momenta being minimised out already.
+    /// The state to add the next row block to along with the estimator's
+    /// ([`super::augmented_qr::AugmentedQr::add`]): it holds the rows of the shared
+    /// unknowns only, the initial momenta being minimised out already. Call once per row
+    /// block: a full time block is closed first.
     pub fn chain_mut(&mut self) -> &mut NormalEquations {
-        &mut self.chain
+        if self.in_block >= self.block_rows {
+            self.close_block();
+        }
+        self.in_block += 1;
+        &mut self.block
     }
 
-    /// The chain in progress ended: file its rows in its group. Nothing happens for a
-    /// chain without rows.
+    /// File the block in progress (if it has rows) with the chain's and in the time
+    /// blocks; once there are `2·GROUPS`, neighbours are merged in pairs and the blocks
+    /// after them are twice as long.
+    fn close_block(&mut self) {
+        self.in_block = 0;
+        if self.block.counts().rows() == 0 {
+            return;
+        }
+        let b = self.block.factor();
+        self.block = NormalEquations::default();
+        self.chain.merge(&b);
+        self.blocks[self.closed] = b;
+        self.closed += 1;
+        self.blocks_ever += 1;
+        if self.closed == self.blocks.len() {
+            for i in 0..GROUPS {
+                let mut pair = self.blocks[2 * i];
+                pair.merge(&self.blocks[2 * i + 1]);
+                self.blocks[i] = pair;
+            }
+            self.closed = GROUPS;
+            self.block_rows *= 2;
+        }
+    }
+
+    /// The chain in progress ended: its last block closes, and its rows are filed in its
+    /// group. Nothing happens for a chain without rows.
     pub fn end_chain(&mut self) {
-        if self.chain.counts().rows() == 0 {
+        self.close_block();
+        if self.chain.rows() == 0 {
             return;
         }
         if let Some(g) = self.groups.get_mut(self.chains % GROUPS) {
-            g.merge(&self.chain.factor());
+            g.merge(&self.chain);
         }
-        self.chain = NormalEquations::default();
+        self.chain = SharedQr::new(0);
         self.chains += 1;
     }
 
@@ -121,19 +187,33 @@ impl ChainGroups {
     /// Each delete-one-group problem carries the prior knowledge of `constraints`
     /// ([`super::prior::augment`]), as the estimate does.
     pub fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
-        if let Some((chains, sigma)) = self.cached {
-            if chains == self.chains {
+        if let Some((chains, blocks, sigma)) = self.cached {
+            if chains == self.chains && blocks == self.blocks_ever {
                 return sigma.map(|s| self.scaled(s));
             }
         }
         let sigma = self.compute(constraints);
-        self.cached = Some((self.chains, sigma));
+        self.cached = Some((self.chains, self.blocks_ever, sigma));
         sigma.map(|s| self.scaled(s))
     }
 
+    /// Whether the groups are the chains (else the time blocks).
+    fn by_chain(&self) -> bool {
+        self.chains >= MIN_GROUPS
+    }
+
     fn scaled(&self, s: [f64; 6]) -> [f64; 6] {
-        let done: f64 = self.groups.iter().map(SharedQr::weight).sum();
-        let all = done + self.chain.counts().weight();
+        let pending = self.block.counts().weight();
+        let (done, all) = if self.by_chain() {
+            let done: f64 = self.groups.iter().map(SharedQr::weight).sum();
+            (done, done + self.chain.weight() + pending)
+        } else {
+            let done: f64 = self.blocks[..self.closed]
+                .iter()
+                .map(SharedQr::weight)
+                .sum();
+            (done, done + pending)
+        };
         let f = if all > 0.0 {
             crate::math::sqrt(done / all)
         } else {
@@ -143,29 +223,39 @@ impl ChainGroups {
     }
 
     fn compute(&self, constraints: &Constraints) -> Option<[f64; 6]> {
-        let used = self.chains.min(GROUPS);
-        let groups = &self.groups[..used];
-        // The groups before `g` and after it, merged once each way: each delete-one
-        // state is then one merge, not `used − 2`.
-        let mut before = [SharedQr::new(0); GROUPS];
-        let mut after = [SharedQr::new(0); GROUPS];
-        for g in 1..used {
-            before[g] = before[g - 1];
-            before[g].merge(&groups[g - 1]);
-        }
-        for g in (0..used.saturating_sub(1)).rev() {
-            after[g] = after[g + 1];
-            after[g].merge(&groups[g + 1]);
-        }
-        let mut estimates = [InertiaVector::zeros(); GROUPS];
-        for (g, out) in estimates.iter_mut().enumerate().take(used) {
-            let mut rest = before[g];
-            rest.merge(&after[g]);
-            let reduced = super::prior::augment(&rest.reduced(), constraints).0;
-            *out = unconstrained_minimiser(&reduced.r, &reduced.z)?;
-        }
-        estimates.get(..used).and_then(jackknife_sigma)
+        let groups = if self.by_chain() {
+            &self.groups[..self.chains.min(GROUPS)]
+        } else {
+            &self.blocks[..self.closed]
+        };
+        delete_one_sigma(groups, constraints)
     }
+}
+
+/// The jackknife σ of the delete-one-group answers of `groups` (module docs), each
+/// delete-one problem with the prior knowledge of `constraints`.
+fn delete_one_sigma(groups: &[SharedQr], constraints: &Constraints) -> Option<[f64; 6]> {
+    let used = groups.len();
+    // The groups before `g` and after it, merged once each way: each delete-one
+    // state is then one merge, not `used − 2`.
+    let mut before = [SharedQr::new(0); 2 * GROUPS];
+    let mut after = [SharedQr::new(0); 2 * GROUPS];
+    for g in 1..used {
+        before[g] = before[g - 1];
+        before[g].merge(&groups[g - 1]);
+    }
+    for g in (0..used.saturating_sub(1)).rev() {
+        after[g] = after[g + 1];
+        after[g].merge(&groups[g + 1]);
+    }
+    let mut estimates = [InertiaVector::zeros(); 2 * GROUPS];
+    for (g, out) in estimates.iter_mut().enumerate().take(used) {
+        let mut rest = before[g];
+        rest.merge(&after[g]);
+        let reduced = super::prior::augment(&rest.reduced(), constraints).0;
+        *out = unconstrained_minimiser(&reduced.r, &reduced.z)?;
+    }
+    estimates.get(..used).and_then(jackknife_sigma)
 }
 
 #[cfg(test)]
@@ -221,6 +311,74 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    /// Problem: one chain of 1,000 random row blocks, whose groups are time blocks.
+    /// Reference: the blocks' definition and the direct delete-one answers. Once there
+    /// are `GROUPS` blocks there stay between `GROUPS` and `2·GROUPS`, every closed one as
+    /// long as the blocks now (`BLOCK_ROWS · 2^k` row blocks); the closed blocks and the one in progress hold
+    /// the whole chain's information (R of their merge against R of all rows, 1e-9); the
+    /// σ is the direct delete-one-block jackknife of the closed blocks, scaled by
+    /// `√(w_closed / w_all)`, to 1e-9.
+    #[test]
+    fn a_single_chain_is_grouped_in_time_blocks() {
+        let mut rnd = crate::testing::uniform(0x9e37_79b9_7f4a_7c15);
+        let constraints = crate::constraints::ConstraintSet::physical()
+            .validate()
+            .unwrap();
+        let mut groups = ChainGroups::default();
+        let mut all = SharedQr::new(0);
+        for n in 1..=1000 {
+            let a: [SVector<f64, SHARED>; 3] =
+                core::array::from_fn(|_| SVector::from_fn(|_, _| rnd()));
+            let y: [f64; 3] = core::array::from_fn(|_| rnd());
+            groups.chain_mut().add(&(a, y), &y, 0.0);
+            all.add((a, y), &y, 0.0);
+            let length = groups.block_rows;
+            assert!(length.is_power_of_two() && length >= BLOCK_ROWS);
+            assert!(groups.closed <= 2 * GROUPS, "row block {n}");
+            if n > BLOCK_ROWS * GROUPS {
+                assert!(groups.closed >= GROUPS, "row block {n}");
+            }
+            assert_eq!(groups.chains, 0);
+            // Every closed block is as long as the blocks now.
+            for b in &groups.blocks[..groups.closed] {
+                assert_eq!(b.rows(), 3 * length, "row block {n}");
+            }
+        }
+        let mut merged = SharedQr::new(0);
+        for b in &groups.blocks[..groups.closed] {
+            merged.merge(b);
+        }
+        merged.merge(&groups.block.factor());
+        let (r1, r2) = (merged.reduced().r, all.reduced().r);
+        let gram = |r: &nalgebra::Matrix6<f64>| r.transpose() * r;
+        assert!((gram(&r1) - gram(&r2)).norm() <= 1e-9 * gram(&r2).norm());
+        let direct: std::vec::Vec<InertiaVector> = (0..groups.closed)
+            .map(|g| {
+                let mut rest = SharedQr::new(0);
+                for (h, b) in groups.blocks[..groups.closed].iter().enumerate() {
+                    if h != g {
+                        rest.merge(b);
+                    }
+                }
+                let reduced = rest.reduced();
+                unconstrained_minimiser(&reduced.r, &reduced.z).expect("regular")
+            })
+            .collect();
+        let done: f64 = groups.blocks[..groups.closed]
+            .iter()
+            .map(SharedQr::weight)
+            .sum();
+        let f = crate::math::sqrt(done / (done + groups.block.counts().weight()));
+        let want = jackknife_sigma(&direct).expect("groups");
+        let got = groups.sigma(&constraints).expect("σ");
+        for k in 0..6 {
+            assert!(
+                (got[k] - want[k] * f).abs() <= 1e-9 * want[k],
+                "element {k}"
+            );
         }
     }
 }

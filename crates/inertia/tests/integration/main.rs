@@ -20,6 +20,7 @@ mod lab_realism;
 mod numeric_range;
 mod pipeline;
 mod prior;
+mod short_records;
 mod sim_realism;
 mod solver_agreement;
 mod solver_random;
