@@ -226,6 +226,8 @@ typedef struct InertiaSettings {
   // are weighted for the drift (needs `uncertainty`). 0 (default) for none (a star
   // tracker or an MEKF).
   double attitude_drift_deg_rth;
+  // One of `InertiaInertialTorque` (discrete momentum). Default off.
+  uint32_t inertial_torque;
 } InertiaSettings;
 
 // One telemetry sample at time `t_s` (README "Estimating your own telemetry").

@@ -8,7 +8,7 @@ use inertia::constraints::ConstraintSet;
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::estimator::observability::ObservabilitySettings;
 use inertia::estimator::recursive::RecursiveSettings;
-use inertia::pipeline::{PipelineError, PipelineSettings};
+use inertia::pipeline::{InertialTorque, PipelineError, PipelineSettings};
 use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::Component;
 
@@ -62,6 +62,19 @@ pub enum InertiaRhoModel {
     Held = 2,
     /// The plain trapezoid.
     Plain = 3,
+}
+
+/// Whether to estimate a torque constant in the inertial frame, per chain
+/// (`InertiaSettings::inertial_torque`, discrete momentum; the CLI's `--inertial-torque`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaInertialTorque {
+    /// Not estimated (default).
+    Off = 0,
+    /// Always estimated.
+    On = 1,
+    /// Estimated where a nested χ² test says the data need it.
+    Auto = 2,
 }
 
 /// What to do when the attitude jumps against the gyro (`InertiaSettings::glitches`).
@@ -123,6 +136,8 @@ pub struct InertiaSettings {
     /// are weighted for the drift (needs `uncertainty`). 0 (default) for none (a star
     /// tracker or an MEKF).
     pub attitude_drift_deg_rth: f64,
+    /// One of `InertiaInertialTorque` (discrete momentum). Default off.
+    pub inertial_torque: u32,
 }
 
 /// What the C settings ask for, without the heap (no estimator name string).
@@ -138,6 +153,7 @@ pub(crate) struct Plan {
     torque_bias: bool,
     rotation_source: Option<RotationSource>,
     rho_model: RhoModel,
+    inertial_torque: InertialTorque,
     max_chain_s: Option<f64>,
     glitches: GlitchPolicy,
 }
@@ -267,6 +283,7 @@ impl Plan {
                     RhoModel::Plain,
                 ],
             )?,
+            inertial_torque: choice("inertial_torque", s.inertial_torque, &InertialTorque::ALL)?,
             max_chain_s: optional_positive("max_chain_s", s.max_chain_s)?,
             glitches: choice(
                 "glitches",
@@ -300,8 +317,7 @@ impl Plan {
             rotation_source: self.rotation_source,
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
-            // Not in the C settings yet: the fixed-size engine has no inertial torque.
-            inertial_torque: inertia::pipeline::InertialTorque::Off,
+            inertial_torque: self.inertial_torque,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,
@@ -336,6 +352,10 @@ impl Plan {
             ("rotation_source", self.rotation_source.is_some()),
             ("rho_model", self.rho_model != RhoModel::Auto),
             ("torque_bias", !self.torque_bias),
+            (
+                "inertial_torque",
+                self.inertial_torque != InertialTorque::Off,
+            ),
             (
                 "max_chain_s",
                 self.max_chain_s != Some(inertia::pipeline::DEFAULT_MAX_CHAIN_S),
@@ -403,5 +423,6 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         max_chain_s: inertia::pipeline::DEFAULT_MAX_CHAIN_S,
         glitches: InertiaGlitchPolicy::Stop as u32,
         attitude_drift_deg_rth: 0.0,
+        inertial_torque: InertiaInertialTorque::Off as u32,
     }
 }

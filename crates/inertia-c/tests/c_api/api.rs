@@ -156,6 +156,22 @@ fn bad_settings_name_the_setting() {
         ),
         (
             InertiaSettings {
+                inertial_torque: 3,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "inertial_torque",
+        ),
+        (
+            InertiaSettings {
+                inertial_torque: InertiaInertialTorque::On as u32,
+                ..variational()
+            },
+            InertiaStatus::InvalidSetting,
+            "inertial_torque",
+        ),
+        (
+            InertiaSettings {
                 attitude_drift_deg_rth: 0.036,
                 ..inertia_settings_default()
             },

@@ -219,3 +219,53 @@ fn a_memory_shorter_than_the_step_is_refused_by_both_engines() {
         free(est);
     }
 }
+
+/// `inertial_torque` reaches the discrete momentum estimator: on the paper's slew, C with
+/// `on` gives the library pipeline's final J with `InertialTorque::On` (to 1e-12
+/// relative, as the C example against the CLI), and a different J from `off`.
+#[test]
+fn the_inertial_torque_reaches_the_discrete_momentum_estimator() {
+    use inertia::pipeline::{InertialTorque, Pipeline, PipelineSettings};
+    let run = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let c_final = |mode: InertiaInertialTorque| {
+        let est = new(&InertiaSettings {
+            inertial_torque: mode as u32,
+            ..inertia_settings_default()
+        });
+        for x in &run.samples {
+            assert_eq!(
+                push(est, &c_sample(x)),
+                InertiaStatus::Ok,
+                "{}",
+                last_error()
+            );
+        }
+        let e = get(est);
+        free(est);
+        e.j
+    };
+    let mut p = Pipeline::new(&PipelineSettings {
+        inertial_torque: InertialTorque::On,
+        ..PipelineSettings::default()
+    })
+    .unwrap();
+    for x in &run.samples {
+        p.push(x).unwrap();
+    }
+    let library = p.last().and_then(|e| e.j()).expect("answer");
+    let on = c_final(InertiaInertialTorque::On);
+    let off = c_final(InertiaInertialTorque::Off);
+    let gap = |a: &[f64; 6]| {
+        (0..6)
+            .map(|k| (a[k] - library[k]).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        gap(&on) <= 1e-12 * library.norm(),
+        "on: {on:?} against {library:?}"
+    );
+    assert!(
+        gap(&off) > 1e-9 * library.norm(),
+        "off gives on's answer: {off:?}"
+    );
+}
