@@ -444,9 +444,9 @@ pub struct EstimateArgs {
     pub no_torque_bias: bool,
     /// A disturbance torque constant in the inertial frame (discrete-momentum estimator;
     /// aerodynamic or solar force fixed in space, or the momentum's drift over a short
-    /// record), one per chain: `off` (default), `on`, or `auto` (both models folded; a
-    /// nested chi-squared test at 1e-3 takes it where the data need it, and the report's
-    /// `rows:` line says so).
+    /// record), one per chain: `off` (default), `on`, or `auto` (both models folded; it is
+    /// taken where a nested chi-squared test at 1e-3 and the BIC both say the data need
+    /// it, and the report's `rows:` line says so).
     #[arg(long, value_name = "MODE", default_value = "off",
           value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
     pub inertial_torque: String,

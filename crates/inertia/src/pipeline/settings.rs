@@ -365,9 +365,9 @@ pub enum InertialTorque {
     Off,
     /// Always estimated.
     On,
-    /// Estimated where a nested χ² test at 10⁻³ says the data need it
-    /// (`estimators/discrete_momentum/select.rs`): both models are folded, and the
-    /// report says which answered.
+    /// Estimated where a nested χ² test at 10⁻³ and the Bayesian information criterion
+    /// both say the data need it (`estimators/discrete_momentum/select.rs`): both models
+    /// are folded, and the report says which answered.
     Auto,
 }
 
