@@ -282,6 +282,7 @@ fn read_csv(
         period_tolerance: conv.period_tolerance,
         delimiter: b',',
         negate_rho: conv.negate_rho,
+        ..CsvOptions::default()
     };
     py.allow_threads(|| read(&path, options))
         .map_err(|f| f.into_py(py))

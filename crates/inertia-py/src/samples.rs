@@ -144,6 +144,7 @@ impl Checker {
             QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(row.q),
             QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(row.q),
             QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(row.q),
+            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(row.q),
         };
         let norm = raw.norm();
         if (norm - 1.0).abs() > c.unit_tolerance {

@@ -118,6 +118,8 @@ class Estimate:
         torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,);
             ``None`` where it is not estimated or the data gave no evidence of one and it
             was held at zero (``report["torque_test"]``: ``chi2``, ``held_at_zero``).
+        warnings: every ``warning:`` line of the text report (the JSON's ``warnings``
+            messages), none of which contradicts ``status``.
         report: the whole report as a dict (the ``inertia estimate --json`` schema).
         text: the readable report (``inertia estimate`` without ``--json``).
 
@@ -139,6 +141,7 @@ class Estimate:
     estimator: str
     relative_error: Optional[float]
     torque_bias_nm: Optional[np.ndarray]
+    warnings: List[str]
     report: Dict[str, Any] = dataclasses.field(repr=False)
     text: str = dataclasses.field(repr=False)
     history_columns: Optional[Dict[str, Any]] = dataclasses.field(default=None, repr=False)
@@ -162,6 +165,7 @@ class Estimate:
             estimator=r["estimator"],
             relative_error=r["relative_error"],
             torque_bias_nm=_array(r["torque_bias_nm"]),
+            warnings=[w["message"] for w in r["warnings"]],
             report=r,
             text=text,
             history_columns=history,

@@ -36,6 +36,7 @@ class Estimate:
     estimator: str
     relative_error: Optional[float]
     torque_bias_nm: Optional[np.ndarray]  # (3,) N m
+    warnings: List[str]
     report: Dict[str, Any]
     text: str
     history_columns: Optional[Dict[str, Any]]

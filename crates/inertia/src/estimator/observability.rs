@@ -287,6 +287,14 @@ pub enum Observability {
     /// The estimator makes no observability test (the momentum RLS baseline): an answer,
     /// with no claim about how well the data determine it.
     Unchecked,
+    /// The rows pass the rank and conditioning tests, but the answer has no standard
+    /// deviation (an estimator or batch form without an uncertainty model, or σ switched
+    /// off): without a σ there is no promise to keep, so it is not
+    /// [`Observability::Determined`] (code `unchecked`; [`crate::pipeline::status`]).
+    NoSigma {
+        /// `σ_1/σ_6` of `R`.
+        condition: f64,
+    },
 }
 
 impl Observability {
@@ -303,7 +311,7 @@ impl Observability {
             Observability::Determined { .. } => "determined",
             Observability::FromPrior(_) => "from_prior",
             Observability::NotObservable(_) => "not_observable",
-            Observability::Unchecked => "unchecked",
+            Observability::Unchecked | Observability::NoSigma { .. } => "unchecked",
         }
     }
 
@@ -320,7 +328,9 @@ impl Observability {
     #[must_use]
     pub fn condition(&self) -> Option<f64> {
         match self {
-            Observability::Determined { condition } => Some(*condition),
+            Observability::Determined { condition } | Observability::NoSigma { condition } => {
+                Some(*condition)
+            }
             _ => None,
         }
     }
@@ -348,6 +358,10 @@ impl core::fmt::Display for Observability {
             Observability::Unchecked => {
                 f.write_str("recursive least squares (no observability test, unconstrained)")
             }
+            Observability::NoSigma { condition } => write!(
+                f,
+                "unchecked: an answer without a standard deviation (this estimator states none here), so nothing says how close it is; the rows pass the rank and conditioning tests (condition number {condition:.3e})"
+            ),
         }
     }
 }

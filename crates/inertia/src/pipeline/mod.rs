@@ -50,6 +50,7 @@ pub mod registry;
 mod run;
 mod sdp;
 mod settings;
+pub mod status;
 
 #[cfg(feature = "csv")]
 pub mod history;
@@ -214,7 +215,7 @@ impl PipelineError {
             PipelineError::AttitudeConvention { fixes, .. } => fixes,
             PipelineError::ReversedMomentum { quaternions, .. } => match quaternions {
                 Verdict::Consistent(_) => &[Fix::NegateRho],
-                _ => &[Fix::NegateRho, Fix::Jpl],
+                _ => &[Fix::NegateRho, Fix::Conjugate],
             },
             PipelineError::AttitudeGlitch { .. } => &[Fix::KeepGlitches],
             PipelineError::ResampleTooFine { .. } => &[Fix::Resample],
@@ -354,6 +355,7 @@ impl Pipeline {
         ));
         self.checks.push(index, s, self.config.glitches)?;
         self.input_samples += 1;
+        let consistency = self.config.constraints().set().consistency;
         let Self {
             resampler,
             estimator,
@@ -370,7 +372,8 @@ impl Pipeline {
                     sample: Some(index),
                     source,
                 })?;
-            if let Some(e) = e {
+            if let Some(mut e) = e {
+                status::settle(&mut e, consistency);
                 checks.estimate(index, &e)?;
                 *last = Some(e);
                 on_estimate(&e);
@@ -512,7 +515,8 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         }
     }
     checks::convention_error(&check)?;
-    let out = run(samples, config)?;
+    let mut out = run(samples, config)?;
+    status::settle(&mut out.estimate, config.constraints().set().consistency);
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
 }

@@ -70,6 +70,19 @@ pub enum QuaternionFormat {
     /// JPL/Shuster (inertial → body attitude matrix, scalar last). Converted with
     /// [`Quaternion::from_jpl_xyzw`].
     Jpl,
+    /// Hamilton, scalar last, but mapping inertial → body (the conjugate of this crate's
+    /// meaning): [`Quaternion::from_hamilton_inertial_to_body_xyzw`].
+    Conjugate,
+}
+
+/// The unit of the gyro rate columns `w_*`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GyroUnit {
+    /// rad/s (the default).
+    #[default]
+    RadPerS,
+    /// deg/s: converted to rad/s as read.
+    DegPerS,
 }
 
 /// Column names. Defaults are those of the table in the module docs.
@@ -148,6 +161,8 @@ pub struct CsvOptions {
     /// are read. Default `false`. The pipeline stops where the data show a reversed sign
     /// ([`crate::pipeline::PipelineError::ReversedMomentum`]).
     pub negate_rho: bool,
+    /// The unit of the `w_*` columns. Default rad/s.
+    pub gyro_unit: GyroUnit,
 }
 
 impl Default for CsvOptions {
@@ -159,6 +174,7 @@ impl Default for CsvOptions {
             period_tolerance: None,
             delimiter: b',',
             negate_rho: false,
+            gyro_unit: GyroUnit::RadPerS,
         }
     }
 }
@@ -647,6 +663,7 @@ impl<R: Read> TelemetryReader<R> {
             QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(c),
             QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(c),
             QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(c),
+            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(c),
         };
         let norm = raw.norm();
         if (norm - 1.0).abs() > self.options.unit_tolerance {
@@ -673,7 +690,12 @@ impl<R: Read> TelemetryReader<R> {
             None => Vector3::zeros(),
         };
         let w = match self.idx.w {
-            Some(i) => Some(self.vec3(line, &i, Quantity::Rate)?),
+            Some(i) => Some(match self.options.gyro_unit {
+                GyroUnit::RadPerS => self.vec3(line, &i, Quantity::Rate)?,
+                GyroUnit::DegPerS => {
+                    self.vec3(line, &i, Quantity::Rate)? * (core::f64::consts::PI / 180.0)
+                }
+            }),
             None => None,
         };
         if let Some(prev) = self.prev {

@@ -417,7 +417,7 @@ mod status {
             (
                 "conjugated",
                 (|q: &Quaternion| q.conjugate()) as fn(&Quaternion) -> Quaternion,
-                &[Fix::Jpl] as &[Fix],
+                &[Fix::Conjugate] as &[Fix],
             ),
             (
                 "scalar first",
@@ -443,7 +443,7 @@ mod status {
                     let [w, x, y, z] = q.conjugate().to_wxyz();
                     Quaternion::from_xyzw([w, x, y, z])
                 },
-                &[Fix::ScalarFirst, Fix::Jpl],
+                &[Fix::ScalarFirst, Fix::Conjugate],
             ),
             (
                 // JPL quaternions stored scalar last, read with --scalar-first.
@@ -452,7 +452,7 @@ mod status {
                     let [x, y, z, w] = q.conjugate().to_xyzw();
                     Quaternion::from_wxyz([x, y, z, w])
                 },
-                &[Fix::ScalarLast, Fix::Jpl],
+                &[Fix::ScalarLast, Fix::Conjugate],
             ),
         ] {
             let bad: Vec<Sample> = good.iter().map(|s| Sample { q: f(&s.q), ..*s }).collect();
@@ -640,7 +640,7 @@ mod status {
                     // named too; where it has, it is not.
                     let confirmed = matches!(quaternions, Verdict::Consistent(_));
                     assert_eq!(
-                        e.fixes().contains(&Fix::Jpl),
+                        e.fixes().contains(&Fix::Conjugate),
                         !confirmed,
                         "{at}, {name}: {text}"
                     );
