@@ -87,6 +87,43 @@ typedef enum InertiaReason {
   INERTIA_REASON_NOT_PHYSICAL = 14,
 } InertiaReason;
 
+// The kind of the last error (`inertia_last_error_kind`): the same kinds, with the same
+// names, as the command line's JSON error (`"kind"`) and Python's `DataError.kind`.
+typedef enum InertiaErrorKind {
+  // No error, or one of no particular kind (a NULL pointer, a bad setting field).
+  INERTIA_ERROR_KIND_NONE = 0,
+  // A value is NaN or infinite.
+  INERTIA_ERROR_KIND_NOT_FINITE = 1,
+  // A value is outside the supported range.
+  INERTIA_ERROR_KIND_OUT_OF_RANGE = 2,
+  // The quaternion's norm differs from 1 by more than 1e-3.
+  INERTIA_ERROR_KIND_NON_UNIT_QUATERNION = 3,
+  // Time does not increase.
+  INERTIA_ERROR_KIND_TIME_NOT_INCREASING = 4,
+  // Gyro rates given for some samples and not for others.
+  INERTIA_ERROR_KIND_GYRO_CHANGED = 5,
+  // The estimator needs gyro rates.
+  INERTIA_ERROR_KIND_NEEDS_GYRO = 6,
+  // A memory shorter than the sample period.
+  INERTIA_ERROR_KIND_MEMORY_SHORTER_THAN_STEP = 7,
+  // A setting is invalid or does not apply.
+  INERTIA_ERROR_KIND_INVALID_SETTING = 8,
+  // The data show the rotor momentum with the opposite sign.
+  INERTIA_ERROR_KIND_REVERSED_MOMENTUM = 9,
+  // The quaternion convention disagrees with the gyro.
+  INERTIA_ERROR_KIND_ATTITUDE_CONVENTION = 10,
+  // The attitude jumps against the gyro.
+  INERTIA_ERROR_KIND_ATTITUDE_GLITCH = 11,
+  // A step or row the estimator cannot use.
+  INERTIA_ERROR_KIND_ROW = 12,
+  // The solver failed.
+  INERTIA_ERROR_KIND_SOLVER = 13,
+  // An earlier error stopped the estimator.
+  INERTIA_ERROR_KIND_STOPPED = 14,
+  // A kind this version of the header does not name.
+  INERTIA_ERROR_KIND_OTHER = 15,
+} InertiaErrorKind;
+
 // The estimators (`InertiaSettings::estimator`).
 typedef enum InertiaEstimatorKind {
   // The discrete momentum estimator (the CLI's default; heap only).
@@ -338,6 +375,18 @@ size_t inertia_last_error_message(char *buf, size_t len);
 // The name of a status code (a static string, e.g. `"INERTIA_STATUS_DATA"`;
 // `"INERTIA_STATUS_UNKNOWN"` for a value that is none).
 const char *inertia_status_name(int32_t status);
+
+// The kind of the last error on this thread (`INERTIA_ERROR_KIND_NONE` when there was
+// none, or it has no particular kind).
+enum InertiaErrorKind inertia_last_error_kind(void);
+
+// The 0-based index of the sample the last error on this thread is about (counted since
+// creation or the last reset), or -1 when it is about no one sample.
+int64_t inertia_last_error_sample(void);
+
+// The name of an error kind (a static string, e.g. `"time_not_increasing"`, the name the
+// command line and Python give it; `"other"` for a value that is none).
+const char *inertia_error_kind_name(int32_t kind);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -10,7 +10,6 @@
 //!   allocates (`tests/no_alloc.rs` counts). `tests/c_api/engines.rs` checks that it gives the
 //!   pipeline's estimates bit for bit.
 
-use inertia::attitude::Quaternion;
 use inertia::constraints::Constraints;
 use inertia::estimator::recursive::RecursiveSettings;
 use inertia::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
@@ -122,16 +121,4 @@ impl Engine {
             Engine::FiniteDifference(_) => true,
         }
     }
-}
-
-/// A quaternion as the CSV reader takes it: renormalised when its norm is not exactly 1
-/// (the range check has bounded the deviation).
-pub(crate) fn unit(c: [f64; 4]) -> Quaternion {
-    let raw = Quaternion::from_xyzw(c);
-    if raw.norm() != 1.0 {
-        if let Some(n) = raw.normalize() {
-            return n;
-        }
-    }
-    raw
 }

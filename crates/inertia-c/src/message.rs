@@ -1,9 +1,10 @@
 //! Error messages in fixed buffers: the last error of each thread, recorded without the
 //! heap (a `const`-initialised thread-local with no destructor needs no allocation).
 
-use core::cell::RefCell;
+use core::cell::{Cell, RefCell};
 use core::ffi::c_char;
 use core::fmt;
+use inertia::error_kind::ErrorKind;
 
 /// Longest message kept, bytes (the library's messages are at most 1000 characters).
 pub(crate) const CAPACITY: usize = 1024;
@@ -70,10 +71,23 @@ impl fmt::Write for Buffer {
 
 thread_local! {
     static LAST: RefCell<Buffer> = const { RefCell::new(Buffer::new()) };
+    /// The last error's kind and the index of its sample.
+    static KIND: Cell<(Option<ErrorKind>, Option<u64>)> = const { Cell::new((None, None)) };
 }
 
-/// Record `msg` as this thread's last error.
+/// Record the kind of this thread's last error (after [`record`], which clears it).
+pub fn set_kind(kind: Option<ErrorKind>, sample: Option<u64>) {
+    let _ = KIND.try_with(|k| k.set((kind, sample)));
+}
+
+/// The kind of this thread's last error and the index of its sample.
+pub fn last_kind() -> (Option<ErrorKind>, Option<u64>) {
+    KIND.try_with(Cell::get).unwrap_or((None, None))
+}
+
+/// Record `msg` as this thread's last error (of no kind until [`set_kind`]).
 pub fn record(msg: fmt::Arguments<'_>) {
+    set_kind(None, None);
     let _ = LAST.try_with(|b| {
         if let Ok(mut b) = b.try_borrow_mut() {
             b.clear();

@@ -62,7 +62,8 @@
 //! discrete momentum estimator given the cell's gyro noise density (`gyro_noise_deg_s_rthz`,
 //! errors-in-variables compensation), as a user with the gyro's datasheet would.
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
-//! (`0`: none) for experiments; unset, the default. `DIGITS=1` prints the medians with
+//! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto` its
+//! `--inertial-torque` (unset: `off`). `DIGITS=1` prints the medians with
 //! four significant digits.
 
 use inertia::constraints::ConstraintSet;
@@ -357,6 +358,10 @@ fn estimate(
             Some(_) => None,
             None => PipelineSettings::default().max_chain_s,
         },
+        inertial_torque: std::env::var("INERTIAL_TORQUE")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_default(),
         ..PipelineSettings::default()
     })
     .ok()?;

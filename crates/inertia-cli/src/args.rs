@@ -429,6 +429,14 @@ pub struct EstimateArgs {
     /// estimator; by default it is estimated, at no cost when it is absent).
     #[arg(long)]
     pub no_torque_bias: bool,
+    /// A disturbance torque constant in the inertial frame (discrete-momentum estimator;
+    /// aerodynamic or solar force fixed in space, or the momentum's drift over a short
+    /// record), one per chain: `off` (default), `on`, or `auto` (both models folded; a
+    /// nested chi-squared test at 1e-3 takes it where the data need it, and the report's
+    /// `rows:` line says so).
+    #[arg(long, value_name = "MODE", default_value = "off",
+          value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
+    pub inertial_torque: String,
     /// Short momentum chain, s (discrete-momentum estimator): the conserved momentum is
     /// re-anchored after this long, which bounds the effect of a drifting attitude
     /// (gyro-propagated attitude); chains a quarter and 4x as long and one chain over the

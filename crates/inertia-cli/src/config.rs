@@ -298,6 +298,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
             RhoModelArg::Plain => RhoModel::Plain,
         },
         torque_bias: !a.no_torque_bias,
+        inertial_torque: a.inertial_torque.parse().map_err(settings_error)?,
         max_chain_s: (a.chain != 0.0).then_some(a.chain),
         glitches: match a.glitches {
             GlitchArg::Stop => GlitchPolicy::Stop,
@@ -318,6 +319,7 @@ fn option_of(field: &str) -> &str {
         "rotation_source" => "--rotation-source",
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",
+        "inertial_torque" => "--inertial-torque",
         "max_chain_s" => "--chain",
         "attitude_drift_deg_rth" => "--attitude-drift",
         other => other,

@@ -4,7 +4,7 @@
 
 use crate::args::EstimateArgs;
 use crate::config::{self, settings_error, InertiaFile};
-use crate::error::{input, internal, read_failed, telemetry, CliError};
+use crate::error::{input, internal, read_failed, telemetry, telemetry_at, CliError};
 use crate::history::HistoryFile;
 use crate::output::{is_stdio, to_stdout};
 use inertia::fix::{Fix, Fixes};
@@ -57,7 +57,12 @@ fn run_error(e: &RunError, file: &str, line: Option<u64>, q_columns: &str) -> Cl
         names: option_names,
         label: "option",
     };
-    input(format!("{at}{columns} {e}{fixes}"))
+    CliError::Refused {
+        message: format!("{at}{columns} {e}{fixes}"),
+        kind: e.error_kind(),
+        sample: e.sample,
+        line,
+    }
 }
 
 /// Run the command.
@@ -105,7 +110,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     };
     let mut write_error = None;
     while let Some(item) = reader.next() {
-        let s = item.map_err(telemetry)?;
+        let s = item.map_err(|e| telemetry_at(e, Some(run.input_samples())))?;
         if lines.len() == keep {
             lines.pop_front();
         }

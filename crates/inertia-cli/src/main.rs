@@ -9,6 +9,10 @@
 //!   (named with its path);
 //! - 1: an internal failure (a bug; nothing in a user's data or arguments leads there).
 //!
+//! With `estimate --json`, a failure also prints `{"error": {"kind", "sample", "line",
+//! "message"}}` on standard output (`kind`: the library's `ErrorKind` name, as Python's
+//! `DataError.kind` and C's `inertia_last_error_kind`).
+//!
 //! Every message is one line of at most [`error::MAX_MESSAGE_CHARS`] characters. Output
 //! files appear only when a run succeeds ([`output`]).
 
@@ -40,6 +44,11 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
+            if let Command::Estimate(a) = &cli.command {
+                if a.json {
+                    println!("{}", e.json());
+                }
+            }
             eprintln!("inertia: {e}");
             ExitCode::from(e.code())
         }

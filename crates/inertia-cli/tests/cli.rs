@@ -1,5 +1,8 @@
 //! End-to-end tests of the `inertia` binary.
 
+#[path = "cli/bad_inputs.rs"]
+mod bad_inputs;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

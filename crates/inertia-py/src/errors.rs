@@ -2,6 +2,7 @@
 //! names the file, line and column (`f.csv:9: columns `q_x,q_y,q_z,q_w`: …`) or, for
 //! arrays, the argument and row (`q[9]: …`).
 
+use inertia::error_kind::ErrorKind;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyOSError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -11,8 +12,10 @@ create_exception!(
     DataError,
     PyValueError,
     "Bad input data: the message names the file, line and column (or the argument and \
-     row) as `inertia estimate` does, and `.line` holds the 1-based line of a file when \
-     there is one (else None)."
+     row) as `inertia estimate` does; `.line` holds the 1-based line of a file when there \
+     is one (else None), `.kind` the error's kind (e.g. 'time_not_increasing', as the CLI's \
+     JSON error and C's inertia_last_error_kind name it) and `.sample` the 0-based index \
+     of the sample at fault (else None)."
 );
 
 pub fn value_error(m: impl Into<String>) -> PyErr {
@@ -23,12 +26,23 @@ pub fn type_error(m: impl Into<String>) -> PyErr {
     PyTypeError::new_err(m.into())
 }
 
-/// A data error, with the line of the file it names (if any) as `.line`.
-pub fn data_error(py: Python<'_>, message: String, line: Option<u64>) -> PyErr {
+/// A data error, with the line of the file it names (if any) as `.line`, its kind
+/// (`inertia::error_kind::ErrorKind`'s name, or None) as `.kind` and the 0-based index of the
+/// sample at fault (or None) as `.sample`.
+pub fn data_error(
+    py: Python<'_>,
+    message: String,
+    line: Option<u64>,
+    kind: Option<ErrorKind>,
+    sample: Option<usize>,
+) -> PyErr {
     let e = DataError::new_err(message);
     // Setting an attribute on a fresh exception object does not fail in practice; if
     // it did, the message still names the line.
-    let _ = e.value(py).setattr("line", line);
+    let v = e.value(py);
+    let _ = v.setattr("line", line);
+    let _ = v.setattr("kind", kind.map(ErrorKind::name));
+    let _ = v.setattr("sample", sample);
     e
 }
 
@@ -40,10 +54,22 @@ pub fn io_error(m: String) -> PyErr {
 /// A failure of a run, before it becomes a Python exception (built without the GIL).
 #[derive(Debug)]
 pub enum Failure {
-    /// Bad data, with the file's line when known.
-    Data(String, Option<u64>),
+    /// Bad data, with the file's line, the kind and the sample's index when known.
+    Data {
+        message: String,
+        line: Option<u64>,
+        kind: Option<ErrorKind>,
+        sample: Option<usize>,
+    },
     /// A bad argument (`ValueError`).
     Argument(String),
+    /// A setting the data refuse (`ValueError` with `.kind` and `.sample`, as
+    /// [`data_error`]).
+    Refused {
+        message: String,
+        kind: ErrorKind,
+        sample: Option<usize>,
+    },
     /// An input that cannot be read.
     Io(String),
 }
@@ -51,8 +77,24 @@ pub enum Failure {
 impl Failure {
     pub fn into_py(self, py: Python<'_>) -> PyErr {
         match self {
-            Failure::Data(m, line) => data_error(py, m, line),
+            Failure::Data {
+                message,
+                line,
+                kind,
+                sample,
+            } => data_error(py, message, line, kind, sample),
             Failure::Argument(m) => value_error(m),
+            Failure::Refused {
+                message,
+                kind,
+                sample,
+            } => {
+                let e = value_error(message);
+                let v = e.value(py);
+                let _ = v.setattr("kind", kind.name());
+                let _ = v.setattr("sample", sample);
+                e
+            }
             Failure::Io(m) => io_error(m),
         }
     }

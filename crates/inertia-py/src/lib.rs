@@ -291,10 +291,12 @@ fn read_csv(
 fn telemetry_failure(e: TelemetryError) -> Failure {
     match e {
         TelemetryError::Io { .. } => Failure::Io(e.to_string()),
-        other => {
-            let line = other.line();
-            Failure::Data(other.to_string(), line)
-        }
+        other => Failure::Data {
+            line: other.line(),
+            kind: Some(other.error_kind()),
+            sample: None,
+            message: other.to_string(),
+        },
     }
 }
 
@@ -376,14 +378,13 @@ fn check_rows(
     conv: &Convention,
     naming: &Naming,
 ) -> Result<(Vec<Sample>, Stats), Failure> {
-    let mut checker = Checker::default();
+    let mut checker = Checker::new(conv);
     let samples = rows
         .iter()
         .enumerate()
-        .map(|(i, r)| checker.sample(r, i, conv, naming))
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|m| Failure::Data(m, None))?;
-    Ok((samples, checker.stats))
+        .map(|(i, r)| checker.sample(r, i, naming))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((samples, checker.stats()))
 }
 
 /// Estimate from arrays (or a table's columns, named by `frame_columns`).

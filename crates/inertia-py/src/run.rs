@@ -76,7 +76,11 @@ impl Origin {
             // argument errors.
             (RunErrorKind::MemoryShorterThanStep { .. }, _) => {
                 let (at, _) = self.at(e.sample);
-                Failure::Argument(format!("{e} ({}){fixes}", at.trim_end_matches(':')))
+                Failure::Refused {
+                    message: format!("{e} ({}){fixes}", at.trim_end_matches(':')),
+                    kind: e.error_kind(),
+                    sample: e.sample,
+                }
             }
             // Settings the batch form does not take.
             (
@@ -85,9 +89,11 @@ impl Origin {
                 ),
                 _,
             ) => Failure::Argument(format!("batch=True: {e}")),
-            (RunErrorKind::NeedsGyro { .. }, Origin::Memory { .. }) => {
-                Failure::Argument(format!("w: {e}"))
-            }
+            (RunErrorKind::NeedsGyro { .. }, Origin::Memory { .. }) => Failure::Refused {
+                message: format!("w: {e}"),
+                kind: e.error_kind(),
+                sample: e.sample,
+            },
             _ => {
                 let (at, line) = match (&e.kind, self) {
                     // The file's header lacks the columns.
@@ -101,7 +107,12 @@ impl Origin {
                 } else {
                     String::new()
                 };
-                Failure::Data(format!("{at}{columns} {e}{fixes}"), line)
+                Failure::Data {
+                    message: format!("{at}{columns} {e}{fixes}"),
+                    line,
+                    kind: Some(e.error_kind()),
+                    sample: e.sample,
+                }
             }
         }
     }

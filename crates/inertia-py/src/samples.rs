@@ -1,17 +1,14 @@
-//! Samples from arrays (or a DataFrame's columns), checked as the CSV reader checks a
-//! file's rows (`inertia::telemetry::csv`): finite values in the supported range, the
-//! quaternion convention applied, quaternions within the unit tolerance renormalised
-//! (and counted), sign flips counted, time increasing, and the period uniform in strict
-//! mode. Messages have the reader's wording with the row (0-based) and the argument or
-//! column in place of the file's line and column.
+//! Samples from arrays (or a DataFrame's columns), checked by the library's sample gate
+//! (`inertia::telemetry::gate`), the one the CSV reader and the C API use: finite values in
+//! the supported range, the quaternion convention applied, quaternions within the unit
+//! tolerance renormalised (and counted), sign flips counted, time increasing, gyro rates
+//! all-or-none, and the period uniform in strict mode. Here are only the names: the row
+//! (0-based) and the argument or column in place of the file's line and column.
 
+use crate::errors::Failure;
 use crate::settings::Convention;
-use inertia::attitude::Quaternion;
-use inertia::sample::{check_value, Quantity, Sample};
-use inertia::telemetry::csv::QuaternionFormat;
-use inertia::text::Num;
-use nalgebra::Vector3;
-
+use inertia::sample::Sample;
+use inertia::telemetry::gate::{Field, Gate, GateOptions, RawSample, SampleError};
 /// One row of raw values, in storage order.
 #[derive(Debug, Clone, Copy)]
 pub struct Row {
@@ -70,143 +67,66 @@ impl Naming {
     }
 }
 
-/// What the reader counts: the CSV reader's counts, for arrays too.
+/// What the gate counts: the CSV reader's counts, for arrays too.
 pub type Stats = inertia::telemetry::csv::ReadStats;
 
-/// The checks that span rows.
-#[derive(Debug, Clone, Default)]
+impl Naming {
+    /// Where `field` of row `i` is.
+    pub fn field(&self, field: Field, i: usize) -> String {
+        match field {
+            Field::Time => self.value(0, None, i),
+            Field::Quaternion(k) => self.value(1, Some(k), i),
+            Field::QuaternionNorm => self.quaternion(i),
+            Field::Rho(k) => self.value(2, Some(k), i),
+            Field::Tau(k) => self.value(3, Some(k), i),
+            Field::Rate(k) => self.value(4, Some(k), i),
+        }
+    }
+}
+
+/// The library's sample gate over one sequence of rows.
+#[derive(Debug, Clone)]
 pub struct Checker {
-    pub stats: Stats,
-    prev: Option<Sample>,
-    period: Option<f64>,
-}
-
-fn finite(naming: &Naming, g: usize, k: Option<usize>, i: usize, v: f64) -> Result<f64, String> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!(
-            "{}: value {v} is not finite",
-            naming.value(g, k, i)
-        ))
-    }
-}
-
-fn in_range(
-    naming: &Naming,
-    g: usize,
-    k: Option<usize>,
-    i: usize,
-    quantity: Quantity,
-    v: f64,
-) -> Result<f64, String> {
-    let v = finite(naming, g, k, i, v)?;
-    check_value(quantity, v).map_err(|_| {
-        let (limit, unit) = quantity.limit();
-        format!(
-            "{}: value {} is outside the supported range (magnitude at most {} {unit})",
-            naming.value(g, k, i),
-            Num(v),
-            Num(limit)
-        )
-    })?;
-    Ok(v)
-}
-
-fn vec3(
-    naming: &Naming,
-    g: usize,
-    i: usize,
-    v: [f64; 3],
-    kind: fn(usize) -> Quantity,
-) -> Result<Vector3<f64>, String> {
-    let mut out = Vector3::zeros();
-    for k in 0..3 {
-        out[k] = in_range(naming, g, Some(k), i, kind(k), v[k])?;
-    }
-    Ok(out)
+    gate: Gate,
 }
 
 impl Checker {
-    /// Row `i` as a sample, or the reader's message for it.
-    pub fn sample(
-        &mut self,
-        row: &Row,
-        i: usize,
-        c: &Convention,
-        naming: &Naming,
-    ) -> Result<Sample, String> {
-        let t = in_range(naming, 0, None, i, Quantity::Time, row.t)?;
-        for k in 0..4 {
-            finite(naming, 1, Some(k), i, row.q[k])?;
+    /// A gate reading rows with the convention `c`.
+    pub fn new(c: &Convention) -> Self {
+        Self {
+            gate: Gate::new(GateOptions {
+                quaternion: c.format,
+                unit_tolerance: c.unit_tolerance,
+                period_tolerance: c.period_tolerance,
+                negate_rho: c.negate_rho,
+                ..GateOptions::default()
+            }),
         }
-        let raw = match c.format {
-            QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(row.q),
-            QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(row.q),
-            QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(row.q),
-            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(row.q),
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> Stats {
+        self.gate.stats()
+    }
+
+    /// Row `i` as a sample, or the gate's refusal placed at the row and argument.
+    pub fn sample(&mut self, row: &Row, i: usize, naming: &Naming) -> Result<Sample, Failure> {
+        let raw = RawSample {
+            t_s: row.t,
+            q: row.q,
+            rho_nms: row.rho,
+            tau_nm: row.tau,
+            w_rad_s: row.w,
         };
-        let norm = raw.norm();
-        if (norm - 1.0).abs() > c.unit_tolerance {
-            return Err(format!(
-                "{}: quaternion norm {norm:.6} differs from 1 by more than {:e}",
-                naming.quaternion(i),
-                c.unit_tolerance
-            ));
-        }
-        let mut q = raw;
-        if norm != 1.0 {
-            if let Some(n) = raw.normalize() {
-                if (norm - 1.0).abs() > 1e-12 {
-                    self.stats.renormalised += 1;
-                }
-                q = n;
-            }
-        }
-        let rho = vec3(naming, 2, i, row.rho, Quantity::Rho)?;
-        let tau = match row.tau {
-            Some(v) => vec3(naming, 3, i, v, Quantity::Tau)?,
-            None => Vector3::zeros(),
-        };
-        let w = row
-            .w
-            .map(|v| vec3(naming, 4, i, v, Quantity::Rate))
-            .transpose()?;
-        if let Some(prev) = self.prev {
-            let dt = t - prev.t_s;
-            if !(dt > 0.0) {
-                return Err(format!(
-                    "{}: time {} s does not increase (previous row: {} s)",
-                    naming.value(0, None, i),
-                    Num(t),
-                    Num(prev.t_s)
-                ));
-            }
-            if let Some(tol) = c.period_tolerance {
-                match self.period {
-                    None => self.period = Some(dt),
-                    Some(p) if (dt - p).abs() > tol * p => {
-                        return Err(format!(
-                            "{}: step {} s differs from the sample period {} s by more than {tol:e} (relative); resample or split the data",
-                            naming.value(0, None, i),
-                            Num(dt),
-                            Num(p)
-                        ));
-                    }
-                    Some(_) => {}
-                }
-            }
-            self.stats.step(dt, &prev.q, &q);
-        }
-        let s = Sample {
-            t_s: t,
-            q,
-            rho_nms: if c.negate_rho { -rho } else { rho },
-            tau_nm: tau,
-            omega_rad_s: w,
-        };
-        self.prev = Some(s);
-        self.stats.rows += 1;
-        Ok(s)
+        self.gate.check(&raw).map_err(|e| Failure::Data {
+            message: match e {
+                // The rates as a whole, not one axis.
+                SampleError::GyroChanged { .. } => format!("{}: {e}", naming.value(4, None, i)),
+                _ => format!("{}: {e}", naming.field(e.field(), i)),
+            },
+            line: None,
+            kind: Some(e.error_kind()),
+            sample: Some(i),
+        })
     }
 }

@@ -5,7 +5,7 @@
 use crate::errors::{type_error, value_error};
 use inertia::constraints::{ConstraintSet, ProductConvention};
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
-use inertia::pipeline::{PipelineError, PipelineSettings, DEFAULT_MAX_CHAIN_S};
+use inertia::pipeline::{InertialTorque, PipelineError, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 use inertia::telemetry::csv::{QuaternionFormat, DEFAULT_UNIT_TOLERANCE};
 use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::Component;
@@ -495,6 +495,10 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
             _ => RhoModel::Auto,
         },
         torque_bias: kw.bool("torque_bias", true)?,
+        inertial_torque: match kw.choice("inertial_torque", &InertialTorque::NAMES)? {
+            Some(name) => name.parse().map_err(|e: PipelineError| value_error(e.to_string()))?,
+            None => InertialTorque::default(),
+        },
         max_chain_s: (chain != 0.0).then_some(chain),
         glitches: match kw.choice("glitches", &["stop", "keep"])? {
             Some("keep") => GlitchPolicy::Keep,

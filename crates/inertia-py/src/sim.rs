@@ -215,7 +215,7 @@ pub fn simulate<'py>(
                 .map_err(|e| Failure::Argument(e.to_string()))?;
             // The samples as the CSV reader would read them back from `inertia simulate`'s
             // file (the file holds each value exactly; the reader renormalises).
-            let mut checker = Checker::default();
+            let mut checker = Checker::new(&Convention::default());
             let samples = out
                 .samples
                 .iter()
@@ -228,10 +228,9 @@ pub fn simulate<'py>(
                         tau: Some(s.tau_nm.into()),
                         w: s.omega_rad_s.map(Into::into),
                     };
-                    checker.sample(&row, i, &Convention::default(), &Naming::Arrays)
+                    checker.sample(&row, i, &Naming::Arrays)
                 })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|m| Failure::Data(m, None))?;
+                .collect::<Result<Vec<_>, _>>()?;
             let t_end = out.samples.last().map_or(0.0, |s| s.t_s);
             let positions: Option<Vec<[f64; 3]>> = out.orbit.map(|o| {
                 out.samples
@@ -244,7 +243,7 @@ pub fn simulate<'py>(
                     samples,
                     lines: None,
                     file: None,
-                    stats: checker.stats,
+                    stats: checker.stats(),
                     q_columns: "q".into(),
                     label: "<simulated>".into(),
                 },

@@ -4,7 +4,7 @@
 use crate::errors::Failure;
 use crate::run::Origin;
 use crate::samples::{Checker, Naming, Row};
-use crate::settings::{self, Convention, Kwargs};
+use crate::settings::{self, Kwargs};
 use inertia::pipeline::report::Report;
 use inertia::pipeline::Run;
 use numpy::PyReadonlyArrayDyn;
@@ -22,16 +22,12 @@ struct State {
 #[pyclass(module = "inertia._inertia")]
 pub struct Stream {
     state: Mutex<State>,
-    conv: Convention,
 }
 
 impl State {
-    fn push(&mut self, row: &Row, conv: &Convention) -> Result<bool, Failure> {
+    fn push(&mut self, row: &Row) -> Result<bool, Failure> {
         let i = self.run.input_samples();
-        let s = self
-            .checker
-            .sample(row, i, conv, &Naming::Arrays)
-            .map_err(|m| Failure::Data(m, None))?;
+        let s = self.checker.sample(row, i, &Naming::Arrays)?;
         let mut produced = false;
         self.run
             .push(&s, |_| produced = true)
@@ -40,7 +36,7 @@ impl State {
     }
 
     fn report(&self) -> Option<Report> {
-        self.run.report("<stream>", &self.checker.stats)
+        self.run.report("<stream>", &self.checker.stats())
     }
 }
 
@@ -68,9 +64,8 @@ impl Stream {
         Ok(Self {
             state: Mutex::new(State {
                 run,
-                checker: Checker::default(),
+                checker: Checker::new(&conv),
             }),
-            conv,
         })
     }
 
@@ -88,8 +83,7 @@ impl Stream {
         let row = Row { t, q, rho, tau, w };
         let mut guard = self.lock()?;
         let st: &mut State = &mut guard;
-        let conv = self.conv;
-        py.allow_threads(|| st.push(&row, &conv))
+        py.allow_threads(|| st.push(&row))
             .map_err(|f| f.into_py(py))
     }
 
@@ -107,11 +101,10 @@ impl Stream {
         let rows = crate::rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
         let mut guard = self.lock()?;
         let st: &mut State = &mut guard;
-        let conv = self.conv;
         py.allow_threads(|| {
             let mut n = 0;
             for r in &rows {
-                n += usize::from(st.push(r, &conv)?);
+                n += usize::from(st.push(r)?);
             }
             Ok(n)
         })

@@ -90,6 +90,7 @@ pub mod discrete;
 pub mod discrete_momentum;
 pub mod dynamics;
 mod eigen3;
+pub mod error_kind;
 pub mod estimator;
 #[cfg(feature = "std")]
 mod estimators;

@@ -402,7 +402,8 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
 _SETTINGS = (
     "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
     "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
-    "resample", "every", "rotation_source", "rho_model", "torque_bias", "chain", "glitches",
+    "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque", "chain",
+    "glitches",
     "solver", "uncertainty",
 )
 #: How the data are read.
@@ -445,6 +446,7 @@ def estimate(
     rotation_source: Optional[str] = None,
     rho_model: str = "auto",
     torque_bias: bool = True,
+    inertial_torque: str = "off",
     chain: float = 30.0,
     glitches: str = "stop",
     solver: str = "native",
@@ -503,6 +505,8 @@ def estimate(
         every: solve every N samples. rotation_source: ``"attitude"`` or ``"gyro"``
             (default: chosen from the data). rho_model: ``"auto"``, ``"smooth"``,
             ``"held"``, ``"plain"``. torque_bias: estimate an unknown constant torque.
+            inertial_torque: a torque constant in the inertial frame, per chain: ``"off"``,
+            ``"on"`` or ``"auto"`` (a nested χ² test decides; ``report["row_model"]``).
             chain: momentum chain, s (0: chains end only at gaps). glitches: ``"stop"``
             or ``"keep"``. solver: ``"native"``. uncertainty: compute σ.
         batch: one batch solve instead of the recursive estimator (``--batch``).
@@ -594,6 +598,7 @@ class Estimator:
         rotation_source: Optional[str] = None,
         rho_model: str = "auto",
         torque_bias: bool = True,
+        inertial_torque: str = "off",
         chain: float = 30.0,
         glitches: str = "stop",
         solver: str = "native",

@@ -21,6 +21,7 @@ use super::momentum_rows::{AugmentedRow, ANCHOR0, ANCHOR1, J, TORQUE};
 use super::normal_equations::NormalEquations;
 use super::qr::RecursiveQr;
 use super::shared_qr::{SharedBlock, SharedQr, J_SHARED, SHARED};
+use super::trend_slot::{Trend, TrendStep};
 use crate::math::sqrt;
 use nalgebra::{Matrix3, SVector};
 
@@ -43,6 +44,9 @@ struct SlotMean {
     p: Option<Matrix3<f64>>,
     /// Time of the slot's last block, s.
     t_s: f64,
+    /// The slot's inertial torque, for blocks that have one
+    /// ([`AugmentedRow::trend_s`], [`super::trend_slot`]).
+    trend: Option<Trend<SHARED>>,
 }
 
 impl SlotMean {
@@ -53,6 +57,7 @@ impl SlotMean {
             b: [0.0; 3],
             p: None,
             t_s: 0.0,
+            trend: None,
         }
     }
 }
@@ -66,6 +71,8 @@ pub struct AugmentedQr {
     drift: Option<AttitudeDrift>,
     /// Time of the block being folded, s ([`Self::advance_to`]).
     now_s: f64,
+    /// Whether each slot has an inertial torque ([`Self::with_inertial_torque`]).
+    inertial_torque: bool,
 }
 
 impl AugmentedQr {
@@ -78,6 +85,16 @@ impl AugmentedQr {
             slots: [SlotMean::empty(); 2],
             drift: None,
             now_s: 0.0,
+            inertial_torque: false,
+        }
+    }
+
+    /// The state with an inertial torque per slot ([`super::trend_slot`]) or without.
+    #[must_use]
+    pub fn with_inertial_torque(self, on: bool) -> Self {
+        Self {
+            inertial_torque: on,
+            ..self
         }
     }
 
@@ -142,19 +159,53 @@ impl AugmentedQr {
             core::array::from_fn(|m| row.a.fixed_view::<1, SHARED>(m, TORQUE).transpose());
         let slot = &mut self.slots[p];
         let w = slot.weight;
-        if w == 0.0 {
+        let trend = self.inertial_torque;
+        let absorb = |slot: &mut SlotMean| {
             *slot = SlotMean {
                 weight: 1.0,
                 a,
                 b: y,
                 p: None,
                 t_s: self.now_s,
+                trend: trend.then(|| Trend::start(row.trend_s)),
             };
+        };
+        if w == 0.0 {
+            absorb(slot);
             self.shared.count_absorbed(&y, row.noise_s);
             if let Some(c) = chain {
                 c.count_absorbed(&y, row.noise_s);
             }
             return None;
+        }
+        if let Some(trend) = slot.trend.as_mut() {
+            let s = row.trend_s;
+            let q = self.drift.map_or_else(Matrix3::zeros, |d| {
+                d.process(&slot.a, &slot.b, row.noise_s, self.now_s - slot.t_s)
+            });
+            let step = trend.step((&a, &y), s, (&mut slot.a, &mut slot.b), &q);
+            slot.weight = w + 1.0;
+            slot.t_s = self.now_s;
+            let block = match step {
+                Some(TrendStep::Row(block)) => block,
+                // The torque fixed, or a state that cannot go on (the slot restarts at
+                // the block, with its unknowns counted again).
+                other => {
+                    if other.is_none() {
+                        absorb(slot);
+                        self.shared.add_nuisance(6);
+                    }
+                    self.shared.count_absorbed(&y, row.noise_s);
+                    if let Some(c) = chain {
+                        c.count_absorbed(&y, row.noise_s);
+                    }
+                    return None;
+                }
+            };
+            if let Some(c) = chain {
+                c.add(&block, &y, row.noise_s);
+            }
+            return Some(block);
         }
         // Weighted for a drift, or once weighted (the covariance of the mean is then no
         // longer `I/w`): the local-level filter; otherwise the centring above.
@@ -213,6 +264,9 @@ impl AugmentedQr {
             s.weight *= lambda;
             if let Some(p) = &mut s.p {
                 *p /= lambda;
+            }
+            if let Some(t) = &mut s.trend {
+                t.scale(lambda);
             }
         }
     }
@@ -357,6 +411,7 @@ mod tests {
             a,
             b: Vector3::from_fn(|_, _| rnd()),
             noise_s: rnd().abs(),
+            trend_s: 0.0,
         }
     }
 

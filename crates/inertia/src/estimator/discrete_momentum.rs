@@ -131,7 +131,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         Ok(Self {
             source: MomentumRows::new(*r),
             clock: ChainClock::new(r.max_chain_s),
-            qr: AugmentedQr::new(r.shared_nuisance()),
+            qr: AugmentedQr::new(r.shared_nuisance()).with_inertial_torque(r.inertial_torque),
             // The delete-a-group jackknife weighs its groups equally: with forgetting they
             // are not, and it is not kept ([`super::jackknife`]).
             groups: settings
@@ -180,8 +180,8 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// must feed it every block from the first on.
     pub fn fold_shared(&mut self, row: &AugmentedRow, source: &MomentumRows, t_s: f64) {
         debug_assert_eq!(
-            source.settings().rows_only(),
-            self.settings.rows.rows_only()
+            source.settings().source_key(),
+            self.settings.rows.source_key()
         );
         let epoch = self.clock.epoch(source);
         self.fold_row(row, epoch, t_s);
@@ -198,7 +198,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         t_s: f64,
     ) {
         for e in [&*a, &*b] {
-            debug_assert_eq!(source.settings().rows_only(), e.settings.rows.rows_only());
+            debug_assert_eq!(source.settings().source_key(), e.settings.rows.source_key());
         }
         let (ea, eb) = (a.clock.epoch(source), b.clock.epoch(source));
         a.before_fold(ea, t_s);
@@ -470,21 +470,38 @@ pub fn reduce_batch(
     let mut nuisance = settings.shared_nuisance() as f64;
     for chain in &chains {
         nuisance += settings.nuisance_per_chain() as f64;
-        let columns: Vec<usize> = (0..settings.nuisance_per_chain())
+        // The initial momenta the chain uses, then (with an inertial torque) each one's
+        // torque, whose column is the initial momentum's times the block's `s`
+        // ([`super::momentum_rows`], "Inertial torque"), then the shared unknowns.
+        let used: Vec<usize> = (0..settings.anchors_per_chain())
             .filter(|&k| chain.iter().any(|r| uses(r, k)))
-            .chain(shared_columns.iter().copied())
             .collect();
-        let anchors = columns.len() - shared;
+        let trends = if settings.inertial_torque {
+            used.len()
+        } else {
+            0
+        };
+        let anchors = used.len() + trends;
         let m = 3 * chain.len();
-        let a = DMatrix::from_fn(m, columns.len(), |i, k| chain[i / 3].a[(i % 3, columns[k])]);
+        let columns = anchors + shared;
+        let a = DMatrix::from_fn(m, columns, |i, k| {
+            let row = &chain[i / 3];
+            if k < used.len() {
+                row.a[(i % 3, used[k])]
+            } else if k < anchors {
+                row.a[(i % 3, used[k - used.len()])] * row.trend_s
+            } else {
+                row.a[(i % 3, shared_columns[k - anchors])]
+            }
+        });
         let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);
         rows += m;
         let (r, qty, energy) = factor(a, y);
         y_energy += energy;
         rss += (energy - qty.norm_squared()).max(0.0);
         let mut block = (Vec::new(), Vec::new());
-        for i in anchors..columns.len() {
-            block.0.extend((anchors..columns.len()).map(|k| r[(i, k)]));
+        for i in anchors..columns {
+            block.0.extend((anchors..columns).map(|k| r[(i, k)]));
             block.1.push(qty[i]);
         }
         blocks.push(block);

@@ -33,6 +33,7 @@ pub mod resample;
 pub mod rows;
 pub mod shared_qr;
 pub mod svd_tracker;
+pub mod trend_slot;
 pub mod uncertainty;
 
 use crate::discrete::RowError;

@@ -53,6 +53,20 @@
 //! momenta absorb: the same least-squares problem as restarting the sums. Rows therefore
 //! do not depend on the chain length, and candidates that differ only in it can share
 //! one row source.
+//!
+//! # Inertial torque
+//!
+//! A disturbance torque constant in the *inertial* frame, `τ_I` (N m; an aerodynamic or
+//! solar force whose direction is fixed in space, or any slow drift of the momentum over
+//! a short record), enters the impulse sum as `Σ h̄_m C_m (C_mᵀ τ_I) = s_k τ_I` with the
+//! scalar `s_k = Σ_{m=1..k} h̄_m` (the time from the chain's first interval's midpoint to
+//! interval k's): the row gains `− s_k τ_I`, and the Richardson row the same
+//! combination of the three `s`. With [`MomentumRowSettings::inertial_torque`] each
+//! block carries its `s` ([`AugmentedRow::trend_s`]) and the torque is one more unknown of
+//! the block's initial-momentum slot: minimised out with it per chain (and per parity,
+//! so the Richardson rows' two slots each have their own), as a linear trend of the
+//! inertial momentum ([`super::trend_slot`]). A split chain's torque before and after the
+//! split are then two unknowns, like its initial momenta.
 
 use crate::attitude::Quaternion;
 use crate::discrete::{check_phi, check_unit, RowError};
@@ -180,6 +194,10 @@ pub struct MomentumRowSettings {
     pub stencil: Stencil,
     /// Estimate a constant body-frame disturbance torque `τ_b` (default `true`).
     pub torque_bias: bool,
+    /// Estimate a constant inertial-frame disturbance torque `τ_I` per chain (and per
+    /// Richardson parity), beside its initial momentum (module docs, "Inertial torque";
+    /// default `false`).
+    pub inertial_torque: bool,
     /// Longest chain, s (the first [`super::jackknife::MIN_GROUPS`] chains a quarter of
     /// it): a chain is split (its initial momentum becomes a new unknown) once it spans
     /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
@@ -195,6 +213,7 @@ impl Default for MomentumRowSettings {
             rotation: RotationSource::Attitude,
             stencil: Stencil::Plain,
             torque_bias: true,
+            inertial_torque: false,
             max_chain_s: None,
         }
     }
@@ -219,7 +238,12 @@ impl core::fmt::Display for MomentumRowSettings {
         } else {
             ""
         };
-        write!(f, "{rotation}, {stencil}{torque}")?;
+        let inertial = if self.inertial_torque {
+            ", unknown inertial torque per chain"
+        } else {
+            ""
+        };
+        write!(f, "{rotation}, {stencil}{torque}{inertial}")?;
         if let Some(max) = self.max_chain_s {
             write!(f, ", chains of {max} s")?;
         }
@@ -228,8 +252,8 @@ impl core::fmt::Display for MomentumRowSettings {
 }
 
 impl MomentumRowSettings {
-    /// The settings the rows themselves depend on: these but for the chain length, which
-    /// only [`ChainClock`] uses. Candidates with equal rows can share one row source.
+    /// The model but for the chain length, which only [`ChainClock`] uses: candidates
+    /// equal in it fit the same model in different chains.
     #[must_use]
     pub fn rows_only(&self) -> Self {
         Self {
@@ -238,14 +262,32 @@ impl MomentumRowSettings {
         }
     }
 
-    /// Unknowns besides `j` the rows involve in one chain.
+    /// The settings the rows themselves depend on: [`Self::rows_only`] but for the
+    /// inertial torque, which only the state uses. Candidates equal in it can share one
+    /// row source.
     #[must_use]
-    pub fn nuisance_per_chain(&self) -> usize {
+    pub fn source_key(&self) -> Self {
+        Self {
+            inertial_torque: false,
+            ..self.rows_only()
+        }
+    }
+
+    /// Initial-momentum unknowns of one chain: `X₀`, and `X₁` for Richardson rows.
+    #[must_use]
+    pub fn anchors_per_chain(&self) -> usize {
         if self.stencil.richardson() {
             6
         } else {
             3
         }
+    }
+
+    /// Unknowns besides `j` the rows involve in one chain: the initial momenta and, with
+    /// [`Self::inertial_torque`], a torque for each.
+    #[must_use]
+    pub fn nuisance_per_chain(&self) -> usize {
+        self.anchors_per_chain() * (1 + usize::from(self.inertial_torque))
     }
 
     /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`).
@@ -270,6 +312,11 @@ pub struct AugmentedRow {
     /// `A = (2/h) C N G(φ)`); Richardson rows: `Σ_i c_i² h_i/4` with `c_i` the stencil's
     /// coefficient on `δφ_i` (`c_i = 1/h`, so `noise_s = 1/(2h)`, for equal steps).
     pub noise_s: f64,
+    /// The coefficient `s` of the block's inertial torque, s, for a state that estimates
+    /// one ([`MomentumRowSettings::inertial_torque`]): the block then reads
+    /// `−X_p − s τ_{I,p} + a_rest x = b` (module docs, "Inertial torque"); only
+    /// differences of `s` within a chain matter.
+    pub trend_s: f64,
 }
 
 /// A plain row's parts, kept for the Richardson combination.
@@ -281,6 +328,8 @@ struct Plain {
     rhs: Vector3<f64>,
     /// `S_k`.
     s: Matrix3<f64>,
+    /// `Σ h̄` to the same node: the inertial torque's coefficient.
+    si: f64,
 }
 
 /// A node as the rows need it.
@@ -365,9 +414,12 @@ pub struct MomentumRows {
     /// `S`, `T` of the unit-step grid, up to the newest interior node.
     s: Matrix3<f64>,
     t: Vector3<f64>,
+    /// `Σ h̄` of the unit-step grid (the inertial torque's impulse per N m).
+    si: f64,
     /// The same per parity of the stride-2 subgrid.
     s2: [Matrix3<f64>; 2],
     t2: [Vector3<f64>; 2],
+    si2: [f64; 2],
     prev: Option<Plain>,
     /// The gyro's angle increment over the previous interval (coning term).
     alpha_prev: Option<Vector3<f64>>,
@@ -388,8 +440,10 @@ impl MomentumRows {
             chain_start_s: 0.0,
             s: Matrix3::zeros(),
             t: Vector3::zeros(),
+            si: 0.0,
             s2: [Matrix3::zeros(); 2],
             t2: [Vector3::zeros(); 2],
+            si2: [0.0; 2],
             prev: None,
             alpha_prev: None,
             epoch: 0,
@@ -516,12 +570,14 @@ impl MomentumRows {
             let hbar = 0.5 * (node.t_s - a.t_s);
             self.s += b.c * hbar;
             self.t += b.c * b.tau_nm * hbar;
+            self.si += hbar;
         }
         let m = IntervalMomentum::new(&b.c, &f.v, &(0.5 * (b.rho_nms + node.rho_nms)), h);
         let plain = Plain {
             m,
             rhs: m.b + self.t,
             s: self.s,
+            si: self.si,
         };
         let f_prev = self.f_last;
         self.t_older_s = [self.t_older_s[1], self.nodes[0].map(|n| n.t_s)];
@@ -533,7 +589,7 @@ impl MomentumRows {
             return Ok(Some(self.assemble(
                 &plain.m.a,
                 &plain.rhs,
-                &plain.s,
+                (&plain.s, plain.si),
                 ANCHOR0,
                 1.0 / h,
             )));
@@ -552,6 +608,7 @@ impl MomentumRows {
                 let hbar2 = 0.5 * (node.t_s - t_before);
                 self.s2[parity] += cm1.c * hbar2;
                 self.t2[parity] += cm1.c * cm1.tau_nm * hbar2;
+                self.si2[parity] += hbar2;
             }
         }
         let h2 = node.t_s - cm1.t_s;
@@ -568,12 +625,13 @@ impl MomentumRows {
         let a = (prev.m.a + plain.m.a) * w - m2.a * v;
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
+        let si = (prev.si + plain.si) * w - self.si2[parity] * v;
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
         let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
         let c0 = 4.0 / (3.0 * h0) - 2.0 / (3.0 * h2);
         let c1 = 4.0 / (3.0 * h1) - 2.0 / (3.0 * h2);
         let noise_s = 0.25 * (c0 * c0 * h0 + c1 * c1 * h1);
-        let mut row = self.assemble(&a, &rhs, &s, anchor, noise_s);
+        let mut row = self.assemble(&a, &rhs, (&s, si), anchor, noise_s);
         if self.settings.stencil == Stencil::Adaptive {
             // Every ρ̄ of the stencil moves by κ Δ²ρ_c (h̄² times the second divided
             // difference at c): the κ column is minus the stencil's b for ρ̄ := Δ²ρ_c.
@@ -593,7 +651,7 @@ impl MomentumRows {
         &self,
         a: &Matrix3x6<f64>,
         rhs: &Vector3<f64>,
-        s: &Matrix3<f64>,
+        (s, si): (&Matrix3<f64>, f64),
         anchor: usize,
         noise_s: f64,
     ) -> AugmentedRow {
@@ -609,6 +667,7 @@ impl MomentumRows {
             a: out,
             b: *rhs,
             noise_s,
+            trend_s: si,
         }
     }
 }

@@ -61,7 +61,7 @@ pub use checks::AttitudeChecks;
 pub use registry::{BatchOutput, Capabilities, Estimator};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
 pub use sdp::Constrained;
-pub use settings::{PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
+pub use settings::{InertialTorque, PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;
@@ -106,6 +106,16 @@ pub enum PipelineError {
         /// Its value.
         value: f64,
         /// What it must be.
+        expected: &'static str,
+    },
+    /// A setting named a value it does not have.
+    #[error("setting `{setting}`: unknown value `{}` (known: {expected})", crate::text::Clipped::new(.value))]
+    UnknownChoice {
+        /// The setting.
+        setting: &'static str,
+        /// The value given.
+        value: String,
+        /// The values it has.
         expected: &'static str,
     },
     /// A setting that needs another one.
@@ -220,6 +230,25 @@ impl PipelineError {
             PipelineError::AttitudeGlitch { .. } => &[Fix::KeepGlitches],
             PipelineError::ResampleTooFine { .. } => &[Fix::Resample],
             _ => &[],
+        }
+    }
+
+    /// Its kind, as every front end reports it.
+    #[must_use]
+    pub fn error_kind(&self) -> crate::error_kind::ErrorKind {
+        use crate::error_kind::ErrorKind as K;
+        match self {
+            PipelineError::AttitudeConvention { .. } => K::AttitudeConvention,
+            PipelineError::ReversedMomentum { .. } => K::ReversedMomentum,
+            PipelineError::AttitudeGlitch { .. } => K::AttitudeGlitch,
+            PipelineError::OutOfRange { .. } => K::OutOfRange,
+            PipelineError::Estimator { source, .. } => match source {
+                EstimatorError::Solve(_) => K::Solver,
+                EstimatorError::TooFewSamples { .. } => K::TooFewSamples,
+                EstimatorError::Row { .. } => K::Row,
+                _ => K::InvalidSetting,
+            },
+            _ => K::InvalidSetting,
         }
     }
 

@@ -19,9 +19,11 @@
 //!   front end to name in its own vocabulary ([`crate::fix`]).
 
 use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError, MAX_RESAMPLE_FACTOR};
+use crate::error_kind::ErrorKind;
 use crate::estimator::Estimate;
 use crate::fix::Fix;
 use crate::sample::Sample;
+use crate::telemetry::gate::{Order, SampleError};
 use crate::text::Num;
 use std::collections::VecDeque;
 use std::vec::Vec;
@@ -51,20 +53,10 @@ pub enum RunErrorKind {
         /// The estimator.
         estimator: &'static str,
     },
-    /// Gyro rates given for some samples and not for others.
-    #[error("gyro rates {} here but {} for the earlier samples: give them for every sample or none", given(*.given_here), given(!*.given_here))]
-    GyroChanged {
-        /// Whether this sample has them.
-        given_here: bool,
-    },
-    /// Time does not increase.
-    #[error("time {} s does not increase (previous sample: {} s)", Num(*.t_s), Num(*.previous_s))]
-    TimeNotIncreasing {
-        /// This sample's time, s.
-        t_s: f64,
-        /// The previous sample's, s.
-        previous_s: f64,
-    },
+    /// A sample the sample gate refuses ([`crate::telemetry::gate::Order`]): time not
+    /// increasing, gyro rates given for some samples and not for others.
+    #[error(transparent)]
+    Sample(SampleError),
     /// A memory shorter than the sample period forgets each sample before the next.
     #[error("the memory {} s is shorter than the sample period {} s; the memory must span several samples", Num(*.memory_s), Num(*.step_s))]
     MemoryShorterThanStep {
@@ -91,14 +83,6 @@ pub enum RunErrorKind {
     /// The pipeline or the estimator stopped.
     #[error(transparent)]
     Pipeline(PipelineError),
-}
-
-fn given(yes: bool) -> &'static str {
-    if yes {
-        "given"
-    } else {
-        "missing"
-    }
 }
 
 fn resampled(got: usize, read: usize) -> std::string::String {
@@ -178,6 +162,19 @@ impl RunError {
         }
     }
 
+    /// Its kind, as every front end reports it.
+    #[must_use]
+    pub fn error_kind(&self) -> ErrorKind {
+        match &self.kind {
+            RunErrorKind::NeedsGyro { .. } => ErrorKind::NeedsGyro,
+            RunErrorKind::Sample(e) => e.error_kind(),
+            RunErrorKind::MemoryShorterThanStep { .. } => ErrorKind::MemoryShorterThanStep,
+            RunErrorKind::TooFewSamples { .. } => ErrorKind::TooFewSamples,
+            RunErrorKind::Stopped(_) => ErrorKind::Stopped,
+            RunErrorKind::Pipeline(e) => e.error_kind(),
+        }
+    }
+
     /// The pipeline's error, where the pipeline or the estimator stopped.
     #[must_use]
     pub fn pipeline(&self) -> Option<&PipelineError> {
@@ -224,7 +221,8 @@ pub struct Run {
     /// Input samples accepted.
     input: usize,
     first_t_s: [f64; 2],
-    gyro: Option<bool>,
+    /// Time order and gyro rates all-or-none, as the sample gate checks them.
+    order: Order,
     /// `(time, index)` of the last [`RECENT`] samples.
     recent: VecDeque<(f64, usize)>,
     stopped: Option<std::string::String>,
@@ -258,7 +256,7 @@ impl Run {
             mode,
             input: 0,
             first_t_s: [f64::NAN; 2],
-            gyro: None,
+            order: Order::default(),
             recent: VecDeque::with_capacity(RECENT),
             stopped: None,
         })
@@ -308,30 +306,15 @@ impl Run {
         on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), RunError> {
         let has_w = s.omega_rad_s.is_some();
-        match self.gyro {
-            None => self.check_columns(has_w).map_err(|e| RunError {
+        if index == 0 {
+            self.check_columns(has_w).map_err(|e| RunError {
                 sample: Some(index),
                 ..e
-            })?,
-            Some(g) if g != has_w => {
-                return Err(RunError::at(
-                    index,
-                    RunErrorKind::GyroChanged { given_here: has_w },
-                ))
-            }
-            Some(_) => {}
+            })?;
         }
-        if let Some(&(previous_s, _)) = self.recent.back() {
-            if !(s.t_s > previous_s) {
-                return Err(RunError::at(
-                    index,
-                    RunErrorKind::TimeNotIncreasing {
-                        t_s: s.t_s,
-                        previous_s,
-                    },
-                ));
-            }
-        }
+        self.order
+            .check(s.t_s, has_w)
+            .map_err(|e| RunError::at(index, RunErrorKind::Sample(e)))?;
         if index < 2 {
             self.first_t_s[index] = s.t_s;
         }
@@ -343,7 +326,7 @@ impl Run {
             )
             .map_err(|kind| RunError::at(index, kind))?;
         }
-        self.gyro = Some(has_w);
+        self.order.accept(s.t_s, has_w);
         if self.recent.len() == RECENT {
             self.recent.pop_front();
         }

@@ -48,6 +48,9 @@ pub struct PipelineSettings {
     /// Estimate an unknown constant body-frame disturbance torque (discrete momentum
     /// estimator; default `true`).
     pub torque_bias: bool,
+    /// Whether to estimate a disturbance torque constant in the inertial frame, per chain
+    /// (discrete momentum estimator; default [`InertialTorque::Off`]).
+    pub inertial_torque: InertialTorque,
     /// Short momentum chain, s (discrete momentum estimator): bounds how far a
     /// drifting attitude error can rotate the conserved momentum
     /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
@@ -91,6 +94,7 @@ impl Default for PipelineSettings {
             rotation_source: None,
             rho_model: RhoModel::Auto,
             torque_bias: true,
+            inertial_torque: InertialTorque::Off,
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
             glitches: GlitchPolicy::Stop,
@@ -113,6 +117,7 @@ pub struct PipelineConfig {
     pub(crate) rotation_source: Option<RotationSource>,
     pub(crate) rho_model: RhoModel,
     pub(crate) torque_bias: bool,
+    pub(crate) inertial_torque: InertialTorque,
     pub(crate) max_chain_s: Option<f64>,
     pub(crate) attitude_drift_deg_rth: Option<f64>,
     pub(crate) glitches: GlitchPolicy,
@@ -198,6 +203,10 @@ impl PipelineSettings {
                 ),
                 ("rho_model", self.rho_model != defaults.rho_model),
                 ("torque_bias", self.torque_bias != defaults.torque_bias),
+                (
+                    "inertial_torque",
+                    self.inertial_torque != defaults.inertial_torque,
+                ),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
                 (
                     "attitude_drift_deg_rth",
@@ -242,6 +251,7 @@ impl PipelineSettings {
             rotation_source: self.rotation_source,
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
+            inertial_torque: self.inertial_torque,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift_deg_rth,
             glitches: self.glitches,
@@ -317,6 +327,12 @@ impl PipelineConfig {
         self.torque_bias
     }
 
+    /// Whether an unknown constant inertial-frame torque is estimated.
+    #[must_use]
+    pub fn inertial_torque(&self) -> InertialTorque {
+        self.inertial_torque
+    }
+
     /// Longest momentum chain, s.
     #[must_use]
     pub fn max_chain_s(&self) -> Option<f64> {
@@ -333,5 +349,60 @@ impl PipelineConfig {
     #[must_use]
     pub fn observability(&self) -> &ObservabilitySettings {
         &self.observability
+    }
+}
+
+/// Whether the discrete momentum estimator estimates a disturbance torque constant in the
+/// inertial frame, per chain ([`crate::estimator::momentum_rows`], "Inertial torque"):
+/// an aerodynamic or solar force whose direction is fixed in space, the momentum's drift
+/// over a short record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum InertialTorque {
+    /// Not estimated (default).
+    #[default]
+    Off,
+    /// Always estimated.
+    On,
+    /// Estimated where a nested χ² test at 10⁻³ says the data need it
+    /// (`estimators/discrete_momentum/select.rs`): both models are folded, and the
+    /// report says which answered.
+    Auto,
+}
+
+impl InertialTorque {
+    /// Every value, in the order of [`Self::NAMES`].
+    pub const ALL: [InertialTorque; 3] = [
+        InertialTorque::Off,
+        InertialTorque::On,
+        InertialTorque::Auto,
+    ];
+    /// The names options and keywords use (`off`, `on`, `auto`).
+    pub const NAMES: [&'static str; 3] = ["off", "on", "auto"];
+
+    /// The name for reports and options.
+    #[must_use]
+    pub fn name(&self) -> &'static str {
+        match self {
+            InertialTorque::Off => "off",
+            InertialTorque::On => "on",
+            InertialTorque::Auto => "auto",
+        }
+    }
+}
+
+impl core::str::FromStr for InertialTorque {
+    type Err = PipelineError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|v| v.name() == s)
+            .ok_or_else(|| PipelineError::UnknownChoice {
+                setting: "inertial_torque",
+                value: s.into(),
+                expected: "off, on, auto",
+            })
     }
 }

@@ -15,13 +15,17 @@
 //!
 //! # Validation
 //!
-//! Every error names the file, the line and the column: unparsable numbers, NaN or
-//! infinite values, values outside the supported range ([`crate::sample::range`]), missing or duplicated columns, lines longer than [`MAX_LINE_BYTES`]
-//! (checked while reading, so a file without line breaks fails fast), lines starting with
-//! `#` (there are no comment lines: every non-blank line is data), quaternions whose norm differs from 1 by more than
-//! [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and counted),
-//! non-increasing time, and, only when [`CsvOptions::period_tolerance`] is set, a step
-//! that differs from the first one by more than that (relative). What concerns pairs of
+//! Every error names the file, the line and the column. The reader refuses what is about
+//! the file: unparsable numbers, missing or duplicated columns, lines longer than
+//! [`MAX_LINE_BYTES`] (checked while reading, so a file without line breaks fails fast),
+//! lines starting with `#` (there are no comment lines: every non-blank line is data). The
+//! values themselves go through the sample gate that Python's arrays and the C API also use
+//! ([`super::gate`], [`TelemetryError::Sample`]): NaN or infinite values, values outside the
+//! supported range ([`crate::sample::range`]), quaternions whose norm differs from 1 by
+//! more than [`CsvOptions::unit_tolerance`] (smaller deviations are renormalised and
+//! counted), non-increasing time, gyro columns blank in a row after rows that had rates,
+//! and, only when [`CsvOptions::period_tolerance`] is set, a step that differs from the
+//! first one by more than that (relative). What concerns pairs of
 //! samples as rows (the rotation of a step, gaps) is the estimators' to check and count,
 //! once ([`crate::estimator::rows`]).
 //!
@@ -40,12 +44,13 @@
 //! The reader is an iterator and holds one row at a time: memory does not grow with the
 //! file.
 
+use super::gate::{Field, Gate, GateOptions, RawSample, SampleError};
+pub use super::gate::{GyroUnit, QuaternionFormat, ReadStats, DEFAULT_UNIT_TOLERANCE};
 use super::line_cap::{LineCap, LineTooLong};
 use super::time_stamp::{Clock, StampError};
-use crate::attitude::Quaternion;
-use crate::sample::{check_value, Quantity, Sample};
-use crate::text::{Clipped, Num, Quoted};
-use nalgebra::Vector3;
+use crate::error_kind::ErrorKind;
+use crate::sample::Sample;
+use crate::text::{Clipped, Quoted};
 use std::collections::HashMap;
 use std::fs::File;
 use std::io::Read;
@@ -53,37 +58,6 @@ use std::path::Path;
 
 /// The longest line accepted, bytes (1 MiB).
 pub const MAX_LINE_BYTES: usize = 1 << 20;
-
-/// Default tolerance on `| |q| − 1 |` below which quaternions are renormalised.
-pub const DEFAULT_UNIT_TOLERANCE: f64 = 1e-3;
-
-/// Where the scalar part of the quaternion is stored, and what the quaternion means.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum QuaternionFormat {
-    /// Hamilton, body → inertial, the four columns are the vector part then the scalar
-    /// (this crate's convention). The default.
-    #[default]
-    HamiltonScalarLast,
-    /// Hamilton, body → inertial, but the column named for `q_x` holds the scalar:
-    /// columns `[q_x, q_y, q_z, q_w]` hold `[w, x, y, z]`.
-    HamiltonScalarFirst,
-    /// JPL/Shuster (inertial → body attitude matrix, scalar last). Converted with
-    /// [`Quaternion::from_jpl_xyzw`].
-    Jpl,
-    /// Hamilton, scalar last, but mapping inertial → body (the conjugate of this crate's
-    /// meaning): [`Quaternion::from_hamilton_inertial_to_body_xyzw`].
-    Conjugate,
-}
-
-/// The unit of the gyro rate columns `w_*`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum GyroUnit {
-    /// rad/s (the default).
-    #[default]
-    RadPerS,
-    /// deg/s: converted to rad/s as read.
-    DegPerS,
-}
 
 /// Column names. Defaults are those of the table in the module docs.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -179,45 +153,6 @@ impl Default for CsvOptions {
     }
 }
 
-/// Counts of what was read.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ReadStats {
-    /// Data rows returned.
-    pub rows: usize,
-    /// Quaternions renormalised (within the tolerance).
-    pub renormalised: usize,
-    /// Quaternions whose sign was opposite to the previous one's (same attitude).
-    pub sign_flips: usize,
-    /// Rows rejected (the reader stops at the first; this is 0 or 1).
-    pub rejected: usize,
-    /// Shortest and longest step, s (0 before two rows).
-    pub min_step_s: f64,
-    /// Longest step, s.
-    pub max_step_s: f64,
-}
-
-impl ReadStats {
-    /// Count the step of `dt` s into the next row, whose quaternion `q` follows `prev`
-    /// (before that row is counted in `rows`): the shortest and longest step, and a sign
-    /// opposite to the previous quaternion's.
-    pub fn step(
-        &mut self,
-        dt: f64,
-        prev: &crate::attitude::Quaternion,
-        q: &crate::attitude::Quaternion,
-    ) {
-        self.min_step_s = if self.rows > 1 {
-            self.min_step_s.min(dt)
-        } else {
-            dt
-        };
-        self.max_step_s = self.max_step_s.max(dt);
-        if prev.v.dot(&q.v) + prev.s * q.s < 0.0 {
-            self.sign_flips += 1;
-        }
-    }
-}
-
 /// What is wrong, where.
 #[derive(Debug, thiserror::Error)]
 pub enum TelemetryError {
@@ -285,78 +220,27 @@ pub enum TelemetryError {
         /// Extra explanation (may be empty).
         hint: &'static str,
     },
-    /// A field is NaN or infinite.
-    #[error("{file}:{line}: column `{}`: value {value} is not finite", Clipped::new(.column))]
-    NonFinite {
+    /// A value the sample gate refused ([`super::gate`]).
+    #[error("{file}:{line}: {} `{}`: {source}", noun(.source), Clipped::new(.column))]
+    Sample {
         /// File name.
         file: String,
         /// Line.
         line: u64,
-        /// Column.
+        /// The column (the quaternion's columns, comma-separated, for its norm).
         column: String,
-        /// The value.
-        value: f64,
+        /// What is wrong.
+        source: SampleError,
     },
-    /// A value outside the supported range ([`crate::sample::range`]).
-    #[error("{file}:{line}: column `{}`: value {} is outside the supported range (magnitude at most {} {unit})", Clipped::new(.column), Num(*.value), Num(*.limit))]
-    OutOfRange {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// Column.
-        column: String,
-        /// The value.
-        value: f64,
-        /// The largest magnitude supported.
-        limit: f64,
-        /// Its unit.
-        unit: &'static str,
-    },
-    /// A quaternion's norm is too far from 1.
-    #[error("{file}:{line}: columns `{}`: quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}", Clipped::new(.columns))]
-    NonUnitQuaternion {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// The quaternion columns.
-        columns: String,
-        /// Its norm.
-        norm: f64,
-        /// The tolerance.
-        tolerance: f64,
-    },
-    /// Time does not increase.
-    #[error("{file}:{line}: column `{}`: time {} s does not increase (previous row: {} s)", Clipped::new(.column), Num(*.t), Num(*.previous))]
-    NonIncreasingTime {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// Column.
-        column: String,
-        /// This row's time.
-        t: f64,
-        /// Previous row's time.
-        previous: f64,
-    },
-    /// The sample period changed.
-    #[error("{file}:{line}: column `{}`: step {} s differs from the sample period {} s by more than {tolerance:e} (relative); resample or split the file", Clipped::new(.column), Num(*.dt), Num(*.period))]
-    NonUniformPeriod {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// Column.
-        column: String,
-        /// This step.
-        dt: f64,
-        /// The period set by the first step.
-        period: f64,
-        /// The tolerance.
-        tolerance: f64,
-    },
+}
+
+/// `column`, or `columns` for the quaternion's norm.
+fn noun(e: &SampleError) -> &'static str {
+    if e.field() == Field::QuaternionNorm {
+        "columns"
+    } else {
+        "column"
+    }
 }
 
 impl TelemetryError {
@@ -371,11 +255,22 @@ impl TelemetryError {
             TelemetryError::LineTooLong { line, .. }
             | TelemetryError::Malformed { line, .. }
             | TelemetryError::Parse { line, .. }
-            | TelemetryError::NonFinite { line, .. }
-            | TelemetryError::OutOfRange { line, .. }
-            | TelemetryError::NonUnitQuaternion { line, .. }
-            | TelemetryError::NonIncreasingTime { line, .. }
-            | TelemetryError::NonUniformPeriod { line, .. } => Some(*line),
+            | TelemetryError::Sample { line, .. } => Some(*line),
+        }
+    }
+
+    /// Its kind, as every front end reports it.
+    #[must_use]
+    pub fn error_kind(&self) -> ErrorKind {
+        match self {
+            TelemetryError::Io { .. } => ErrorKind::Io,
+            TelemetryError::DuplicateColumn { .. } | TelemetryError::MissingColumn { .. } => {
+                ErrorKind::Columns
+            }
+            TelemetryError::LineTooLong { .. }
+            | TelemetryError::Malformed { .. }
+            | TelemetryError::Parse { .. } => ErrorKind::Unparsable,
+            TelemetryError::Sample { source, .. } => source.error_kind(),
         }
     }
 }
@@ -396,12 +291,10 @@ pub struct TelemetryReader<R: Read> {
     /// 1-based line of the last record read.
     line: u64,
     file: String,
-    options: CsvOptions,
     idx: Indices,
     headers: Vec<String>,
-    stats: ReadStats,
-    prev: Option<Sample>,
-    period: Option<f64>,
+    /// The checks of every sample's values ([`super::gate`]).
+    gate: Gate,
     /// For ISO time stamps: the first row's (seconds, nanoseconds) on the clock's scale.
     time_origin: Option<(i64, i64)>,
     /// Converts ISO time stamps, counting leap seconds.
@@ -475,16 +368,20 @@ impl<R: Read> TelemetryReader<R> {
             tau: optional3(&c.tau)?,
             w: optional3(&c.w)?,
         };
+        let gate = Gate::new(GateOptions {
+            quaternion: options.quaternion,
+            unit_tolerance: options.unit_tolerance,
+            period_tolerance: options.period_tolerance,
+            negate_rho: options.negate_rho,
+            gyro_unit: options.gyro_unit,
+        });
         Ok(Self {
             reader,
             record: csv::StringRecord::new(),
             file: file.to_string(),
-            options,
             idx,
             headers,
-            stats: ReadStats::default(),
-            prev: None,
-            period: None,
+            gate,
             time_origin: None,
             clock: Clock::default(),
             failed: false,
@@ -495,7 +392,7 @@ impl<R: Read> TelemetryReader<R> {
     /// Counts so far.
     #[must_use]
     pub fn stats(&self) -> ReadStats {
-        self.stats
+        self.gate.stats()
     }
 
     /// `true` when the file has gyro-rate columns.
@@ -528,60 +425,44 @@ impl<R: Read> TelemetryReader<R> {
         &self.file
     }
 
+    /// Column `i` as a number (its checks are the gate's).
     fn field(&self, line: u64, i: usize) -> Result<f64, TelemetryError> {
         let raw = self.record.get(i).unwrap_or("").trim();
-        let v: f64 = raw.parse().map_err(|_| TelemetryError::Parse {
+        raw.parse().map_err(|_| TelemetryError::Parse {
             file: self.file.clone(),
             line,
             column: self.headers[i].clone(),
             value: raw.to_string(),
             hint: "",
-        })?;
-        if !v.is_finite() {
-            return Err(TelemetryError::NonFinite {
-                file: self.file.clone(),
-                line,
-                column: self.headers[i].clone(),
-                value: v,
-            });
-        }
-        Ok(v)
+        })
     }
 
-    /// `v`, read from column `i`, when it lies in the supported range of `quantity`.
-    fn in_range(
-        &self,
-        line: u64,
-        i: usize,
-        quantity: Quantity,
-        v: f64,
-    ) -> Result<f64, TelemetryError> {
-        check_value(quantity, v).map_err(|_| {
-            let (limit, unit) = quantity.limit();
-            TelemetryError::OutOfRange {
-                file: self.file.clone(),
-                line,
-                column: self.headers[i].clone(),
-                value: v,
-                limit,
-                unit,
-            }
-        })?;
-        Ok(v)
+    /// Three columns, or `None` where all three are blank (a gyro rate not given in this
+    /// row, which the gate refuses after rows that had one).
+    fn vec3(&self, line: u64, i: &[usize; 3]) -> Result<Option<[f64; 3]>, TelemetryError> {
+        if i.iter()
+            .all(|&c| self.record.get(c).is_none_or(|f| f.trim().is_empty()))
+        {
+            return Ok(None);
+        }
+        Ok(Some([
+            self.field(line, i[0])?,
+            self.field(line, i[1])?,
+            self.field(line, i[2])?,
+        ]))
     }
 
-    /// Three columns of `kind` (`Quantity::Rho`, …), each within the supported range.
-    fn vec3(
-        &self,
-        line: u64,
-        i: &[usize; 3],
-        kind: fn(usize) -> Quantity,
-    ) -> Result<Vector3<f64>, TelemetryError> {
-        let mut v = Vector3::zeros();
-        for (axis, &col) in i.iter().enumerate() {
-            v[axis] = self.in_range(line, col, kind(axis), self.field(line, col)?)?;
-        }
-        Ok(v)
+    /// The column of `field`, for messages.
+    fn column(&self, field: Field) -> String {
+        let i = match field {
+            Field::Time => self.idx.t,
+            Field::Quaternion(k) => self.idx.q[k],
+            Field::QuaternionNorm => return self.quaternion_columns(),
+            Field::Rho(k) => self.idx.rho[k],
+            Field::Tau(k) => self.idx.tau.map_or(self.idx.t, |c| c[k]),
+            Field::Rate(k) => self.idx.w.map_or(self.idx.t, |c| c[k]),
+        };
+        self.headers[i].clone()
     }
 
     /// The names of the quaternion columns, comma-separated (for messages).
@@ -597,16 +478,7 @@ impl<R: Read> TelemetryReader<R> {
         let raw = self.record.get(i).unwrap_or("").trim();
         if self.time_origin.is_none() {
             if let Ok(v) = raw.parse::<f64>() {
-                return if v.is_finite() {
-                    Ok(v)
-                } else {
-                    Err(TelemetryError::NonFinite {
-                        file: self.file.clone(),
-                        line,
-                        column: self.headers[i].clone(),
-                        value: v,
-                    })
-                };
+                return Ok(v);
             }
         }
         let stamp = self.clock.parse(raw).map_err(|e| TelemetryError::Parse {
@@ -623,7 +495,7 @@ impl<R: Read> TelemetryReader<R> {
                 }
             },
         })?;
-        if self.prev.is_some() && self.time_origin.is_none() {
+        if self.gate.stats().rows > 0 && self.time_origin.is_none() {
             // Seconds so far, a time stamp now: not the same clock.
             return Err(TelemetryError::Parse {
                 file: self.file.clone(),
@@ -651,90 +523,40 @@ impl<R: Read> TelemetryReader<R> {
                     .into(),
             });
         }
-        let t = self.time(line)?;
-        let t = self.in_range(line, self.idx.t, Quantity::Time, t)?;
-        let c = [
-            self.field(line, self.idx.q[0])?,
-            self.field(line, self.idx.q[1])?,
-            self.field(line, self.idx.q[2])?,
-            self.field(line, self.idx.q[3])?,
-        ];
-        let raw = match self.options.quaternion {
-            QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(c),
-            QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(c),
-            QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(c),
-            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(c),
+        let raw = RawSample {
+            t_s: self.time(line)?,
+            q: [
+                self.field(line, self.idx.q[0])?,
+                self.field(line, self.idx.q[1])?,
+                self.field(line, self.idx.q[2])?,
+                self.field(line, self.idx.q[3])?,
+            ],
+            rho_nms: [
+                self.field(line, self.idx.rho[0])?,
+                self.field(line, self.idx.rho[1])?,
+                self.field(line, self.idx.rho[2])?,
+            ],
+            tau_nm: match self.idx.tau {
+                Some(i) => Some([
+                    self.field(line, i[0])?,
+                    self.field(line, i[1])?,
+                    self.field(line, i[2])?,
+                ]),
+                None => None,
+            },
+            w_rad_s: match self.idx.w {
+                Some(i) => self.vec3(line, &i)?,
+                None => None,
+            },
         };
-        let norm = raw.norm();
-        if (norm - 1.0).abs() > self.options.unit_tolerance {
-            return Err(TelemetryError::NonUnitQuaternion {
+        self.gate
+            .check(&raw)
+            .map_err(|source| TelemetryError::Sample {
                 file: self.file.clone(),
                 line,
-                columns: self.quaternion_columns(),
-                norm,
-                tolerance: self.options.unit_tolerance,
-            });
-        }
-        let mut q = raw;
-        if norm != 1.0 {
-            if let Some(n) = raw.normalize() {
-                if (norm - 1.0).abs() > 1e-12 {
-                    self.stats.renormalised += 1;
-                }
-                q = n;
-            }
-        }
-        let rho = self.vec3(line, &self.idx.rho, Quantity::Rho)?;
-        let tau = match self.idx.tau {
-            Some(i) => self.vec3(line, &i, Quantity::Tau)?,
-            None => Vector3::zeros(),
-        };
-        let w = match self.idx.w {
-            Some(i) => Some(match self.options.gyro_unit {
-                GyroUnit::RadPerS => self.vec3(line, &i, Quantity::Rate)?,
-                GyroUnit::DegPerS => {
-                    self.vec3(line, &i, Quantity::Rate)? * (core::f64::consts::PI / 180.0)
-                }
-            }),
-            None => None,
-        };
-        if let Some(prev) = self.prev {
-            let dt = t - prev.t_s;
-            if !(dt > 0.0) {
-                return Err(TelemetryError::NonIncreasingTime {
-                    file: self.file.clone(),
-                    line,
-                    column: self.headers[self.idx.t].clone(),
-                    t,
-                    previous: prev.t_s,
-                });
-            }
-            if let Some(tol) = self.options.period_tolerance {
-                match self.period {
-                    None => self.period = Some(dt),
-                    Some(p) => {
-                        if (dt - p).abs() > tol * p {
-                            return Err(TelemetryError::NonUniformPeriod {
-                                file: self.file.clone(),
-                                line,
-                                column: self.headers[self.idx.t].clone(),
-                                dt,
-                                period: p,
-                                tolerance: tol,
-                            });
-                        }
-                    }
-                }
-            }
-            self.stats.step(dt, &prev.q, &q);
-        }
-        Ok(Sample {
-            t_s: t,
-            q,
-            rho_nms: if self.options.negate_rho { -rho } else { rho },
-            tau_nm: tau,
-            omega_rad_s: w,
-        })
+                column: self.column(source.field()),
+                source,
+            })
     }
 }
 
@@ -800,15 +622,12 @@ impl<R: Read> Iterator for TelemetryReader<R> {
                 self.parse_row(line)
             }
         };
-        match &item {
-            Ok(s) => {
-                self.stats.rows += 1;
-                self.prev = Some(*s);
+        if let Err(e) = &item {
+            // The gate counts the samples it refused.
+            if !matches!(e, TelemetryError::Sample { .. }) {
+                self.gate.reject();
             }
-            Err(_) => {
-                self.stats.rejected += 1;
-                self.failed = true;
-            }
+            self.failed = true;
         }
         Some(item)
     }
@@ -816,49 +635,6 @@ impl<R: Read> Iterator for TelemetryReader<R> {
 
 #[cfg(test)]
 mod tests;
+mod write;
 
-/// Write samples as CSV in the default format (scalar-last Hamilton quaternion; the gyro
-/// columns `w_*` only when every sample has a rate). Used by the simulator's command-line
-/// front end and by tests.
-pub fn write_samples<W: std::io::Write>(out: W, samples: &[Sample]) -> std::io::Result<()> {
-    write_samples_with(out, samples, [], |_| [])
-}
-
-/// [`write_samples`] with `N` extra columns named `names`, valued `extra(sample)`. Streams:
-/// one row at a time.
-pub fn write_samples_with<W: std::io::Write, const N: usize>(
-    out: W,
-    samples: &[Sample],
-    names: [&str; N],
-    extra: impl Fn(&Sample) -> [f64; N],
-) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    let with_rates = samples.iter().all(|s| s.omega_rad_s.is_some());
-    let header = [
-        "t", "q_x", "q_y", "q_z", "q_w", "rho_x", "rho_y", "rho_z", "tau_x", "tau_y", "tau_z",
-        "w_x", "w_y", "w_z",
-    ];
-    let n = if with_rates { 14 } else { 11 };
-    w.write_record(header[..n].iter().chain(&names))?;
-    for s in samples {
-        let rate = s.omega_rad_s.unwrap_or_default();
-        let v = [
-            s.t_s,
-            s.q.v.x,
-            s.q.v.y,
-            s.q.v.z,
-            s.q.s,
-            s.rho_nms.x,
-            s.rho_nms.y,
-            s.rho_nms.z,
-            s.tau_nm.x,
-            s.tau_nm.y,
-            s.tau_nm.z,
-            rate.x,
-            rate.y,
-            rate.z,
-        ];
-        w.write_record(v[..n].iter().chain(&extra(s)).map(|x| format!("{x:?}")))?;
-    }
-    w.flush()
-}
+pub use write::{write_samples, write_samples_with};

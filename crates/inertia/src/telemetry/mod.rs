@@ -6,6 +6,7 @@
 pub mod convention;
 #[cfg(feature = "csv")]
 pub mod csv;
+pub mod gate;
 pub mod glitch;
 #[cfg(feature = "csv")]
 mod line_cap;

@@ -69,7 +69,7 @@ fn paper_rows_are_rotated_differences_of_interval_momenta() {
 }
 
 /// The paper's slew for its first `duration_s`, with `common`'s noise.
-fn slew_for(duration_s: f64, common: Common) -> inertia::sim::SimOutput {
+pub(crate) fn slew_for(duration_s: f64, common: Common) -> inertia::sim::SimOutput {
     Scenario::slew()
         .simulate(&Common {
             duration_s: Some(duration_s),
@@ -135,7 +135,7 @@ fn conservation_is_second_order_plain_and_fourth_order_with_richardson() {
     }
 }
 
-fn estimator(rows: MomentumRowSettings) -> DiscreteMomentumEstimator<NativeSolver> {
+pub(crate) fn estimator(rows: MomentumRowSettings) -> DiscreteMomentumEstimator<NativeSolver> {
     DiscreteMomentumEstimator::new(
         MomentumEstimatorSettings {
             rows,
@@ -149,7 +149,7 @@ fn estimator(rows: MomentumRowSettings) -> DiscreteMomentumEstimator<NativeSolve
     .expect("valid settings")
 }
 
-fn final_error(
+pub(crate) fn final_error(
     samples: &[Sample],
     rows: MomentumRowSettings,
     truth: &nalgebra::Matrix3<f64>,
@@ -398,7 +398,7 @@ fn recursive_and_batch_agree_with_gaps_and_chains() {
 /// cancels) and nuisance count, the same torque test (its χ² to 1e-3, the same
 /// decision unless within 1e-3 of the threshold), and see the same gaps; returns the
 /// gaps.
-fn assert_recursive_matches_batch(
+pub(crate) fn assert_recursive_matches_batch(
     samples: &[Sample],
     rows: MomentumRowSettings,
     tolerance: f64,

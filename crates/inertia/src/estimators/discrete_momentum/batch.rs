@@ -5,7 +5,7 @@
 use super::candidates::{candidates, chained_siblings};
 use super::cross_check::COMPARABLE_FIT;
 use super::finish::{finish, Evidence, Finished};
-use super::select::{alternatives_from_s, in_running, pick};
+use super::select::{alternatives_from_s, in_running, pick, test_inertial_torque};
 use super::sigma::{discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife};
 use super::standing::RULE_OUT_AFTER;
 use super::twins;
@@ -57,7 +57,7 @@ pub(super) fn run_batch(
         reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
     let attitude_is_gyro_integral = drop_batch_twins(&mut reduced, c);
-    let fits: Vec<(f64, f64, Option<f64>)> = reduced
+    let mut fits: Vec<(f64, f64, Option<f64>)> = reduced
         .iter()
         .map(|(rows, b)| {
             (
@@ -68,6 +68,7 @@ pub(super) fn run_batch(
         })
         .collect();
     let rows: Vec<MomentumRowSettings> = reduced.iter().map(|(r, _)| *r).collect();
+    test_inertial_torque(&mut fits, &rows);
     let (chosen, from_s) = pick(&fits, &rows, |i| {
         reduced.get(i).and_then(|(_, b)| b.jackknife_sigma_kg_m2)
     });

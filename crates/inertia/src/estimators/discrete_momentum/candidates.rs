@@ -8,7 +8,7 @@ use crate::estimator::momentum_rows::{
     MomentumRowSettings, MomentumRows, RhoModel, RotationSource, Stencil,
 };
 use crate::estimator::recursive::RecursiveSettings;
-use crate::pipeline::PipelineConfig;
+use crate::pipeline::{InertialTorque, PipelineConfig};
 use crate::solver::Backend;
 use std::boxed::Box;
 use std::vec::Vec;
@@ -41,16 +41,25 @@ pub(super) fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowS
         ],
         None => std::vec![None],
     };
+    let inertial: &[bool] = match c.inertial_torque {
+        InertialTorque::Off => &[false],
+        InertialTorque::On => &[true],
+        // Both, the test deciding at each solve ([`super::select::test_inertial_torque`]).
+        InertialTorque::Auto => &[false, true],
+    };
     let mut out = Vec::new();
     for max_chain_s in chains {
         for &rotation in rotations {
             for &stencil in stencils {
-                out.push(MomentumRowSettings {
-                    rotation,
-                    stencil,
-                    torque_bias: c.torque_bias,
-                    max_chain_s,
-                });
+                for &inertial_torque in inertial {
+                    out.push(MomentumRowSettings {
+                        rotation,
+                        stencil,
+                        torque_bias: c.torque_bias,
+                        inertial_torque,
+                        max_chain_s,
+                    });
+                }
             }
         }
     }
@@ -119,7 +128,7 @@ pub(super) struct SharedSource {
 pub(super) fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSource> {
     let mut out: Vec<SharedSource> = Vec::new();
     for (i, r) in candidates.iter().enumerate() {
-        let key = r.rows_only();
+        let key = r.source_key();
         match out.iter_mut().find(|g| *g.rows.settings() == key) {
             Some(g) => g.members.push(i),
             None => out.push(SharedSource {

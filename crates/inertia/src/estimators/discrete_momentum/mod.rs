@@ -64,7 +64,7 @@ use candidates::{candidates, chained_siblings, settings, shared_sources, Candida
 use cross_check::CrossCheck;
 use finish::{finish, Evidence, Finished};
 use nalgebra::Vector3;
-use select::{alternatives_from_s, in_running, pick};
+use select::{alternatives_from_s, in_running, pick, test_inertial_torque};
 use sigma::{candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer};
 use standing::{Standing, RULE_OUT_AFTER};
 use std::boxed::Box;
@@ -330,6 +330,7 @@ impl DiscreteMomentum {
         for (i, c) in self.candidates.iter().enumerate() {
             self.fits.push(self.fit(i, c));
         }
+        test_inertial_torque(&mut self.fits, &self.rows);
         let (candidates, standing) = (&mut self.candidates, &self.standing);
         let (chosen, from_s) = pick(&self.fits, &self.rows, |i| {
             candidates

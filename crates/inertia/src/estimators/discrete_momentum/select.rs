@@ -136,3 +136,55 @@ pub(super) fn steadier(
     }
     best.0
 }
+
+/// The 1 − 10⁻³ quantile of χ² with `k` degrees of freedom (Wilson–Hilferty; within 1 %
+/// of the exact quantile from `k = 3` on).
+pub(crate) fn chi2_quantile_999(k: f64) -> f64 {
+    const Z: f64 = 3.090_232;
+    let a = 2.0 / (9.0 * k);
+    k * (1.0 - a + Z * a.sqrt()).powi(3)
+}
+
+/// Whether the data need the inertial torque, from the fits `(residual sum of squares,
+/// residual degrees of freedom)` of the same rows without and with it: the nested test
+/// `Δρ²/s² > χ²_k(1 − 10⁻³)`, `s²` the variance with it and `k` its unknowns (the
+/// difference of the degrees of freedom). Errors correlated along the rows make `s²` too
+/// small and the statistic too large, which errs toward the torque (a wider σ, not a
+/// bias). No test (not a finite statistic, or no unknowns between them): not needed.
+pub(super) fn needs_inertial_torque(without: (f64, f64), with: (f64, f64)) -> bool {
+    let k = without.1 - with.1;
+    let s2 = with.0 / with.1;
+    let chi2 = (without.0 - with.0) / s2;
+    if !(k >= 1.0 && s2.is_finite() && s2 > 0.0 && chi2.is_finite()) {
+        return false;
+    }
+    chi2 > chi2_quantile_999(k)
+}
+
+/// Of each pair of candidates in `fits` (as for [`choose`]) that differ only in the
+/// inertial torque and are both standing, the one [`needs_inertial_torque`] rejects is out
+/// of this choice (its variance infinite).
+pub(super) fn test_inertial_torque(
+    fits: &mut [(f64, f64, Option<f64>)],
+    rows: &[MomentumRowSettings],
+) {
+    for (w, rw) in rows.iter().enumerate().filter(|(_, r)| r.inertial_torque) {
+        let twin = MomentumRowSettings {
+            inertial_torque: false,
+            ..*rw
+        };
+        let Some(o) = rows.iter().position(|r| *r == twin) else {
+            continue;
+        };
+        let ((vo, dof_o, _), (vw, dof_w, _)) = (fits[o], fits[w]);
+        if !(vo.is_finite() && vw.is_finite()) {
+            continue;
+        }
+        let loser = if needs_inertial_torque((vo * dof_o, dof_o), (vw * dof_w, dof_w)) {
+            o
+        } else {
+            w
+        };
+        fits[loser].0 = f64::INFINITY;
+    }
+}

@@ -1,0 +1,407 @@
+//! Settings from C: plain integers and numbers (no heap, no strings) validated into a
+//! [`Plan`], from which the heap engine's library settings or the fixed-size engine are
+//! built.
+
+use crate::engine::{self, Engine, FixedConfig};
+use crate::status::{fail, pipeline_fail, InertiaStatus};
+use inertia::constraints::ConstraintSet;
+use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
+use inertia::estimator::observability::ObservabilitySettings;
+use inertia::estimator::recursive::RecursiveSettings;
+use inertia::pipeline::{PipelineError, PipelineSettings};
+use inertia::telemetry::glitch::GlitchPolicy;
+use inertia::tensor::Component;
+
+/// The estimators (`InertiaSettings::estimator`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaEstimatorKind {
+    /// The discrete momentum estimator (the CLI's default; heap only).
+    DiscreteMomentum = 0,
+    /// The paper's discrete variational estimator (heap or caller storage).
+    Variational = 1,
+    /// The paper's finite-difference baseline; needs gyro rates (heap or caller storage).
+    FiniteDifference = 2,
+    /// The momentum recursive least-squares baseline, unconstrained (heap only).
+    Momentum = 3,
+}
+
+/// The feasible set of J (`InertiaSettings::constraints`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaConstraintKind {
+    /// J ⪰ εI and Σ = ½tr(J)I − J ⪰ 0 (default).
+    Physical = 0,
+    /// The paper's set: J ⪰ εI and the diagonal triangle inequalities.
+    Paper = 1,
+}
+
+/// Where the discrete momentum estimator takes the rotation from
+/// (`InertiaSettings::rotation_source`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaRotationSource {
+    /// Both when the samples have gyro rates; the better fit is used (default).
+    Auto = 0,
+    /// The attitude quaternions.
+    Attitude = 1,
+    /// The gyro rates.
+    Gyro = 2,
+}
+
+/// What the wheel momentum does between samples (`InertiaSettings::rho_model`,
+/// discrete momentum estimator).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaRhoModel {
+    /// Decided from the data (default).
+    Auto = 0,
+    /// Smooth.
+    Smooth = 1,
+    /// Commands held over each step.
+    Held = 2,
+    /// The plain trapezoid.
+    Plain = 3,
+}
+
+/// What to do when the attitude jumps against the gyro (`InertiaSettings::glitches`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InertiaGlitchPolicy {
+    /// Stop with `INERTIA_STATUS_DATA` (default).
+    Stop = 0,
+    /// Estimate anyway.
+    Keep = 1,
+}
+
+/// Settings of an estimator. Start from `inertia_settings_default()` and change fields.
+/// The enum-valued fields are plain integers holding one of the named constants (an
+/// unknown value is `INERTIA_STATUS_INVALID_SETTING`, never undefined behaviour); flags
+/// are 0 or non-zero. Units SI.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InertiaSettings {
+    /// One of `InertiaEstimatorKind`. Default discrete momentum.
+    pub estimator: u32,
+    /// One of `InertiaConstraintKind`. Default physical.
+    pub constraints: u32,
+    /// Lower bound per element `[J11, J22, J33, J12, J13, J23]`, kg m²; `-INFINITY`
+    /// (default) for none. Products are tensor entries (`J12 = −Σ m x y`).
+    pub bound_lower_kg_m2: [f64; 6],
+    /// Upper bound per element, kg m²; `INFINITY` (default) for none. A lower bound
+    /// equal to the upper one is an equality: the solver eliminates that element.
+    pub bound_upper_kg_m2: [f64; 6],
+    /// Gaussian prior mean per element, kg m² (tensor entries; negate a CAD tool's
+    /// products of inertia). Used when `prior_sigma_kg_m2` is set.
+    pub prior_mean_kg_m2: [f64; 6],
+    /// Gaussian prior standard deviation per element, kg m², each finite and > 0; all
+    /// zero (default) for no prior.
+    pub prior_sigma_kg_m2: [f64; 6],
+    /// Solve every this many samples (default 1).
+    pub solve_every: u32,
+    /// Memory time constant, s; 0 (default) for none.
+    pub memory_s: f64,
+    /// Resample onto a uniform grid of this period, s; 0 (default) for none. Heap only.
+    pub resample_s: f64,
+    /// Gyro rate-noise density, deg/s/√Hz, for errors-in-variables compensation; 0
+    /// (default) for none.
+    pub gyro_noise_deg_s_rthz: f64,
+    /// Non-zero (default): attach σ to each estimate.
+    pub uncertainty: u8,
+    /// Non-zero (default): estimate an unknown constant torque (discrete momentum).
+    pub torque_bias: u8,
+    /// One of `InertiaRotationSource` (discrete momentum). Default auto.
+    pub rotation_source: u32,
+    /// One of `InertiaRhoModel` (discrete momentum). Default auto.
+    pub rho_model: u32,
+    /// Short momentum chain, s (discrete momentum); default 30; 0: chains end only at gaps.
+    pub max_chain_s: f64,
+    /// One of `InertiaGlitchPolicy`. Default stop.
+    pub glitches: u32,
+    /// Angle random walk of the attitude solution, deg/√h (discrete momentum, with
+    /// `gyro_noise_deg_s_rthz`): for an attitude propagated from a gyro, its ARW; the rows
+    /// are weighted for the drift (needs `uncertainty`). 0 (default) for none (a star
+    /// tracker or an MEKF).
+    pub attitude_drift_deg_rth: f64,
+}
+
+/// What the C settings ask for, without the heap (no estimator name string).
+pub(crate) struct Plan {
+    kind: InertiaEstimatorKind,
+    constraints: ConstraintSet,
+    solve_every: usize,
+    pub(crate) memory_s: Option<f64>,
+    pub(crate) resample_s: Option<f64>,
+    attitude_drift: Option<f64>,
+    gyro_noise: Option<f64>,
+    uncertainty: bool,
+    torque_bias: bool,
+    rotation_source: Option<RotationSource>,
+    rho_model: RhoModel,
+    max_chain_s: Option<f64>,
+    glitches: GlitchPolicy,
+}
+
+fn finite(name: &str, v: f64) -> Result<(), InertiaStatus> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(fail(
+            InertiaStatus::NotFinite,
+            format_args!("setting `{name}` is {v}: expected a finite number"),
+        ))
+    }
+}
+
+/// `0` means none; anything else must be finite and > 0.
+fn optional_positive(name: &str, v: f64) -> Result<Option<f64>, InertiaStatus> {
+    finite(name, v)?;
+    if v == 0.0 {
+        Ok(None)
+    } else if v > 0.0 {
+        Ok(Some(v))
+    } else {
+        Err(fail(
+            InertiaStatus::InvalidSetting,
+            format_args!("setting `{name}` = {v} is invalid: expected 0 (none) or > 0"),
+        ))
+    }
+}
+
+fn choice<T: Copy>(name: &str, v: u32, options: &[T]) -> Result<T, InertiaStatus> {
+    options.get(v as usize).copied().ok_or_else(|| {
+        fail(
+            InertiaStatus::InvalidSetting,
+            format_args!(
+                "setting `{name}` = {v} is invalid: expected 0 to {}",
+                options.len() - 1
+            ),
+        )
+    })
+}
+
+impl Plan {
+    pub(crate) fn from_c(s: &InertiaSettings) -> Result<Self, InertiaStatus> {
+        use InertiaEstimatorKind as K;
+        let kind = choice(
+            "estimator",
+            s.estimator,
+            &[
+                K::DiscreteMomentum,
+                K::Variational,
+                K::FiniteDifference,
+                K::Momentum,
+            ],
+        )?;
+        let mut constraints = choice(
+            "constraints",
+            s.constraints,
+            &[ConstraintSet::physical(), ConstraintSet::paper()],
+        )?;
+        for (k, c) in Component::ALL.iter().enumerate() {
+            let (l, u) = (s.bound_lower_kg_m2[k], s.bound_upper_kg_m2[k]);
+            if l.is_nan() || u.is_nan() || l == f64::INFINITY || u == f64::NEG_INFINITY {
+                return Err(fail(
+                    InertiaStatus::NotFinite,
+                    format_args!(
+                        "bound on {}: [{l}, {u}] (NaN, or infinite on the wrong side)",
+                        inertia::tensor::COMPONENT_NAMES[k]
+                    ),
+                ));
+            }
+            let (l, u) = (l.is_finite().then_some(l), u.is_finite().then_some(u));
+            if l.is_some() || u.is_some() {
+                constraints = constraints.with_bounds(*c, l, u);
+            }
+        }
+        // A prior is given when any σ is; the library checks each value (finite, > 0).
+        if s.prior_sigma_kg_m2.iter().any(|&v| v != 0.0) {
+            constraints.prior = Some(inertia::constraints::GaussianPrior {
+                mean_kg_m2: s.prior_mean_kg_m2,
+                sigma_kg_m2: s.prior_sigma_kg_m2,
+            });
+        }
+        if s.solve_every == 0 {
+            return Err(fail(
+                InertiaStatus::InvalidSetting,
+                format_args!("setting `solve_every` = 0 is invalid: expected at least 1"),
+            ));
+        }
+        let gyro_noise = {
+            let g = s.gyro_noise_deg_s_rthz;
+            finite("gyro_noise_deg_s_rthz", g)?;
+            if g < 0.0 {
+                return Err(fail(
+                    InertiaStatus::InvalidSetting,
+                    format_args!("setting `gyro_noise_deg_s_rthz` = {g} is invalid: expected >= 0"),
+                ));
+            }
+            (g > 0.0).then_some(g)
+        };
+        Ok(Plan {
+            kind,
+            constraints,
+            solve_every: s.solve_every as usize,
+            memory_s: optional_positive("memory_s", s.memory_s)?,
+            resample_s: optional_positive("resample_s", s.resample_s)?,
+            attitude_drift: optional_positive("attitude_drift_deg_rth", s.attitude_drift_deg_rth)?,
+            gyro_noise,
+            uncertainty: s.uncertainty != 0,
+            torque_bias: s.torque_bias != 0,
+            rotation_source: choice(
+                "rotation_source",
+                s.rotation_source,
+                &[
+                    None,
+                    Some(RotationSource::Attitude),
+                    Some(RotationSource::Gyro),
+                ],
+            )?,
+            rho_model: choice(
+                "rho_model",
+                s.rho_model,
+                &[
+                    RhoModel::Auto,
+                    RhoModel::Smooth,
+                    RhoModel::Held,
+                    RhoModel::Plain,
+                ],
+            )?,
+            max_chain_s: optional_positive("max_chain_s", s.max_chain_s)?,
+            glitches: choice(
+                "glitches",
+                s.glitches,
+                &[GlitchPolicy::Stop, GlitchPolicy::Keep],
+            )?,
+        })
+    }
+
+    fn name(&self) -> &'static str {
+        match self.kind {
+            InertiaEstimatorKind::DiscreteMomentum => "discrete-momentum",
+            InertiaEstimatorKind::Variational => "variational",
+            InertiaEstimatorKind::FiniteDifference => "finite-difference",
+            InertiaEstimatorKind::Momentum => "momentum",
+        }
+    }
+
+    /// The library's settings (allocates: the estimator's name is a `String`).
+    pub(crate) fn pipeline_settings(&self) -> PipelineSettings {
+        PipelineSettings {
+            estimator: self.name().into(),
+            solver: "native".into(),
+            constraints: self.constraints,
+            solve_every: self.solve_every,
+            memory_s: self.memory_s,
+            resample_s: self.resample_s,
+            gyro_noise_deg_s_rthz: self.gyro_noise,
+            uncertainty: self.uncertainty,
+            observability: ObservabilitySettings::default(),
+            rotation_source: self.rotation_source,
+            rho_model: self.rho_model,
+            torque_bias: self.torque_bias,
+            // Not in the C settings yet: the fixed-size engine has no inertial torque.
+            inertial_torque: inertia::pipeline::InertialTorque::Off,
+            max_chain_s: self.max_chain_s,
+            attitude_drift_deg_rth: self.attitude_drift,
+            glitches: self.glitches,
+        }
+    }
+
+    /// The fixed-size engine, validated as `PipelineSettings::validate` would, without
+    /// the heap.
+    pub(crate) fn fixed_engine(&self) -> Result<Engine, InertiaStatus> {
+        let fd = match self.kind {
+            InertiaEstimatorKind::Variational => false,
+            InertiaEstimatorKind::FiniteDifference => true,
+            _ => {
+                return Err(fail(
+                    InertiaStatus::NeedsHeap,
+                    format_args!(
+                        "the {} estimator cannot run in caller storage (only variational and finite-difference can): use inertia_estimator_new",
+                        self.name()
+                    ),
+                ))
+            }
+        };
+        if self.resample_s.is_some() {
+            return Err(fail(
+                InertiaStatus::NeedsHeap,
+                format_args!("resampling cannot run in caller storage: use inertia_estimator_new"),
+            ));
+        }
+        // The row-model settings at `PipelineSettings::default()`'s values (not built here:
+        // it holds `String`s). `tests/c_api/engines.rs` checks the two agree.
+        for (setting, changed) in [
+            ("rotation_source", self.rotation_source.is_some()),
+            ("rho_model", self.rho_model != RhoModel::Auto),
+            ("torque_bias", !self.torque_bias),
+            (
+                "max_chain_s",
+                self.max_chain_s != Some(inertia::pipeline::DEFAULT_MAX_CHAIN_S),
+            ),
+            ("gyro_noise_deg_s_rthz", fd && self.gyro_noise.is_some()),
+            ("attitude_drift_deg_rth", self.attitude_drift.is_some()),
+        ] {
+            if changed {
+                return Err(fail(
+                    InertiaStatus::InvalidSetting,
+                    format_args!(
+                        "setting `{setting}` does not apply to the {} estimator",
+                        self.name()
+                    ),
+                ));
+            }
+        }
+        let constraints = self
+            .constraints
+            .validate()
+            .map_err(|e| pipeline_fail(&PipelineError::Constraints(e)))?;
+        let config = FixedConfig {
+            constraints,
+            recursive: RecursiveSettings {
+                solve_every: self.solve_every,
+                observability: ObservabilitySettings::default(),
+                memory_s: self.memory_s,
+                gyro_noise_rad_s_rthz: self.gyro_noise.map(f64::to_radians),
+            },
+            // The finite-difference baseline has no uncertainty model.
+            uncertainty: self.uncertainty && !fd,
+            residual_test: self.memory_s.is_none(),
+            glitches: self.glitches,
+        };
+        let engine = if fd {
+            engine::Fixed::new(config).map(Engine::FiniteDifference)
+        } else {
+            engine::Fixed::new(config).map(Engine::Variational)
+        };
+        engine.map_err(|e| pipeline_fail(&e))
+    }
+}
+
+/// The default settings: the discrete momentum estimator, the physical constraint set,
+/// no bounds, no memory, no resampling, no gyro-noise compensation, σ on, torque bias on,
+/// chains of 30 s, glitches stop the run (the CLI's `estimate` defaults). For caller
+/// storage set `estimator = INERTIA_ESTIMATOR_KIND_VARIATIONAL`.
+#[no_mangle]
+pub extern "C" fn inertia_settings_default() -> InertiaSettings {
+    InertiaSettings {
+        estimator: InertiaEstimatorKind::DiscreteMomentum as u32,
+        constraints: InertiaConstraintKind::Physical as u32,
+        bound_lower_kg_m2: [f64::NEG_INFINITY; 6],
+        bound_upper_kg_m2: [f64::INFINITY; 6],
+        prior_mean_kg_m2: [0.0; 6],
+        prior_sigma_kg_m2: [0.0; 6],
+        solve_every: 1,
+        memory_s: 0.0,
+        resample_s: 0.0,
+        gyro_noise_deg_s_rthz: 0.0,
+        uncertainty: 1,
+        torque_bias: 1,
+        rotation_source: InertiaRotationSource::Auto as u32,
+        rho_model: InertiaRhoModel::Auto as u32,
+        max_chain_s: inertia::pipeline::DEFAULT_MAX_CHAIN_S,
+        glitches: InertiaGlitchPolicy::Stop as u32,
+        attitude_drift_deg_rth: 0.0,
+    }
+}

@@ -1,0 +1,447 @@
+//! The sample gate: the one place that checks a raw sample before it becomes a
+//! [`Sample`], for every front end (the CSV reader, Python's arrays, the C API).
+//!
+//! A [`RawSample`] holds the numbers as read, in storage order. [`Gate::check`] refuses it
+//! with a typed [`SampleError`] naming the [`Field`] at fault, or returns the sample:
+//!
+//! 1. each value finite and within the supported range ([`crate::sample::range`]), in the
+//!    order time, quaternion, ρ, τ, ω;
+//! 2. the quaternion read in its [`QuaternionFormat`] (Hamilton scalar last or first, or
+//!    JPL, eq. 1's convention, or Hamilton inertial → body), its norm within [`GateOptions::unit_tolerance`] of 1, then
+//!    renormalised (and counted);
+//! 3. across samples ([`Order`]): time increasing, gyro rates given for every sample or
+//!    none, and, in strict mode ([`GateOptions::period_tolerance`]), a uniform step;
+//! 4. ρ (and with it nothing else) negated where the data use the opposite sign
+//!    ([`GateOptions::negate_rho`]); gyro rates stored in deg/s converted to rad/s
+//!    before their range check ([`GateOptions::gyro_unit`]).
+//!
+//! A front end keeps only its locating (a file's line and column name, an array's name and
+//! row, a C sample's index) and the rendering of the message. A refused sample leaves the
+//! gate as it was. [`ReadStats`] counts what was accepted, renormalised and sign-flipped.
+//! The gate holds no heap memory (the C API's caller storage holds one).
+
+use crate::attitude::Quaternion;
+use crate::error_kind::ErrorKind;
+use crate::sample::{check_value, Quantity, Sample};
+use crate::text::Num;
+use nalgebra::Vector3;
+
+/// Default tolerance on `| |q| − 1 |` below which quaternions are renormalised.
+pub const DEFAULT_UNIT_TOLERANCE: f64 = 1e-3;
+
+/// Where the scalar part of the quaternion is stored, and what the quaternion means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum QuaternionFormat {
+    /// Hamilton, body → inertial, the four values are the vector part then the scalar
+    /// (this crate's convention). The default.
+    #[default]
+    HamiltonScalarLast,
+    /// Hamilton, body → inertial, scalar first: `[w, x, y, z]`.
+    HamiltonScalarFirst,
+    /// JPL/Shuster (inertial → body attitude matrix, scalar last). Converted with
+    /// [`Quaternion::from_jpl_xyzw`].
+    Jpl,
+    /// Hamilton, scalar last, but mapping inertial → body (the conjugate of this crate's
+    /// meaning): [`Quaternion::from_hamilton_inertial_to_body_xyzw`].
+    Conjugate,
+}
+
+/// The unit of the gyro rates as stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GyroUnit {
+    /// rad/s (the default).
+    #[default]
+    RadPerS,
+    /// deg/s: converted to rad/s as read, before the range check.
+    DegPerS,
+}
+
+impl GyroUnit {
+    /// The factor that turns a stored rate into rad/s.
+    #[must_use]
+    pub fn to_rad_s(self) -> f64 {
+        match self {
+            Self::RadPerS => 1.0,
+            Self::DegPerS => core::f64::consts::PI / 180.0,
+        }
+    }
+}
+
+/// One sample as a front end read it: the numbers in storage order, unchecked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RawSample {
+    /// Time, s.
+    pub t_s: f64,
+    /// The quaternion's four values in storage order ([`QuaternionFormat`]).
+    pub q: [f64; 4],
+    /// Total rotor angular momentum, N m s, as stored (before any negation).
+    pub rho_nms: [f64; 3],
+    /// Known external torque, N m (`None`: zero).
+    pub tau_nm: Option<[f64; 3]>,
+    /// Gyro rate averaged over the step, in [`GateOptions::gyro_unit`] (rad/s by
+    /// default; `None`: not measured).
+    pub w_rad_s: Option<[f64; 3]>,
+}
+
+/// A value of a sample: what a front end maps to its column, array element or C field.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Field {
+    /// The time.
+    Time,
+    /// The quaternion's value at storage position `0..4`.
+    Quaternion(usize),
+    /// The quaternion as a whole (its norm).
+    QuaternionNorm,
+    /// Rotor momentum, axis `0..3`.
+    Rho(usize),
+    /// Known torque, axis `0..3`.
+    Tau(usize),
+    /// Gyro rate, axis `0..3`.
+    Rate(usize),
+}
+
+/// Why the gate refused a sample.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SampleError {
+    /// A value is NaN or infinite.
+    #[error("value {value} is not finite")]
+    NotFinite {
+        /// Which.
+        field: Field,
+        /// The value.
+        value: f64,
+    },
+    /// A value outside the supported range ([`crate::sample::range`]).
+    #[error("value {} is outside the supported range (magnitude at most {} {unit})", Num(*.value), Num(*.limit))]
+    OutOfRange {
+        /// Which.
+        field: Field,
+        /// The value.
+        value: f64,
+        /// The largest magnitude supported.
+        limit: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
+    /// The quaternion's norm is too far from 1.
+    #[error("quaternion norm {norm:.6} differs from 1 by more than {tolerance:e}")]
+    NonUnitQuaternion {
+        /// Its norm.
+        norm: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+    /// Time does not increase.
+    #[error("time {} s does not increase (previous row: {} s)", Num(*.t_s), Num(*.previous_s))]
+    TimeNotIncreasing {
+        /// This sample's time, s.
+        t_s: f64,
+        /// The previous sample's, s.
+        previous_s: f64,
+    },
+    /// In strict mode, the step differs from the first one.
+    #[error("step {} s differs from the sample period {} s by more than {tolerance:e} (relative); resample or split the data", Num(*.dt_s), Num(*.period_s))]
+    NonUniformPeriod {
+        /// This step, s.
+        dt_s: f64,
+        /// The period set by the first step, s.
+        period_s: f64,
+        /// The relative tolerance.
+        tolerance: f64,
+    },
+    /// Gyro rates given for some samples and not for others.
+    #[error("gyro rates {} here but {} for the earlier samples: give them for every sample or none", given(*.given_here), given(!*.given_here))]
+    GyroChanged {
+        /// Whether this sample has them.
+        given_here: bool,
+    },
+}
+
+fn given(yes: bool) -> &'static str {
+    if yes {
+        "given"
+    } else {
+        "missing"
+    }
+}
+
+impl SampleError {
+    /// The value at fault.
+    #[must_use]
+    pub fn field(&self) -> Field {
+        match self {
+            SampleError::NotFinite { field, .. } | SampleError::OutOfRange { field, .. } => *field,
+            SampleError::NonUnitQuaternion { .. } => Field::QuaternionNorm,
+            SampleError::TimeNotIncreasing { .. } | SampleError::NonUniformPeriod { .. } => {
+                Field::Time
+            }
+            SampleError::GyroChanged { .. } => Field::Rate(0),
+        }
+    }
+
+    /// Its kind, as every front end reports it.
+    #[must_use]
+    pub fn error_kind(&self) -> ErrorKind {
+        match self {
+            SampleError::NotFinite { .. } => ErrorKind::NotFinite,
+            SampleError::OutOfRange { .. } => ErrorKind::OutOfRange,
+            SampleError::NonUnitQuaternion { .. } => ErrorKind::NonUnitQuaternion,
+            SampleError::TimeNotIncreasing { .. } => ErrorKind::TimeNotIncreasing,
+            SampleError::NonUniformPeriod { .. } => ErrorKind::NonUniformPeriod,
+            SampleError::GyroChanged { .. } => ErrorKind::GyroChanged,
+        }
+    }
+}
+
+/// Counts of what was read.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ReadStats {
+    /// Samples accepted.
+    pub rows: usize,
+    /// Quaternions renormalised (within the tolerance).
+    pub renormalised: usize,
+    /// Quaternions whose sign was opposite to the previous one's (same attitude).
+    pub sign_flips: usize,
+    /// Samples rejected (a reader stops at the first; this is 0 or 1).
+    pub rejected: usize,
+    /// Shortest step, s (0 before two samples).
+    pub min_step_s: f64,
+    /// Longest step, s.
+    pub max_step_s: f64,
+}
+
+impl ReadStats {
+    /// Count the step of `dt` s into the next sample, whose quaternion `q` follows `prev`
+    /// (before that sample is counted in `rows`): the shortest and longest step, and a sign
+    /// opposite to the previous quaternion's.
+    pub fn step(&mut self, dt: f64, prev: &Quaternion, q: &Quaternion) {
+        self.min_step_s = if self.rows > 1 {
+            self.min_step_s.min(dt)
+        } else {
+            dt
+        };
+        self.max_step_s = self.max_step_s.max(dt);
+        if prev.v.dot(&q.v) + prev.s * q.s < 0.0 {
+            self.sign_flips += 1;
+        }
+    }
+}
+
+/// The checks across samples: time increasing and gyro rates all-or-none. Also used by
+/// [`crate::pipeline::Run`] for samples that did not come through a [`Gate`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Order {
+    last_t_s: Option<f64>,
+    gyro: Option<bool>,
+}
+
+impl Order {
+    /// Whether a sample at `t_s`, with gyro rates or not, may follow the accepted ones.
+    pub fn check(&self, t_s: f64, has_gyro: bool) -> Result<(), SampleError> {
+        if let Some(g) = self.gyro {
+            if g != has_gyro {
+                return Err(SampleError::GyroChanged {
+                    given_here: has_gyro,
+                });
+            }
+        }
+        if let Some(previous_s) = self.last_t_s {
+            if !(t_s > previous_s) {
+                return Err(SampleError::TimeNotIncreasing { t_s, previous_s });
+            }
+        }
+        Ok(())
+    }
+
+    /// Record an accepted sample.
+    pub fn accept(&mut self, t_s: f64, has_gyro: bool) {
+        self.last_t_s = Some(t_s);
+        self.gyro = Some(has_gyro);
+    }
+
+    /// The time of the last accepted sample, s.
+    #[must_use]
+    pub fn last_t_s(&self) -> Option<f64> {
+        self.last_t_s
+    }
+}
+
+/// How the gate reads the values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GateOptions {
+    /// Quaternion storage and convention.
+    pub quaternion: QuaternionFormat,
+    /// Quaternions with `| |q| − 1 |` up to this are renormalised (and counted); beyond it
+    /// they are refused. Default [`DEFAULT_UNIT_TOLERANCE`].
+    pub unit_tolerance: f64,
+    /// When set, the relative tolerance on the uniformity of the step (strict mode).
+    pub period_tolerance: Option<f64>,
+    /// ρ holds the rotor momentum with the opposite sign of this library's convention:
+    /// negate it.
+    pub negate_rho: bool,
+    /// The unit of the stored gyro rates. Default rad/s.
+    pub gyro_unit: GyroUnit,
+}
+
+impl Default for GateOptions {
+    fn default() -> Self {
+        Self {
+            quaternion: QuaternionFormat::default(),
+            unit_tolerance: DEFAULT_UNIT_TOLERANCE,
+            period_tolerance: None,
+            negate_rho: false,
+            gyro_unit: GyroUnit::RadPerS,
+        }
+    }
+}
+
+/// The gate over one sequence of samples.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Gate {
+    options: GateOptions,
+    order: Order,
+    prev_q: Option<Quaternion>,
+    period_s: Option<f64>,
+    stats: ReadStats,
+}
+
+fn value(field: Field, quantity: Quantity, v: f64) -> Result<f64, SampleError> {
+    if !v.is_finite() {
+        return Err(SampleError::NotFinite { field, value: v });
+    }
+    check_value(quantity, v).map_err(|_| {
+        let (limit, unit) = quantity.limit();
+        SampleError::OutOfRange {
+            field,
+            value: v,
+            limit,
+            unit,
+        }
+    })?;
+    Ok(v)
+}
+
+fn vec3(
+    v: [f64; 3],
+    field: fn(usize) -> Field,
+    quantity: fn(usize) -> Quantity,
+) -> Result<Vector3<f64>, SampleError> {
+    let mut out = Vector3::zeros();
+    for k in 0..3 {
+        out[k] = value(field(k), quantity(k), v[k])?;
+    }
+    Ok(out)
+}
+
+impl Gate {
+    /// A gate reading with `options`.
+    #[must_use]
+    pub fn new(options: GateOptions) -> Self {
+        Self {
+            options,
+            ..Self::default()
+        }
+    }
+
+    /// The options.
+    #[must_use]
+    pub fn options(&self) -> &GateOptions {
+        &self.options
+    }
+
+    /// Counts so far.
+    #[must_use]
+    pub fn stats(&self) -> ReadStats {
+        self.stats
+    }
+
+    /// Count a sample refused by its front end before the gate saw it (unparsable).
+    pub fn reject(&mut self) {
+        self.stats.rejected += 1;
+    }
+
+    /// The next sample, checked; a refused one leaves the gate as it was (but counted in
+    /// [`ReadStats::rejected`]).
+    pub fn check(&mut self, raw: &RawSample) -> Result<Sample, SampleError> {
+        self.checked(raw).inspect_err(|_| self.reject())
+    }
+
+    fn checked(&mut self, raw: &RawSample) -> Result<Sample, SampleError> {
+        let t_s = value(Field::Time, Quantity::Time, raw.t_s)?;
+        for (k, &v) in raw.q.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(SampleError::NotFinite {
+                    field: Field::Quaternion(k),
+                    value: v,
+                });
+            }
+        }
+        let read = match self.options.quaternion {
+            QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(raw.q),
+            QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(raw.q),
+            QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(raw.q),
+            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(raw.q),
+        };
+        let norm = read.norm();
+        let tolerance = self.options.unit_tolerance;
+        if !((norm - 1.0).abs() <= tolerance) {
+            return Err(SampleError::NonUnitQuaternion { norm, tolerance });
+        }
+        let mut q = read;
+        let mut renormalised = false;
+        if norm != 1.0 {
+            if let Some(n) = read.normalize() {
+                renormalised = (norm - 1.0).abs() > 1e-12;
+                q = n;
+            }
+        }
+        let rho = vec3(raw.rho_nms, Field::Rho, Quantity::Rho)?;
+        let tau = match raw.tau_nm {
+            Some(v) => vec3(v, Field::Tau, Quantity::Tau)?,
+            None => Vector3::zeros(),
+        };
+        let to_rad_s = self.options.gyro_unit.to_rad_s();
+        let w = raw
+            .w_rad_s
+            .map(|v| vec3(v.map(|x| x * to_rad_s), Field::Rate, Quantity::Rate))
+            .transpose()?;
+        self.order.check(t_s, w.is_some())?;
+        let mut period_s = self.period_s;
+        if let (Some(previous_s), Some(tol)) =
+            (self.order.last_t_s(), self.options.period_tolerance)
+        {
+            let dt_s = t_s - previous_s;
+            match period_s {
+                None => period_s = Some(dt_s),
+                Some(p) if (dt_s - p).abs() > tol * p => {
+                    return Err(SampleError::NonUniformPeriod {
+                        dt_s,
+                        period_s: p,
+                        tolerance: tol,
+                    })
+                }
+                Some(_) => {}
+            }
+        }
+        // Accepted: from here on the gate changes.
+        self.period_s = period_s;
+        if let (Some(previous_s), Some(prev_q)) = (self.order.last_t_s(), self.prev_q) {
+            self.stats.step(t_s - previous_s, &prev_q, &q);
+        }
+        self.stats.renormalised += usize::from(renormalised);
+        self.stats.rows += 1;
+        self.order.accept(t_s, w.is_some());
+        self.prev_q = Some(q);
+        Ok(Sample {
+            t_s,
+            q,
+            rho_nms: if self.options.negate_rho { -rho } else { rho },
+            tau_nm: tau,
+            omega_rad_s: w,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
