@@ -104,8 +104,9 @@ class Estimate:
         sigma: one standard deviation of each element of ``j``, kg m² (noise and
             discretisation bias), or ``None`` for estimators without an uncertainty
             model.
-        status: ``"determined"``, ``"from_prior"``, ``"not_observable"`` or
-            ``"unchecked"``.
+        status: ``"determined"``, ``"from_prior"``, ``"not_observable"``,
+            ``"unchecked"`` (no observability test, or no σ) or ``"model_check_failed"``
+            (an answer with its σ that breaks J1 > 0 or J1 + J2 ≥ J3 beyond 3σ).
         reason: why the data fall short, when they do (else ``None``).
         condition: σ₁/σ₆ of the information factor R when determined.
         principal_moments: ascending, kg m² (3,).

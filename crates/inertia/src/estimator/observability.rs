@@ -141,6 +141,20 @@ pub enum Unobservable {
         /// Smallest eigenvalue of `½ tr(J) I − J` (the second-moment matrix), kg m².
         min_second_moment_kg_m2: f64,
     },
+    /// A constrained answer breaks `J1 > 0` or `J1 + J2 ≥ J3` (principal moments
+    /// `J1 ≤ J2 ≤ J3`) by more than [`crate::pipeline::status::PHYSICAL_Z`] of its stated
+    /// σ: a real body's J is physical, so a model check failed
+    /// ([`Observability::ModelCheckFailed`]; the answer and its σ stay visible).
+    Unphysical {
+        /// Smallest principal moment `J1`, kg m².
+        min_moment_kg_m2: f64,
+        /// `J1 + J2 − J3`, kg m² (negative: the triangle inequality is broken).
+        triangle_kg_m2: f64,
+        /// σ of `J1 + J2 − J3` (the principal moments' σ taken as independent), kg m².
+        triangle_sigma_kg_m2: f64,
+        /// The larger of the two violations in units of its σ.
+        z: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -256,6 +270,15 @@ impl core::fmt::Display for Unobservable {
                 crate::text::Num(*min_moment_kg_m2),
                 crate::text::Num(*min_second_moment_kg_m2)
             ),
+            Unobservable::Unphysical {
+                min_moment_kg_m2,
+                triangle_kg_m2,
+                triangle_sigma_kg_m2,
+                z,
+            } => write!(
+                f,
+                "not a physical inertia (J1 + J2 − J3 = {triangle_kg_m2:.2e} ± {triangle_sigma_kg_m2:.1e} kg m², J1 = {min_moment_kg_m2:.4e} kg m²; {z:.1} σ outside J1 > 0, J1 + J2 ≥ J3): a real body's J is physical, so the row model or the data's conventions do not hold here; the answer and its σ are shown, not promised (the physical constraint set keeps the answer physical)"
+            ),
             Unobservable::IllConditioned {
                 condition,
                 threshold,
@@ -295,6 +318,11 @@ pub enum Observability {
         /// `σ_1/σ_6` of `R`.
         condition: f64,
     },
+    /// An answer with its σ that a model check refutes (the reason, e.g.
+    /// [`Unobservable::Unphysical`]): it is reported with its σ, but not determined,
+    /// since the promise rests on a model the data contradict (code
+    /// `model_check_failed`; [`crate::pipeline::status`]).
+    ModelCheckFailed(Unobservable),
 }
 
 impl Observability {
@@ -304,7 +332,8 @@ impl Observability {
         !matches!(self, Observability::NotObservable(_))
     }
 
-    /// Short code for files: `determined`, `from_prior`, `not_observable`, `unchecked`.
+    /// Short code for files: `determined`, `from_prior`, `not_observable`, `unchecked`,
+    /// `model_check_failed`.
     #[must_use]
     pub fn code(&self) -> &'static str {
         match self {
@@ -312,6 +341,7 @@ impl Observability {
             Observability::FromPrior(_) => "from_prior",
             Observability::NotObservable(_) => "not_observable",
             Observability::Unchecked | Observability::NoSigma { .. } => "unchecked",
+            Observability::ModelCheckFailed(_) => "model_check_failed",
         }
     }
 
@@ -319,7 +349,9 @@ impl Observability {
     #[must_use]
     pub fn reason(&self) -> Option<Unobservable> {
         match self {
-            Observability::FromPrior(r) | Observability::NotObservable(r) => Some(*r),
+            Observability::FromPrior(r)
+            | Observability::NotObservable(r)
+            | Observability::ModelCheckFailed(r) => Some(*r),
             _ => None,
         }
     }
@@ -362,6 +394,7 @@ impl core::fmt::Display for Observability {
                 f,
                 "unchecked: an answer without a standard deviation (this estimator states none here), so nothing says how close it is; the rows pass the rank and conditioning tests (condition number {condition:.3e})"
             ),
+            Observability::ModelCheckFailed(r) => write!(f, "model check failed: {r}"),
         }
     }
 }

@@ -311,7 +311,11 @@ impl Report {
     #[must_use]
     pub fn warning_list(&self) -> std::vec::Vec<Warning> {
         let mut w = std::vec::Vec::new();
-        if let Some(p) = self.physical {
+        // A failed physicality check is the status line itself: not said twice.
+        if let Some(p) = self
+            .physical
+            .filter(|_| !matches!(self.observability, Observability::ModelCheckFailed(_)))
+        {
             w.push(Warning::NotPhysical(p));
         }
         if let Some(v) = self.attitude_disagreement() {

@@ -13,9 +13,16 @@
 //!   eq. 9). A constraint set that does not enforce it (`paper` on the diagonal only,
 //!   `positive-definite`) can return an answer that breaks it; when it breaks it by more
 //!   than [`PHYSICAL_Z`] of its stated σ (`σ(J1 + J2 − J3)` from the principal moments' σ,
-//!   taken as independent), the data do not support a physical J there and the answer is
-//!   withdrawn ([`Unobservable::NotPhysical`]). Within that, it is consistent with a
-//!   physical inertia at its accuracy (the report says so, [`physical_margin`]).
+//!   taken as independent), a model check failed: the truth is physical, so an answer
+//!   that far outside the physical set is not within 3σ of it, and the row model or the
+//!   data's conventions do not hold. The answer is not determined
+//!   ([`Observability::ModelCheckFailed`] with [`Unobservable::Unphysical`]), but it and
+//!   its σ stay visible: the project refuses only for rank or conditioning, a convention
+//!   error the gyro proves, or a user's limit, and an unphysical answer is none of them
+//!   (the paper's own J breaks `J1 + J2 ≥ J3` by 4.9e-5 kg m², so an estimator that is
+//!   right to its σ can be here when its σ is smaller than that). Within [`PHYSICAL_Z`] σ
+//!   the answer is consistent with a physical inertia at its accuracy and stays
+//!   determined (the report says so, [`physical_margin`]).
 
 use crate::constraints::Consistency;
 use crate::estimator::observability::{Observability, Unobservable};
@@ -37,6 +44,9 @@ pub struct PhysicalMargin {
     pub min_moment_kg_m2: f64,
     /// `J1 + J2 − J3`, kg m² (negative: the triangle inequality is broken).
     pub triangle_kg_m2: f64,
+    /// σ of `J1 + J2 − J3` from the principal moments' σ taken as independent (`None`
+    /// without a σ).
+    pub triangle_sigma_kg_m2: Option<f64>,
     /// The larger of the two violations in units of its σ (`None` without a σ).
     pub z: Option<f64>,
 }
@@ -61,9 +71,12 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
     if m[0] > 0.0 && triangle >= -tol {
         return None;
     }
-    let z = e.uncertainty.map(|u| {
+    let triangle_sigma = e.uncertainty.map(|u| {
         let s = u.principal_sigma_kg_m2;
-        let st = crate::math::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        crate::math::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+    });
+    let z = e.uncertainty.zip(triangle_sigma).map(|(u, st)| {
+        let s = u.principal_sigma_kg_m2;
         let zt = if triangle < -tol { -triangle / st } else { 0.0 };
         let z1 = if m[0] <= 0.0 { -m[0] / s[0] } else { 0.0 };
         let z = zt.max(z1);
@@ -76,6 +89,7 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
     Some(PhysicalMargin {
         min_moment_kg_m2: m[0],
         triangle_kg_m2: triangle,
+        triangle_sigma_kg_m2: triangle_sigma,
         z,
     })
 }
@@ -91,14 +105,12 @@ pub fn settle(e: &mut Estimate, consistency: Consistency) {
         );
     if judged && e.uncertainty.is_some() {
         if let Some(p) = physical_margin(e).filter(PhysicalMargin::significant) {
-            // The second-moment matrix ½ tr(J) I − J has eigenvalues ½ tr J − J_i, the
-            // smallest ½ (J1 + J2 − J3).
-            e.observability = Observability::NotObservable(Unobservable::NotPhysical {
+            e.observability = Observability::ModelCheckFailed(Unobservable::Unphysical {
                 min_moment_kg_m2: p.min_moment_kg_m2,
-                min_second_moment_kg_m2: 0.5 * p.triangle_kg_m2,
+                triangle_kg_m2: p.triangle_kg_m2,
+                triangle_sigma_kg_m2: p.triangle_sigma_kg_m2.unwrap_or(f64::INFINITY),
+                z: p.z.unwrap_or(f64::INFINITY),
             });
-            e.solution = None;
-            e.uncertainty = None;
             return;
         }
     }
