@@ -319,3 +319,54 @@ fn gyro_rates_in_degrees_are_named() {
         assert_eq!(v["status"], r["status"], "{args:?}");
     }
 }
+
+/// A Hamilton quaternion mapping inertial → body (this tool's conjugate): the error on
+/// the file advises `--conjugate` (never `--jpl`, whose numbers are this tool's), and
+/// with it the answer is the unconjugated file's, exactly.
+#[test]
+fn conjugated_quaternions_are_read_with_conjugate() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = simulate(
+        dir.path(),
+        "slew",
+        &["--scenario", "slew", "--duration", "120"],
+    );
+    let body = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = body.lines();
+    let header = lines.next().unwrap();
+    let cols: Vec<&str> = header.split(',').collect();
+    let q: Vec<usize> = ["q_x", "q_y", "q_z"]
+        .iter()
+        .map(|n| cols.iter().position(|c| c == n).unwrap())
+        .collect();
+    let mut out = format!("{header}\n");
+    for line in lines {
+        let f: Vec<String> = line
+            .split(',')
+            .enumerate()
+            .map(|(i, v)| {
+                if q.contains(&i) {
+                    // Exact: negation changes only the sign bit.
+                    let x: f64 = v.parse().unwrap();
+                    format!("{:?}", -x)
+                } else {
+                    v.to_string()
+                }
+            })
+            .collect();
+        out.push_str(&f.join(","));
+        out.push('\n');
+    }
+    let conj = dir.path().join("conjugated.csv");
+    std::fs::write(&conj, out).unwrap();
+    let o = inertia(&["estimate", conj.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let t = text(&o);
+    assert!(t.contains("--conjugate") && !t.contains("--jpl"), "{t}");
+    let (_, fixed) = both(&conj, &["--conjugate"]);
+    let (_, plain) = both(&csv, &[]);
+    assert_eq!(fixed["j"], plain["j"]);
+    assert_eq!(fixed["sigma"], plain["sigma"]);
+    assert_eq!(fixed["status"], plain["status"]);
+    assert_eq!(plain["status"], "determined");
+}

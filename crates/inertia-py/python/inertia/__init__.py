@@ -8,8 +8,10 @@ the command line's. This module only converts arguments and results.
 Units are SI throughout: time s, angles rad, rates rad/s, rotor momentum N m s, torque
 N m, inertia kg m². Vectors are in body axes. Quaternions are ``[x, y, z, w]``, scalar
 last, Hamilton, body → inertial, unless ``scalar_first=True`` (columns hold
-``[w, x, y, z]``) or ``jpl=True`` (JPL/Shuster: inertial → body, scalar last) says
-otherwise, as the command line's ``--scalar-first`` and ``--jpl``.
+``[w, x, y, z]``), ``jpl=True`` (JPL/Shuster: inertial → body, scalar last) or
+``conjugate=True`` (Hamilton, inertial → body, scalar last) says otherwise, as the
+command line's ``--scalar-first``, ``--jpl`` and ``--conjugate``; gyro rates are rad/s
+unless ``gyro_unit="deg/s"`` (``--gyro-unit``).
 
 Quick start::
 
@@ -226,6 +228,8 @@ class Telemetry:
         *,
         scalar_first: bool = False,
         jpl: bool = False,
+        conjugate: bool = False,
+        gyro_unit: Optional[str] = None,
         negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
@@ -238,6 +242,8 @@ class Telemetry:
                 kwargs=dict(
                     scalar_first=scalar_first,
                     jpl=jpl,
+                    conjugate=conjugate,
+                    gyro_unit=gyro_unit,
                     negate_rho=negate_rho,
                     unit_tolerance=unit_tolerance,
                     period_tolerance=period_tolerance,
@@ -294,6 +300,8 @@ def read_csv(
     *,
     scalar_first: bool = False,
     jpl: bool = False,
+    conjugate: bool = False,
+    gyro_unit: Optional[str] = None,
     negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
@@ -308,7 +316,12 @@ def read_csv(
     Args:
         path: the file.
         scalar_first: the quaternion columns hold ``[w, x, y, z]`` (``--scalar-first``).
-        jpl: JPL/Shuster quaternions, inertial → body (``--jpl``).
+        jpl: JPL/Shuster quaternions, inertial → body (``--jpl``; the same numbers as
+            this library's Hamilton body → inertial ones).
+        conjugate: Hamilton quaternions mapping inertial → body, scalar last: read
+            conjugated (``--conjugate``).
+        gyro_unit: the unit of the ``w_*`` columns, ``"rad/s"`` (default, ``None``) or
+            ``"deg/s"`` (``--gyro-unit``).
         negate_rho: the rho columns hold the rotor momentum with the opposite sign
             (e.g. the wheels' reaction on the body): negate them (``--negate-rho``).
         columns: renamed columns, ``{"t": "time", "rho_x": "hw_x"}`` (``--column``).
@@ -326,6 +339,8 @@ def read_csv(
             kwargs=dict(
                 scalar_first=scalar_first,
                 jpl=jpl,
+                conjugate=conjugate,
+                gyro_unit=gyro_unit,
                 negate_rho=negate_rho,
                 columns=None if columns is None else dict(columns),
                 unit_tolerance=unit_tolerance,
@@ -408,7 +423,10 @@ _SETTINGS = (
     "solver", "uncertainty",
 )
 #: How the data are read.
-_CONVENTIONS = ("scalar_first", "jpl", "negate_rho", "unit_tolerance", "period_tolerance")
+_CONVENTIONS = (
+    "scalar_first", "jpl", "conjugate", "gyro_unit", "negate_rho", "unit_tolerance",
+    "period_tolerance",
+)
 
 
 def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
@@ -457,6 +475,8 @@ def estimate(
     truth: Any = None,
     scalar_first: bool = False,
     jpl: bool = False,
+    conjugate: bool = False,
+    gyro_unit: Optional[str] = None,
     negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
@@ -515,7 +535,8 @@ def estimate(
         truth: the true J (3×3, kg m²), for ``Estimate.relative_error``.
 
     Input conventions (arrays, DataFrame, path): ``scalar_first``, ``jpl``,
-    ``negate_rho``, ``unit_tolerance``, ``period_tolerance``; ``columns`` for a DataFrame or a path.
+    ``conjugate``, ``gyro_unit``, ``negate_rho``, ``unit_tolerance``,
+    ``period_tolerance``; ``columns`` for a DataFrame or a path.
 
     The GIL is released while the data are checked and the estimator runs.
 
@@ -573,7 +594,8 @@ class Estimator:
     """A streaming estimator: push samples one at a time (or in blocks).
 
     Takes the settings of :func:`estimate` (not ``batch``, ``history``, ``truth``) and
-    the input conventions (``scalar_first``, ``jpl``, ``negate_rho``, ``unit_tolerance``,
+    the input conventions (``scalar_first``, ``jpl``, ``conjugate``, ``gyro_unit``,
+    ``negate_rho``, ``unit_tolerance``,
     ``period_tolerance``). Each sample is checked as a file's row is. Pushing the
     samples of a file one by one gives the same estimate as :func:`estimate` on it.
     The GIL is released while a sample is processed.
@@ -606,6 +628,8 @@ class Estimator:
         uncertainty: bool = True,
         scalar_first: bool = False,
         jpl: bool = False,
+        conjugate: bool = False,
+        gyro_unit: Optional[str] = None,
         negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
@@ -686,7 +710,9 @@ def simulate(scenario: Optional[str] = None, **options: Any) -> Simulation:
     ``wheel_scale_error``, ``wheel_misalignment_deg`` (deg),
     ``gravity_gradient_altitude_km``, ``orbit_inclination_deg``,
     ``constant_torque_nm`` (N m), ``inertia_step`` ``(T, SCALE)``, ``inertia_ramp``
-    ``(T0, T1, SCALE)``.
+    ``(T0, T1, SCALE)``, ``paper_inertia`` (the paper's J exactly, which breaks
+    J1 + J2 ≥ J3 by 4.9e-5 kg m²; by default the scenarios' truth is the paper's J +
+    1e-4 I).
 
     The same settings and seed give the same samples as the CLI's file, bit for bit.
     """

@@ -19,6 +19,9 @@ use nalgebra::Vector3;
 pub const STEPS_NEEDED: usize = 64;
 /// Smallest gyro rate counted, rad/s (a step slower than this says little about frames).
 pub const MIN_RATE_RAD_S: f64 = 2e-3;
+/// Smallest `|cos|` of the angle between the gyro's rate and the attitude's for a step to
+/// count in the gyro-unit check (a random direction passes with probability 5 %).
+pub const SCALE_MIN_COS: f64 = 0.9;
 /// A reading fits when its median relative mismatch is below this.
 pub const FIT: f64 = 0.25;
 
@@ -187,7 +190,7 @@ impl ConventionCheck {
             return;
         };
         let wn = w.norm();
-        self.push_scale(&a, s, wn, h);
+        self.push_scale(&a, s, &w, h);
         if self.steps >= STEPS_NEEDED {
             return;
         }
@@ -211,16 +214,23 @@ impl ConventionCheck {
         self.steps += 1;
     }
 
-    /// The scale of the gyro against the attitude over one step: the attitude's rate
-    /// `|2 vec(q_a† q_b)|/h` (the same magnitude under every quaternion reading that
-    /// conjugates) from steps that turn clearly and slowly enough for it to be a rate.
-    fn push_scale(&mut self, a: &Sample, b: &Sample, wn: f64, h: f64) {
+    /// The scale of the gyro against the attitude over one step: `|w|/|ω_q|` with the
+    /// attitude's rate `ω_q = 2 vec(q_a† q_b)/h`, from steps that turn clearly
+    /// (`|ω_q| ≥` [`MIN_RATE_RAD_S`]), slowly enough for it to be a rate, and **along
+    /// the gyro's axis** (`|cos ∠(w, ω_q)| ≥` [`SCALE_MIN_COS`]; a unit scales `w`, not its
+    /// direction). The last condition keeps out steps whose attitude turns by its noise
+    /// alone (a star tracker's 40″ at 10 Hz is ~3e-3 rad/s), whose `ω_q` points anywhere
+    /// and whose ratio is noise: once their median fell within 10 % of π/180 on honest
+    /// rad/s data, and they hid a real deg/s (tests/integration/gyro_unit.rs).
+    fn push_scale(&mut self, a: &Sample, b: &Sample, w: &Vector3<f64>, h: f64) {
+        let wn = w.norm();
         if self.scale_steps >= STEPS_NEEDED || !(h > 0.0 && h.is_finite() && wn.is_finite()) {
             return;
         }
-        let turn = a.q.conjugate().mul(&b.q).positive_scalar().v.norm() * 2.0;
-        let rate = turn / h;
-        if rate >= MIN_RATE_RAD_S && turn <= 0.2 && wn > 0.0 {
+        let wq: Vector3<f64> = a.q.conjugate().mul(&b.q).positive_scalar().v * (2.0 / h);
+        let rate = wq.norm();
+        let aligned = wn > 0.0 && rate > 0.0 && w.dot(&wq).abs() >= SCALE_MIN_COS * wn * rate;
+        if rate >= MIN_RATE_RAD_S && rate * h <= 0.2 && aligned {
             self.scale[self.scale_steps] = wn / rate;
             self.scale_steps += 1;
         }

@@ -15,6 +15,7 @@ mod discrete_convergence;
 mod discrete_momentum;
 mod dynamics;
 mod estimators;
+mod gyro_unit;
 mod inertial_torque;
 mod numeric_range;
 mod pipeline;
