@@ -88,6 +88,7 @@ static const char *status_word(enum InertiaEstimateStatus s) {
     case INERTIA_ESTIMATE_STATUS_FROM_PRIOR: return "from_prior";
     case INERTIA_ESTIMATE_STATUS_NOT_OBSERVABLE: return "not_observable";
     case INERTIA_ESTIMATE_STATUS_UNCHECKED: return "unchecked";
+    case INERTIA_ESTIMATE_STATUS_MODEL_CHECK_FAILED: return "model_check_failed";
     default: return "none";
     }
 }

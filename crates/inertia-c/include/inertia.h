@@ -49,8 +49,11 @@ typedef enum InertiaEstimateStatus {
   INERTIA_ESTIMATE_STATUS_FROM_PRIOR = 2,
   // The data do not determine J: no answer (see the reason).
   INERTIA_ESTIMATE_STATUS_NOT_OBSERVABLE = 3,
-  // An answer with no observability test (the momentum baseline).
+  // An answer with no observability test (the momentum baseline), or without a σ.
   INERTIA_ESTIMATE_STATUS_UNCHECKED = 4,
+  // An answer with its σ that a model check refutes (it is not a physical inertia
+  // beyond 3σ; see the reason): shown, not promised.
+  INERTIA_ESTIMATE_STATUS_MODEL_CHECK_FAILED = 5,
 } InertiaEstimateStatus;
 
 // Why an estimate is not `DETERMINED` (the library's `Unobservable`).
@@ -83,7 +86,8 @@ typedef enum InertiaReason {
   INERTIA_REASON_OTHER = 12,
   // The data contradict the Gaussian prior (`prior_chi2` above its threshold).
   INERTIA_REASON_PRIOR_CONFLICT = 13,
-  // The momentum baseline's unconstrained J is not a physical inertia.
+  // Not a physical inertia: the momentum baseline's unconstrained J (no answer), or a
+  // constrained answer beyond 3σ of the physical set (`MODEL_CHECK_FAILED`).
   INERTIA_REASON_NOT_PHYSICAL = 14,
 } InertiaReason;
 

@@ -5,7 +5,7 @@
 //! * [`Engine::Fixed`]: the constrained least-squares estimators (`variational`,
 //!   `finite-difference`) with the native solver, in fixed-size state: the same steps the
 //!   pipeline's adapter takes (`pipeline/sdp.rs`: the half-rate shadow for σ, the status
-//!   audit, the residual test, the glitch, convention and reversed-momentum checks), on concrete types with
+//!   audit, the residual test, the status rule (`inertia::pipeline::status`), the glitch, convention and reversed-momentum checks), on concrete types with
 //!   no box. It can live in caller storage, and neither its construction nor a push
 //!   allocates (`tests/no_alloc.rs` counts). `tests/c_api/engines.rs` checks that it gives the
 //!   pipeline's estimates bit for bit.
@@ -72,10 +72,11 @@ impl<S: RowSource + Default> Fixed<S> {
                 sample: Some(index),
                 source,
             })?;
-        if let Some(e) = &e {
-            self.checks.estimate(index, e)?;
-        }
-        Ok(e)
+        let Some(mut e) = e else { return Ok(None) };
+        // The one status rule, as the pipeline applies it (no allocation).
+        inertia::pipeline::status::settle(&mut e, self.config.constraints.set().consistency);
+        self.checks.estimate(index, &e)?;
+        Ok(Some(e))
     }
 }
 

@@ -16,8 +16,11 @@ pub enum InertiaEstimateStatus {
     FromPrior = 2,
     /// The data do not determine J: no answer (see the reason).
     NotObservable = 3,
-    /// An answer with no observability test (the momentum baseline).
+    /// An answer with no observability test (the momentum baseline), or without a σ.
     Unchecked = 4,
+    /// An answer with its σ that a model check refutes (it is not a physical inertia
+    /// beyond 3σ; see the reason): shown, not promised.
+    ModelCheckFailed = 5,
 }
 
 /// Why an estimate is not `DETERMINED` (the library's `Unobservable`).
@@ -52,7 +55,8 @@ pub enum InertiaReason {
     Other = 12,
     /// The data contradict the Gaussian prior (`prior_chi2` above its threshold).
     PriorConflict = 13,
-    /// The momentum baseline's unconstrained J is not a physical inertia.
+    /// Not a physical inertia: the momentum baseline's unconstrained J (no answer), or a
+    /// constrained answer beyond 3σ of the physical set (`MODEL_CHECK_FAILED`).
     NotPhysical = 14,
 }
 
@@ -114,6 +118,7 @@ impl InertiaEstimator {
             Observability::Determined { .. } => InertiaEstimateStatus::Determined,
             Observability::FromPrior(_) => InertiaEstimateStatus::FromPrior,
             Observability::NotObservable(_) => InertiaEstimateStatus::NotObservable,
+            Observability::ModelCheckFailed(_) => InertiaEstimateStatus::ModelCheckFailed,
             _ => InertiaEstimateStatus::Unchecked,
         };
         out.reason = e.observability.reason().map_or(InertiaReason::None, reason);
@@ -152,7 +157,9 @@ fn reason(r: Unobservable) -> InertiaReason {
         Unobservable::DensityOverstated { .. } => InertiaReason::DensityOverstated,
         Unobservable::IllConditioned { .. } => InertiaReason::IllConditioned,
         Unobservable::PriorConflict { .. } => InertiaReason::PriorConflict,
-        Unobservable::NotPhysical { .. } => InertiaReason::NotPhysical,
+        Unobservable::NotPhysical { .. } | Unobservable::Unphysical { .. } => {
+            InertiaReason::NotPhysical
+        }
         _ => InertiaReason::Other,
     }
 }

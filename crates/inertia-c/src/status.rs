@@ -113,6 +113,9 @@ fn c_names(fix: Fix) -> Option<&'static str> {
         Fix::Memory => "memory_s",
         Fix::Resample => "resample_s",
         Fix::GyroNoise => "gyro_noise_deg_s_rthz",
+        Fix::GyroDegrees => "multiply w_rad_s by pi/180 before pushing (the rates are in deg/s)",
+        Fix::GyroRadians => "the rates are already rad/s: do not convert them",
+        Fix::Conjugate => "conjugate q before pushing (inertial to body)",
         _ => return None,
     })
 }

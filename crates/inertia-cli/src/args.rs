@@ -248,6 +248,11 @@ pub struct SimulateArgs {
     /// Output CSV file (the truth goes to the same name with `.truth.json`).
     #[arg(short = 'o', long, value_name = "FILE.csv")]
     pub output: PathBuf,
+    /// The paper's J as the truth, exactly (it breaks the triangle inequality J1 + J2 ≥
+    /// J3 by 4.9e-5 kg m²). By default the scenarios' truth is the paper's J + 1e-4 I,
+    /// the nearest physical inertia of that form.
+    #[arg(long, conflicts_with = "preset")]
+    pub paper_inertia: bool,
     /// Step change of the inertia: at T seconds J becomes SCALE·J (angular momentum
     /// conserved), e.g. `300:1.1`.
     #[arg(long, value_name = "T:SCALE", conflicts_with = "inertia_ramp")]
@@ -327,11 +332,18 @@ pub enum RhoModelArg {
 #[derive(Debug, Args)]
 pub struct InputArgs {
     /// The quaternion columns hold [w, x, y, z] (scalar first) instead of [x, y, z, w].
-    #[arg(long, conflicts_with = "jpl")]
+    #[arg(long, conflicts_with_all = ["jpl", "conjugate"])]
     pub scalar_first: bool,
     /// The quaternion follows the JPL/Shuster convention (inertial → body, scalar last).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "conjugate")]
     pub jpl: bool,
+    /// The quaternion is a Hamilton quaternion that maps inertial → body (the conjugate
+    /// of this tool's body → inertial), scalar last: conjugate it as it is read.
+    #[arg(long)]
+    pub conjugate: bool,
+    /// The unit of the gyro rate columns w_*: `rad/s` (default) or `deg/s`.
+    #[arg(long, value_name = "UNIT", value_parser = ["rad/s", "deg/s"], default_value = "rad/s")]
+    pub gyro_unit: String,
     /// The rho columns hold the rotor momentum with the opposite sign (e.g. the wheels'
     /// reaction on the body): negate them as they are read.
     #[arg(long)]

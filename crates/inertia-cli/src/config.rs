@@ -386,6 +386,8 @@ pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
             QuaternionFormat::HamiltonScalarFirst
         } else if a.jpl {
             QuaternionFormat::Jpl
+        } else if a.conjugate {
+            QuaternionFormat::Conjugate
         } else {
             QuaternionFormat::HamiltonScalarLast
         },
@@ -394,5 +396,10 @@ pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
         period_tolerance: a.period_tolerance,
         delimiter: b',',
         negate_rho: a.negate_rho,
+        gyro_unit: if a.gyro_unit == "deg/s" {
+            inertia::telemetry::csv::GyroUnit::DegPerS
+        } else {
+            inertia::telemetry::csv::GyroUnit::RadPerS
+        },
     })
 }

@@ -36,6 +36,9 @@ pub fn option_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroNoise => "--gyro-noise",
         Fix::PriorSigma => "--prior-sigma",
         Fix::Products => "--products",
+        Fix::GyroDegrees => "--gyro-unit deg/s",
+        Fix::GyroRadians => "--gyro-unit rad/s",
+        Fix::Conjugate => "--conjugate",
         _ => return None,
     })
 }

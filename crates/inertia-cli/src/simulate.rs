@@ -79,7 +79,8 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
             };
             (p.scenario, p.common)
         }
-        (None, Some(s)) => (scenario(s), Common::paper()),
+        (None, Some(s)) if a.paper_inertia => (scenario(s), Common::paper()),
+        (None, Some(s)) => (scenario(s), Common::physical()),
         (None, None) => return Err(input("one of --scenario and --preset is required")),
     };
     if let Some(d) = a.duration {

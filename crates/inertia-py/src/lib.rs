@@ -150,6 +150,8 @@ impl Telemetry {
         for name in [
             "scalar_first",
             "jpl",
+            "conjugate",
+            "gyro_unit",
             "negate_rho",
             "unit_tolerance",
             "period_tolerance",
@@ -282,6 +284,7 @@ fn read_csv(
         period_tolerance: conv.period_tolerance,
         delimiter: b',',
         negate_rho: conv.negate_rho,
+        gyro_unit: conv.gyro_unit,
     };
     py.allow_threads(|| read(&path, options))
         .map_err(|f| f.into_py(py))

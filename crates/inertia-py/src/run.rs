@@ -131,6 +131,9 @@ pub fn keyword_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroNoise => "gyro_noise",
         Fix::PriorSigma => "prior_sigma",
         Fix::Products => "products",
+        Fix::GyroDegrees => "gyro_unit=\"deg/s\"",
+        Fix::GyroRadians => "gyro_unit=\"rad/s\"",
+        Fix::Conjugate => "conjugate=True",
         _ => return None,
     })
 }

@@ -99,6 +99,7 @@ impl Checker {
                 unit_tolerance: c.unit_tolerance,
                 period_tolerance: c.period_tolerance,
                 negate_rho: c.negate_rho,
+                gyro_unit: c.gyro_unit,
             }),
         }
     }

@@ -6,7 +6,7 @@ use crate::errors::{type_error, value_error};
 use inertia::constraints::{ConstraintSet, ProductConvention};
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::pipeline::{InertialTorque, PipelineError, PipelineSettings, DEFAULT_MAX_CHAIN_S};
-use inertia::telemetry::csv::{QuaternionFormat, DEFAULT_UNIT_TOLERANCE};
+use inertia::telemetry::csv::{GyroUnit, QuaternionFormat, DEFAULT_UNIT_TOLERANCE};
 use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::Component;
 use inertia::text::Num;
@@ -18,7 +18,8 @@ use pyo3::types::{PyDict, PyString};
 pub const DEFAULT_ESTIMATOR: &str = "discrete-momentum";
 
 /// How the quaternion columns are to be read, and the reader's tolerances
-/// (`--scalar-first`, `--jpl`, `--unit-tolerance`, `--period-tolerance`).
+/// (`--scalar-first`, `--jpl`, `--conjugate`, `--gyro-unit`, `--unit-tolerance`,
+/// `--period-tolerance`).
 #[derive(Debug, Clone, Copy)]
 pub struct Convention {
     pub format: QuaternionFormat,
@@ -26,6 +27,8 @@ pub struct Convention {
     pub period_tolerance: Option<f64>,
     /// The rho columns hold the rotor momentum with the opposite sign: negate them.
     pub negate_rho: bool,
+    /// The unit of the gyro rates (`--gyro-unit`).
+    pub gyro_unit: GyroUnit,
 }
 
 impl Default for Convention {
@@ -35,6 +38,7 @@ impl Default for Convention {
             unit_tolerance: DEFAULT_UNIT_TOLERANCE,
             period_tolerance: None,
             negate_rho: false,
+            gyro_unit: GyroUnit::RadPerS,
         }
     }
 }
@@ -274,23 +278,37 @@ pub fn type_name(v: &Bound<'_, PyAny>) -> String {
         .map_or_else(|_| "an object".into(), |n| n.to_string())
 }
 
-/// `--scalar-first`, `--jpl`, `--unit-tolerance`, `--period-tolerance`.
+/// `--scalar-first`, `--jpl`, `--conjugate`, `--gyro-unit`, `--unit-tolerance`,
+/// `--period-tolerance`.
 pub fn convention(kw: &Kwargs<'_>) -> PyResult<Convention> {
     let scalar_first = kw.bool("scalar_first", false)?;
     let jpl = kw.bool("jpl", false)?;
-    if scalar_first && jpl {
+    let conjugate = kw.bool("conjugate", false)?;
+    if usize::from(scalar_first) + usize::from(jpl) + usize::from(conjugate) > 1 {
         return Err(value_error(
-            "scalar_first and jpl: choose one (jpl is scalar last, inertial → body)",
+            "scalar_first, jpl and conjugate: choose one (jpl and conjugate are scalar last; jpl has this library's numbers, conjugate maps inertial → body)",
         ));
     }
+    let gyro_unit = match kw.string("gyro_unit")?.as_deref() {
+        None | Some("rad/s") => GyroUnit::RadPerS,
+        Some("deg/s") => GyroUnit::DegPerS,
+        Some(other) => {
+            return Err(value_error(format!(
+                "gyro_unit={other:?}: expected \"rad/s\" or \"deg/s\""
+            )))
+        }
+    };
     let mut c = Convention {
         format: if scalar_first {
             QuaternionFormat::HamiltonScalarFirst
         } else if jpl {
             QuaternionFormat::Jpl
+        } else if conjugate {
+            QuaternionFormat::Conjugate
         } else {
             QuaternionFormat::HamiltonScalarLast
         },
+        gyro_unit,
         negate_rho: kw.bool("negate_rho", false)?,
         ..Convention::default()
     };

@@ -22,6 +22,12 @@ const MAX_INTEGRATION_STEPS: f64 = MAX_SAMPLES as f64 * 20.0;
 fn settings(kw: &Kwargs<'_>) -> PyResult<(Scenario, Common, &'static str)> {
     let scenario = kw.choice("scenario", &["slew", "spin"])?;
     let preset = kw.choice("preset", &["small-sat", "microsat"])?;
+    let paper_inertia = kw.bool("paper_inertia", false)?;
+    if paper_inertia && preset.is_some() {
+        return Err(value_error(
+            "paper_inertia: only for scenario (a preset has its own inertia)",
+        ));
+    }
     let (sc, mut common, name) = match (preset, scenario) {
         (Some(_), Some(_)) => return Err(value_error("scenario and preset: give one")),
         (Some(p), None) => {
@@ -31,7 +37,13 @@ fn settings(kw: &Kwargs<'_>) -> PyResult<(Scenario, Common, &'static str)> {
         (None, Some(s)) => {
             let sc = if s == "spin" { Scenario::spin() } else { Scenario::slew() };
             let name = sc.name();
-            (sc, Common::paper(), name)
+            // As `inertia simulate`: the physical truth unless the paper's J is asked for.
+            let common = if paper_inertia {
+                Common::paper()
+            } else {
+                Common::physical()
+            };
+            (sc, common, name)
         }
         (None, None) => return Err(value_error("scenario or preset: one is required (scenario=\"slew\", \"spin\"; preset=\"small-sat\", \"microsat\")")),
     };

@@ -246,3 +246,52 @@ def test_read_csv_stats_and_lines(tmp_path, slew):
     assert r2.file == r.file and list(r2.lines) == list(r.lines) and r2.stats == r.stats
     with pytest.raises(OSError, match="cannot read"):
         inertia.read_csv(tmp_path / "absent.csv")
+
+
+def test_conjugated_quaternions_and_gyro_degrees_are_named_and_read(slew):
+    tel, _ = slew
+    ref = inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=tel.w)
+    # Hamilton inertial → body quaternions: the error names the keyword that reads
+    # them (not jpl, which has this library's numbers), and with it the answer is the
+    # unconjugated data's, bit for bit.
+    conj = tel.q * [-1, -1, -1, 1]
+    with pytest.raises(inertia.DataError, match=r"conjugate=True") as err:
+        inertia.estimate(tel.t, conj, tel.rho, tau=tel.tau, w=tel.w)
+    assert "jpl" not in str(err.value)
+    got = inertia.estimate(tel.t, conj, tel.rho, tau=tel.tau, w=tel.w, conjugate=True)
+    np.testing.assert_array_equal(got.inertia, ref.inertia)
+    assert got.status == ref.status
+    # Gyro rates in deg/s: named, and read as deg/s they give the rad/s answer.
+    deg = tel.w * (180.0 / np.pi)
+    with pytest.raises(inertia.DataError, match=r'gyro_unit="deg/s"'):
+        inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=deg)
+    got = inertia.estimate(tel.t, tel.q, tel.rho, tau=tel.tau, w=deg, gyro_unit="deg/s")
+    np.testing.assert_allclose(got.inertia, ref.inertia, rtol=1e-9, atol=1e-12)
+    with pytest.raises(ValueError, match="choose one"):
+        inertia.estimate(tel.t, conj, tel.rho, jpl=True, conjugate=True)
+    with pytest.raises(ValueError, match="gyro_unit"):
+        inertia.estimate(tel.t, tel.q, tel.rho, w=deg, gyro_unit="rpm")
+
+
+def test_warnings_are_the_reports_and_never_contradict_the_status():
+    # The paper's J breaks J1 + J2 ≥ J3 by 4.9e-5 kg m²: beyond the discrete momentum
+    # estimator's 3σ (a model check failed: the answer and σ shown, not determined, said
+    # on the status line), within the variational estimator's (determined, with a
+    # warning that says so).
+    sim = inertia.simulate("slew", paper_inertia=True)
+    np.testing.assert_array_equal(
+        sim.inertia, inertia.simulate("slew", paper_inertia=True, seed=2).inertia
+    )
+    assert not np.array_equal(sim.inertia, inertia.simulate("slew").inertia)
+    dm = inertia.estimate(sim.telemetry, constraints="positive-definite")
+    assert dm.status == "model_check_failed"
+    assert dm.inertia is not None and dm.sigma is not None
+    assert dm.reason.startswith("not a physical inertia")
+    assert not any("J1 + J2" in w for w in dm.warnings)
+    v = inertia.estimate(sim.telemetry, estimator="variational", constraints="positive-definite")
+    assert v.status == "determined"
+    assert any("within 3 σ of a physical inertia" in w for w in v.warnings), v.warnings
+    for e in (dm, v):
+        assert e.warnings == [w["message"] for w in e.report["warnings"]]
+        lines = [l.strip()[len("warning: "):] for l in e.text.splitlines() if l.strip().startswith("warning: ")]
+        assert lines == e.warnings

@@ -366,7 +366,8 @@ def test_cli_estimates_the_total_inertia_from_converted_data(tmp_path):
 
 def test_cli_refuses_the_conjugated_reading(tmp_path):
     """The module docs' claim: reading σ_BN's quaternion as N -> B (conjugated) is caught by
-    the library's convention check, which names --jpl."""
+    the library's convention check, which names --conjugate (a JPL quaternion has this
+    tool's numbers, so --jpl would not read it)."""
     exe = inertia_bin()
     if exe is None:
         pytest.skip("no inertia binary (set INERTIA_BIN or cargo build --release -p inertia-cli)")
@@ -375,7 +376,8 @@ def test_cli_refuses_the_conjugated_reading(tmp_path):
     path = tmp_path / "conjugated.csv"
     bsk.to_csv(path, d)
     out = subprocess.run([str(exe), "estimate", str(path)], capture_output=True, text=True)
-    assert out.returncode == 2 and "--jpl" in out.stderr, out.stderr
+    assert out.returncode == 2 and "--conjugate" in out.stderr, out.stderr
+    assert "--jpl" not in out.stderr, out.stderr
 
 
 # --------------------------------------------------------- end to end, Basilisk itself

@@ -98,7 +98,7 @@ def test_bad_values_are_data_errors(tel, mutate, message):
         (dict(attitude_drift=6e-4), ValueError, "attitude_drift needs gyro_noise > 0"),
         (dict(attitude_drift=6e-4, gyro_noise=1e-5, uncertainty=False), ValueError, "attitude_drift needs uncertainty on"),
         (dict(attitude_drift=6e-4, gyro_noise=1e-5, batch=True), ValueError, "batch=True: setting `attitude_drift_deg_rth` does not apply to the discrete-momentum batch estimator"),
-        (dict(scalar_first=True, jpl=True), ValueError, "scalar_first and jpl: choose one"),
+        (dict(scalar_first=True, jpl=True), ValueError, "scalar_first, jpl and conjugate: choose one"),
         (dict(unit_tolerance=0.0), ValueError, "unit_tolerance=0: must be finite and > 0"),
         (dict(batch=True, memory=30.0), ValueError, "batch=True: setting `memory_s` does not apply to the batch estimator"),
         (dict(truth=np.eye(2)), ValueError, "truth: expected a 3×3 matrix"),

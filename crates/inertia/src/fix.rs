@@ -43,6 +43,12 @@ pub enum Fix {
     PriorSigma,
     /// The sign convention of the prior's products of inertia.
     Products,
+    /// Read the gyro rates as deg/s (they are 180/π times the attitude's rates).
+    GyroDegrees,
+    /// Read the gyro rates as rad/s (they are π/180 times the attitude's rates).
+    GyroRadians,
+    /// Read the quaternions conjugated: Hamilton, inertial → body.
+    Conjugate,
 }
 
 impl Fix {
@@ -61,6 +67,9 @@ impl Fix {
             Fix::GyroNoise => "gyro_noise_deg_s_rthz",
             Fix::PriorSigma => "prior sigma",
             Fix::Products => "products of inertia convention",
+            Fix::GyroDegrees => "gyro_unit = deg/s",
+            Fix::GyroRadians => "gyro_unit = rad/s",
+            Fix::Conjugate => "format = conjugate",
         }
     }
 }

@@ -8,8 +8,10 @@ the command line's. This module only converts arguments and results.
 Units are SI throughout: time s, angles rad, rates rad/s, rotor momentum N m s, torque
 N m, inertia kg m². Vectors are in body axes. Quaternions are ``[x, y, z, w]``, scalar
 last, Hamilton, body → inertial, unless ``scalar_first=True`` (columns hold
-``[w, x, y, z]``) or ``jpl=True`` (JPL/Shuster: inertial → body, scalar last) says
-otherwise, as the command line's ``--scalar-first`` and ``--jpl``.
+``[w, x, y, z]``), ``jpl=True`` (JPL/Shuster: inertial → body, scalar last) or
+``conjugate=True`` (Hamilton, inertial → body, scalar last) says otherwise, as the
+command line's ``--scalar-first``, ``--jpl`` and ``--conjugate``; gyro rates are rad/s
+unless ``gyro_unit="deg/s"`` (``--gyro-unit``).
 
 Quick start::
 
@@ -104,8 +106,9 @@ class Estimate:
         sigma: one standard deviation of each element of ``j``, kg m² (noise and
             discretisation bias), or ``None`` for estimators without an uncertainty
             model.
-        status: ``"determined"``, ``"from_prior"``, ``"not_observable"`` or
-            ``"unchecked"``.
+        status: ``"determined"``, ``"from_prior"``, ``"not_observable"``,
+            ``"unchecked"`` (no observability test, or no σ) or ``"model_check_failed"``
+            (an answer with its σ that breaks J1 > 0 or J1 + J2 ≥ J3 beyond 3σ).
         reason: why the data fall short, when they do (else ``None``).
         condition: σ₁/σ₆ of the information factor R when determined.
         principal_moments: ascending, kg m² (3,).
@@ -118,6 +121,8 @@ class Estimate:
         torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,);
             ``None`` where it is not estimated or the data gave no evidence of one and it
             was held at zero (``report["torque_test"]``: ``chi2``, ``held_at_zero``).
+        warnings: every ``warning:`` line of the text report (the JSON's ``warnings``
+            messages), none of which contradicts ``status``.
         report: the whole report as a dict (the ``inertia estimate --json`` schema).
         text: the readable report (``inertia estimate`` without ``--json``).
 
@@ -139,6 +144,7 @@ class Estimate:
     estimator: str
     relative_error: Optional[float]
     torque_bias_nm: Optional[np.ndarray]
+    warnings: List[str]
     report: Dict[str, Any] = dataclasses.field(repr=False)
     text: str = dataclasses.field(repr=False)
     history_columns: Optional[Dict[str, Any]] = dataclasses.field(default=None, repr=False)
@@ -162,6 +168,7 @@ class Estimate:
             estimator=r["estimator"],
             relative_error=r["relative_error"],
             torque_bias_nm=_array(r["torque_bias_nm"]),
+            warnings=[w["message"] for w in r["warnings"]],
             report=r,
             text=text,
             history_columns=history,
@@ -221,6 +228,8 @@ class Telemetry:
         *,
         scalar_first: bool = False,
         jpl: bool = False,
+        conjugate: bool = False,
+        gyro_unit: Optional[str] = None,
         negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
@@ -233,6 +242,8 @@ class Telemetry:
                 kwargs=dict(
                     scalar_first=scalar_first,
                     jpl=jpl,
+                    conjugate=conjugate,
+                    gyro_unit=gyro_unit,
                     negate_rho=negate_rho,
                     unit_tolerance=unit_tolerance,
                     period_tolerance=period_tolerance,
@@ -289,6 +300,8 @@ def read_csv(
     *,
     scalar_first: bool = False,
     jpl: bool = False,
+    conjugate: bool = False,
+    gyro_unit: Optional[str] = None,
     negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
@@ -303,7 +316,12 @@ def read_csv(
     Args:
         path: the file.
         scalar_first: the quaternion columns hold ``[w, x, y, z]`` (``--scalar-first``).
-        jpl: JPL/Shuster quaternions, inertial → body (``--jpl``).
+        jpl: JPL/Shuster quaternions, inertial → body (``--jpl``; the same numbers as
+            this library's Hamilton body → inertial ones).
+        conjugate: Hamilton quaternions mapping inertial → body, scalar last: read
+            conjugated (``--conjugate``).
+        gyro_unit: the unit of the ``w_*`` columns, ``"rad/s"`` (default, ``None``) or
+            ``"deg/s"`` (``--gyro-unit``).
         negate_rho: the rho columns hold the rotor momentum with the opposite sign
             (e.g. the wheels' reaction on the body): negate them (``--negate-rho``).
         columns: renamed columns, ``{"t": "time", "rho_x": "hw_x"}`` (``--column``).
@@ -321,6 +339,8 @@ def read_csv(
             kwargs=dict(
                 scalar_first=scalar_first,
                 jpl=jpl,
+                conjugate=conjugate,
+                gyro_unit=gyro_unit,
                 negate_rho=negate_rho,
                 columns=None if columns is None else dict(columns),
                 unit_tolerance=unit_tolerance,
@@ -403,7 +423,10 @@ _SETTINGS = (
     "solver", "uncertainty",
 )
 #: How the data are read.
-_CONVENTIONS = ("scalar_first", "jpl", "negate_rho", "unit_tolerance", "period_tolerance")
+_CONVENTIONS = (
+    "scalar_first", "jpl", "conjugate", "gyro_unit", "negate_rho", "unit_tolerance",
+    "period_tolerance",
+)
 
 
 def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
@@ -452,6 +475,8 @@ def estimate(
     truth: Any = None,
     scalar_first: bool = False,
     jpl: bool = False,
+    conjugate: bool = False,
+    gyro_unit: Optional[str] = None,
     negate_rho: bool = False,
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
@@ -510,7 +535,8 @@ def estimate(
         truth: the true J (3×3, kg m²), for ``Estimate.relative_error``.
 
     Input conventions (arrays, DataFrame, path): ``scalar_first``, ``jpl``,
-    ``negate_rho``, ``unit_tolerance``, ``period_tolerance``; ``columns`` for a DataFrame or a path.
+    ``conjugate``, ``gyro_unit``, ``negate_rho``, ``unit_tolerance``,
+    ``period_tolerance``; ``columns`` for a DataFrame or a path.
 
     The GIL is released while the data are checked and the estimator runs.
 
@@ -568,7 +594,8 @@ class Estimator:
     """A streaming estimator: push samples one at a time (or in blocks).
 
     Takes the settings of :func:`estimate` (not ``batch``, ``history``, ``truth``) and
-    the input conventions (``scalar_first``, ``jpl``, ``negate_rho``, ``unit_tolerance``,
+    the input conventions (``scalar_first``, ``jpl``, ``conjugate``, ``gyro_unit``,
+    ``negate_rho``, ``unit_tolerance``,
     ``period_tolerance``). Each sample is checked as a file's row is. Pushing the
     samples of a file one by one gives the same estimate as :func:`estimate` on it.
     The GIL is released while a sample is processed.
@@ -601,6 +628,8 @@ class Estimator:
         uncertainty: bool = True,
         scalar_first: bool = False,
         jpl: bool = False,
+        conjugate: bool = False,
+        gyro_unit: Optional[str] = None,
         negate_rho: bool = False,
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
@@ -681,7 +710,9 @@ def simulate(scenario: Optional[str] = None, **options: Any) -> Simulation:
     ``wheel_scale_error``, ``wheel_misalignment_deg`` (deg),
     ``gravity_gradient_altitude_km``, ``orbit_inclination_deg``,
     ``constant_torque_nm`` (N m), ``inertia_step`` ``(T, SCALE)``, ``inertia_ramp``
-    ``(T0, T1, SCALE)``.
+    ``(T0, T1, SCALE)``, ``paper_inertia`` (the paper's J exactly, which breaks
+    J1 + J2 ≥ J3 by 4.9e-5 kg m²; by default the scenarios' truth is the paper's J +
+    1e-4 I).
 
     The same settings and seed give the same samples as the CLI's file, bit for bit.
     """

@@ -36,6 +36,7 @@ class Estimate:
     estimator: str
     relative_error: Optional[float]
     torque_bias_nm: Optional[np.ndarray]  # (3,) N m
+    warnings: List[str]
     report: Dict[str, Any]
     text: str
     history_columns: Optional[Dict[str, Any]]
@@ -57,6 +58,8 @@ class Telemetry:
         *,
         scalar_first: bool = ...,
         jpl: bool = ...,
+        conjugate: bool = ...,
+        gyro_unit: Optional[str] = ...,
         negate_rho: bool = ...,
         unit_tolerance: Optional[float] = ...,
         period_tolerance: Optional[float] = ...,
@@ -85,6 +88,8 @@ def read_csv(
     *,
     scalar_first: bool = ...,
     jpl: bool = ...,
+    conjugate: bool = ...,
+    gyro_unit: Optional[str] = ...,
     negate_rho: bool = ...,
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
@@ -125,6 +130,8 @@ def estimate(
     truth: Optional[ArrayLike] = ...,
     scalar_first: bool = ...,
     jpl: bool = ...,
+    conjugate: bool = ...,
+    gyro_unit: Optional[str] = ...,
     negate_rho: bool = ...,
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
@@ -159,6 +166,8 @@ class Estimator:
         uncertainty: bool = ...,
         scalar_first: bool = ...,
         jpl: bool = ...,
+        conjugate: bool = ...,
+        gyro_unit: Optional[str] = ...,
         negate_rho: bool = ...,
         unit_tolerance: Optional[float] = ...,
         period_tolerance: Optional[float] = ...,

@@ -50,7 +50,7 @@ quaternion of the active rotation ``R(e, Φ)`` is ``[e sin(Φ/2), cos(Φ/2)]``, 
     q = [2σ / (1 + σ²),  (1 − σ²) / (1 + σ²)]          (x, y, z, w)
 
 Conjugating it (as "σ_BN maps N→B" might suggest) is wrong: the library would see every
-rotation reversed and stop with its convention check (``--jpl``). The tests check the
+rotation reversed and stop with its convention check (``--conjugate``). The tests check the
 formula against ``MRP2C`` (``R(q) = [BN]ᵀ``), against the MRP kinematics
 ``σ̇ = ¼[(1 − σ²)I + 2[σ×] + 2σσᵀ]ω`` (``2 vec(q_k† q_{k+1})/h`` ≈ the body rate), and against
 inertial momentum conservation.

@@ -133,6 +133,8 @@ def estimate_files(
     errors: str = "record",
     scalar_first: bool = False,
     jpl: bool = False,
+    conjugate: bool = False,
+    gyro_unit: Optional[str] = None,
     columns: Optional[Dict[str, str]] = None,
     unit_tolerance: Optional[float] = None,
     period_tolerance: Optional[float] = None,
@@ -147,7 +149,8 @@ def estimate_files(
         errors: ``"record"`` (default): a file that cannot be read or estimated gives a
             row with the message (the CLI's ``FILE:LINE: …``) in ``error``; ``"raise"``:
             the first such error is raised.
-        scalar_first, jpl, columns, unit_tolerance, period_tolerance: how to read the
+        scalar_first, jpl, conjugate, gyro_unit, columns, unit_tolerance,
+        period_tolerance: how to read the
             files (:func:`inertia.read_csv`).
         **settings: estimation settings (:func:`inertia.estimate`; not ``history``).
 
@@ -164,6 +167,8 @@ def estimate_files(
     read = dict(
         scalar_first=scalar_first,
         jpl=jpl,
+        conjugate=conjugate,
+        gyro_unit=gyro_unit,
         columns=columns,
         unit_tolerance=unit_tolerance,
         period_tolerance=period_tolerance,

@@ -431,6 +431,17 @@ impl ConstraintSet {
             .any(Option::is_some)
     }
 
+    /// `true` when a bound keeps J away from zero along its scale: a lower bound above zero
+    /// or an upper bound below it. Without rotor momentum or known torque (`y ≡ 0`) the
+    /// data fix J only up to scale, and the estimators pull it toward the smallest
+    /// feasible scale: only such a bound (or a Gaussian prior) gives it one. Equalities at
+    /// zero (`--diagonal`) do not.
+    #[must_use]
+    pub fn has_scale_bound(&self) -> bool {
+        self.lower_kg_m2.iter().flatten().any(|&l| l > 0.0)
+            || self.upper_kg_m2.iter().flatten().any(|&u| u < 0.0)
+    }
+
     /// Check the set and find a strictly interior point.
     pub fn validate(&self) -> Result<Constraints, ConstraintError> {
         let eps = self.epsilon_kg_m2;

@@ -141,6 +141,20 @@ pub enum Unobservable {
         /// Smallest eigenvalue of `½ tr(J) I − J` (the second-moment matrix), kg m².
         min_second_moment_kg_m2: f64,
     },
+    /// A constrained answer breaks `J1 > 0` or `J1 + J2 ≥ J3` (principal moments
+    /// `J1 ≤ J2 ≤ J3`) by more than [`crate::pipeline::status::PHYSICAL_Z`] of its stated
+    /// σ: a real body's J is physical, so a model check failed
+    /// ([`Observability::ModelCheckFailed`]; the answer and its σ stay visible).
+    Unphysical {
+        /// Smallest principal moment `J1`, kg m².
+        min_moment_kg_m2: f64,
+        /// `J1 + J2 − J3`, kg m² (negative: the triangle inequality is broken).
+        triangle_kg_m2: f64,
+        /// σ of `J1 + J2 − J3` (the principal moments' σ taken as independent), kg m².
+        triangle_sigma_kg_m2: f64,
+        /// The larger of the two violations in units of its σ.
+        z: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -256,6 +270,15 @@ impl core::fmt::Display for Unobservable {
                 crate::text::Num(*min_moment_kg_m2),
                 crate::text::Num(*min_second_moment_kg_m2)
             ),
+            Unobservable::Unphysical {
+                min_moment_kg_m2,
+                triangle_kg_m2,
+                triangle_sigma_kg_m2,
+                z,
+            } => write!(
+                f,
+                "not a physical inertia (J1 + J2 − J3 = {triangle_kg_m2:.2e} ± {triangle_sigma_kg_m2:.1e} kg m², J1 = {min_moment_kg_m2:.4e} kg m²; {z:.1} σ outside J1 > 0, J1 + J2 ≥ J3): a real body's J is physical, so the row model or the data's conventions do not hold here; the answer and its σ are shown, not promised (the physical constraint set keeps the answer physical)"
+            ),
             Unobservable::IllConditioned {
                 condition,
                 threshold,
@@ -287,6 +310,19 @@ pub enum Observability {
     /// The estimator makes no observability test (the momentum RLS baseline): an answer,
     /// with no claim about how well the data determine it.
     Unchecked,
+    /// The rows pass the rank and conditioning tests, but the answer has no standard
+    /// deviation (an estimator or batch form without an uncertainty model, or σ switched
+    /// off): without a σ there is no promise to keep, so it is not
+    /// [`Observability::Determined`] (code `unchecked`; [`crate::pipeline::status`]).
+    NoSigma {
+        /// `σ_1/σ_6` of `R`.
+        condition: f64,
+    },
+    /// An answer with its σ that a model check refutes (the reason, e.g.
+    /// [`Unobservable::Unphysical`]): it is reported with its σ, but not determined,
+    /// since the promise rests on a model the data contradict (code
+    /// `model_check_failed`; [`crate::pipeline::status`]).
+    ModelCheckFailed(Unobservable),
 }
 
 impl Observability {
@@ -296,14 +332,16 @@ impl Observability {
         !matches!(self, Observability::NotObservable(_))
     }
 
-    /// Short code for files: `determined`, `from_prior`, `not_observable`, `unchecked`.
+    /// Short code for files: `determined`, `from_prior`, `not_observable`, `unchecked`,
+    /// `model_check_failed`.
     #[must_use]
     pub fn code(&self) -> &'static str {
         match self {
             Observability::Determined { .. } => "determined",
             Observability::FromPrior(_) => "from_prior",
             Observability::NotObservable(_) => "not_observable",
-            Observability::Unchecked => "unchecked",
+            Observability::Unchecked | Observability::NoSigma { .. } => "unchecked",
+            Observability::ModelCheckFailed(_) => "model_check_failed",
         }
     }
 
@@ -311,7 +349,9 @@ impl Observability {
     #[must_use]
     pub fn reason(&self) -> Option<Unobservable> {
         match self {
-            Observability::FromPrior(r) | Observability::NotObservable(r) => Some(*r),
+            Observability::FromPrior(r)
+            | Observability::NotObservable(r)
+            | Observability::ModelCheckFailed(r) => Some(*r),
             _ => None,
         }
     }
@@ -320,7 +360,9 @@ impl Observability {
     #[must_use]
     pub fn condition(&self) -> Option<f64> {
         match self {
-            Observability::Determined { condition } => Some(*condition),
+            Observability::Determined { condition } | Observability::NoSigma { condition } => {
+                Some(*condition)
+            }
             _ => None,
         }
     }
@@ -348,6 +390,11 @@ impl core::fmt::Display for Observability {
             Observability::Unchecked => {
                 f.write_str("recursive least squares (no observability test, unconstrained)")
             }
+            Observability::NoSigma { condition } => write!(
+                f,
+                "unchecked: an answer without a standard deviation (this estimator states none here), so nothing says how close it is; the rows pass the rank and conditioning tests (condition number {condition:.3e})"
+            ),
+            Observability::ModelCheckFailed(r) => write!(f, "model check failed: {r}"),
         }
     }
 }

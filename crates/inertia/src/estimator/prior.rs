@@ -28,9 +28,12 @@
 //! ‖μ‖²/(rows − 5)`, the misfit of that direction at the prior's size, and the scale
 //! is the prior's alone (the data's information along it is removed).
 //!
-//! With noise-free data (`ρ² = 0`) `s` is floored at [`SCALE_FLOOR`]` · c · min σ_k` (`c`
-//! the root-mean-square column norm of `R`), so that the prior still fixes the directions
-//! the data leave open, with its own σ there, in a problem the solvers resolve.
+//! With noise-free data (`ρ² = 0`), or data that leave a direction open (`σ_6(R)` below
+//! [`SCALE_FLOOR`]` · c`), `s` is floored at [`SCALE_FLOOR`]` · c · min σ_k` (`c` the
+//! root-mean-square column norm of `R`), so that the prior still fixes the directions the
+//! data leave open, with its own σ there, in a problem the solvers resolve. Data that
+//! determine every direction keep their own `s`: a prior never makes σ larger than the
+//! data's alone.
 
 use super::qr::RecursiveQr;
 use crate::constraints::Constraints;
@@ -177,10 +180,20 @@ pub fn augment(qr: &RecursiveQr, constraints: &Constraints) -> (RecursiveQr, Opt
             out.r = projected.qr().r();
         }
     }
-    let s = if dof > 0.0 {
-        crate::math::sqrt((out.rss / dof).max(scale_free)).max(floor)
+    // The floor is for data that leave a direction open (ill-conditioned `R`) and fit
+    // (nearly) exactly: there the prior's rows must keep a weight the solvers resolve.
+    // Data that determine every direction need no floor, and one would make the data's
+    // residual scale, and so σ, grow with the prior's σ (issue 30).
+    let open = out.r.singular_values().min() < SCALE_FLOOR * scale;
+    let own = if dof > 0.0 {
+        crate::math::sqrt((out.rss / dof).max(scale_free))
     } else {
-        floor
+        0.0
+    };
+    let s = if open || !(own > 0.0) {
+        own.max(floor)
+    } else {
+        own
     };
     if dof > 0.0 {
         // Noise-free data: the floor stands for s in every formula downstream.

@@ -306,6 +306,17 @@ pub(crate) fn with_prior(
     constraints: &Constraints,
     settings: &ObservabilitySettings,
 ) -> Observability {
+    // Without excitation only a bound away from zero or a prior gives J its scale
+    // (equalities at zero do not: the answer would be the floor's).
+    let set = constraints.set();
+    let observability = match observability {
+        Observability::FromPrior(r @ super::observability::Unobservable::NoExcitation)
+            if set.prior.is_none() && !set.has_scale_bound() =>
+        {
+            Observability::NotObservable(r)
+        }
+        o => o,
+    };
     // Equalities the data contradict: the answer leans on them (as on a bound).
     if let (Observability::Determined { .. }, Some(chi2)) = (
         observability,

@@ -9,7 +9,7 @@ use super::PipelineError;
 use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::Estimate;
 use crate::sample::Sample;
-use crate::telemetry::convention::{ConventionCheck, Verdict, STEPS_NEEDED};
+use crate::telemetry::convention::{ConventionCheck, Verdict};
 use crate::telemetry::glitch::{GlitchCheck, GlitchPolicy};
 
 /// The glitch and convention checks of one stream.
@@ -24,7 +24,7 @@ pub struct AttitudeChecks {
 impl AttitudeChecks {
     /// Check input sample `index`: a glitch stops the run under [`GlitchPolicy::Stop`]
     /// (it is counted either way), and a wrong convention stops it once the first
-    /// [`STEPS_NEEDED`] steps show it.
+    /// [`crate::telemetry::convention::STEPS_NEEDED`] steps show it.
     pub fn push(
         &mut self,
         index: usize,
@@ -39,7 +39,7 @@ impl AttitudeChecks {
                 });
             }
         }
-        if self.convention.steps() < STEPS_NEEDED {
+        if !self.convention.decided() {
             self.convention.push(s);
             convention_error(&self.convention)?;
         }
@@ -126,8 +126,8 @@ impl core::fmt::Display for ReversedMessage<'_> {
         }
         match self.quaternions {
             Verdict::Consistent(_) => Ok(()),
-            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (read them as JPL): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
-            _ => f.write_str(", or the quaternions are conjugated (read them as JPL): the attitude disagrees with the gyro rates too"),
+            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (read them conjugated): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
+            _ => f.write_str(", or the quaternions are conjugated (read them conjugated): the attitude disagrees with the gyro rates too"),
         }
     }
 }

@@ -50,6 +50,7 @@ pub mod registry;
 mod run;
 mod sdp;
 mod settings;
+pub mod status;
 
 #[cfg(feature = "csv")]
 pub mod history;
@@ -224,7 +225,7 @@ impl PipelineError {
             PipelineError::AttitudeConvention { fixes, .. } => fixes,
             PipelineError::ReversedMomentum { quaternions, .. } => match quaternions {
                 Verdict::Consistent(_) => &[Fix::NegateRho],
-                _ => &[Fix::NegateRho, Fix::Jpl],
+                _ => &[Fix::NegateRho, Fix::Conjugate],
             },
             PipelineError::AttitudeGlitch { .. } => &[Fix::KeepGlitches],
             PipelineError::ResampleTooFine { .. } => &[Fix::Resample],
@@ -383,6 +384,7 @@ impl Pipeline {
         ));
         self.checks.push(index, s, self.config.glitches)?;
         self.input_samples += 1;
+        let consistency = self.config.constraints().set().consistency;
         let Self {
             resampler,
             estimator,
@@ -399,7 +401,8 @@ impl Pipeline {
                     sample: Some(index),
                     source,
                 })?;
-            if let Some(e) = e {
+            if let Some(mut e) = e {
+                status::settle(&mut e, consistency);
                 checks.estimate(index, &e)?;
                 *last = Some(e);
                 on_estimate(&e);
@@ -541,7 +544,8 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         }
     }
     checks::convention_error(&check)?;
-    let out = run(samples, config)?;
+    let mut out = run(samples, config)?;
+    status::settle(&mut out.estimate, config.constraints().set().consistency);
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
 }

@@ -17,8 +17,9 @@
 //! [`Observability::code`]: crate::estimator::observability::Observability::code
 
 use super::settings::PipelineConfig;
+use super::status::{PhysicalMargin, PHYSICAL_Z};
 use crate::constraints::ActiveBound;
-use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO};
+use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO, SHIFT_Z};
 use crate::estimator::discrete_momentum::TORQUE_CHI2;
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
@@ -26,6 +27,7 @@ use crate::estimator::observability::Observability;
 use crate::estimator::Estimate;
 use crate::fix::{Fix, FixNames, Fixes};
 use crate::solver::SolveStatus;
+use crate::telemetry::convention::Verdict;
 use crate::telemetry::glitch::{Glitch, GlitchCheck};
 use crate::tensor::{principal, relative_frobenius_error, COMPONENT_NAMES};
 use crate::text::{Counted, Num};
@@ -142,8 +144,96 @@ pub struct Report {
     /// is the gyro); `null` until the test has decided (3000 row blocks) or without both
     /// sources.
     pub attitude_is_gyro_integral: Option<bool>,
+    /// Every warning the text report prints, in its order: `kind` and `message`
+    /// ([`Warning`]). None contradicts the status ([`super::status`]).
+    pub warnings: std::vec::Vec<WarningEntry>,
     #[serde(skip)]
     observability: Observability,
+    #[serde(skip)]
+    physical: Option<PhysicalMargin>,
+    #[serde(skip)]
+    attitude: Option<Verdict>,
+}
+
+/// One warning of a report.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Warning {
+    /// The answer breaks `J1 > 0` or `J1 + J2 ≥ J3` ([`super::status`]): by less than
+    /// [`PHYSICAL_Z`] σ when the answer is determined, otherwise it makes no claim.
+    NotPhysical(PhysicalMargin),
+    /// A span's residuals exceed [`INCONSISTENT_RATIO`] times the rest's, but the answer
+    /// did not move by [`SHIFT_Z`] σ with or without it, so it is kept.
+    SpanStandsOut(Worst, bool),
+    /// The attitude and the gyro rates disagree and no reading of the quaternions fits
+    /// (median relative mismatch of the body rates).
+    AttitudeGyroDisagree(f64),
+    /// What the excitation report advises.
+    Excitation(String),
+}
+
+/// A [`Warning`] as the JSON report carries it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct WarningEntry {
+    /// `not_physical`, `span_stands_out`, `attitude_gyro_disagree` or `excitation`.
+    pub kind: &'static str,
+    /// The text report's line.
+    pub message: String,
+}
+
+impl Warning {
+    /// Its JSON `kind`.
+    #[must_use]
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Warning::NotPhysical(_) => "not_physical",
+            Warning::SpanStandsOut(..) => "span_stands_out",
+            Warning::AttitudeGyroDisagree(_) => "attitude_gyro_disagree",
+            Warning::Excitation(_) => "excitation",
+        }
+    }
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Warning::NotPhysical(p) => {
+                write!(
+                    f,
+                    "the answer breaks J1 > 0 or J1 + J2 ≥ J3 (J1 = {}, J1 + J2 − J3 = {} kg m²)",
+                    Num(p.min_moment_kg_m2),
+                    Num(p.triangle_kg_m2)
+                )?;
+                match p.z {
+                    Some(z) if z <= PHYSICAL_Z => write!(
+                        f,
+                        ", by {z:.1} σ: within {PHYSICAL_Z} σ of a physical inertia, so consistent with one at this accuracy"
+                    ),
+                    _ => f.write_str(
+                        ": not a physical inertia, and with no σ nothing says the data support it",
+                    ),
+                }
+            }
+            Warning::SpanStandsOut(w, with_sigma) => {
+                write!(
+                    f,
+                    "the residuals between t = {:.1} s and {:.1} s are {} the rest's variance, beyond {INCONSISTENT_RATIO}",
+                    w.t_start_s,
+                    w.t_end_s,
+                    crate::text::Times(w.ratio)
+                )?;
+                if *with_sigma {
+                    write!(f, ", but the answer moves by less than {SHIFT_Z} σ with or without that span: kept (honest residuals of unequal size)")
+                } else {
+                    f.write_str(": without a σ nothing tells whether that span moved the answer")
+                }
+            }
+            Warning::AttitudeGyroDisagree(m) => write!(
+                f,
+                "the attitude and the gyro rates disagree (median relative mismatch of the body rates {m:.2}) and no reading of the quaternions or the rates fits: different frames, time tags or units"
+            ),
+            Warning::Excitation(a) => f.write_str(a),
+        }
+    }
 }
 
 fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
@@ -209,8 +299,64 @@ impl Report {
             gyro_density_ratio: None,
             drift_weighted: None,
             attitude_is_gyro_integral: None,
+            warnings: std::vec::Vec::new(),
             observability: estimate.observability,
+            physical: super::status::physical_margin(estimate),
+            attitude: None,
         }
+        .refreshed()
+    }
+
+    /// The warnings, in the text report's order.
+    #[must_use]
+    pub fn warning_list(&self) -> std::vec::Vec<Warning> {
+        let mut w = std::vec::Vec::new();
+        // A failed physicality check is the status line itself: not said twice.
+        if let Some(p) = self
+            .physical
+            .filter(|_| !matches!(self.observability, Observability::ModelCheckFailed(_)))
+        {
+            w.push(Warning::NotPhysical(p));
+        }
+        if let Some(v) = self.attitude_disagreement() {
+            w.push(Warning::AttitudeGyroDisagree(v));
+        }
+        if let Some(x) = self
+            .residual_consistency
+            .filter(|x| x.ratio > INCONSISTENT_RATIO && self.observability.has_answer())
+        {
+            w.push(Warning::SpanStandsOut(x, self.sigma.is_some()));
+        }
+        if let Some(x) = &self.excitation {
+            w.extend(x.advice.iter().cloned().map(Warning::Excitation));
+        }
+        w
+    }
+
+    fn attitude_disagreement(&self) -> Option<f64> {
+        match self.attitude {
+            Some(Verdict::Disagree(m)) => Some(m),
+            _ => None,
+        }
+    }
+
+    fn refreshed(mut self) -> Self {
+        self.warnings = self
+            .warning_list()
+            .iter()
+            .map(|w| WarningEntry {
+                kind: w.kind(),
+                message: w.to_string(),
+            })
+            .collect();
+        self
+    }
+
+    /// With the verdict of the attitude-against-gyro convention check.
+    #[must_use]
+    pub fn with_attitude_check(mut self, verdict: Verdict) -> Self {
+        self.attitude = Some(verdict);
+        self.refreshed()
     }
 
     /// The report of a streaming pipeline's latest estimate (`None` before one): the
@@ -227,7 +373,8 @@ impl Report {
                 .with_drift_weighted(p.drift_weighted())
                 .with_attitude_is_gyro_integral(p.attitude_is_gyro_integral())
                 .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
-                .with_glitches(Some(p.glitches())),
+                .with_glitches(Some(p.glitches()))
+                .with_attitude_check(p.attitude_check()),
         )
     }
 
@@ -253,7 +400,7 @@ impl Report {
     #[must_use]
     pub fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
         self.excitation = excitation;
-        self
+        self.refreshed()
     }
 
     /// With the row model and the estimated disturbance torque (N m), where the estimator
@@ -299,7 +446,7 @@ impl Report {
     pub fn with_residual_tests(mut self, worst: Option<Worst>, density_ratio: Option<f64>) -> Self {
         self.residual_consistency = worst;
         self.gyro_density_ratio = density_ratio;
-        self
+        self.refreshed()
     }
 
     /// With the glitches kept, if any.
@@ -425,13 +572,6 @@ impl fmt::Display for ReportText<'_> {
                     pm[0], pm[1], pm[2]
                 )?,
             }
-            // Ascending: the triangle inequality J1 + J2 >= J3 and positivity.
-            if pm[0] <= 0.0 || pm[0] + pm[1] < pm[2] * (1.0 - 1e-6) {
-                writeln!(
-                    s,
-                    "warning: not a physical inertia (a principal moment is not positive, or J1 + J2 < J3): the data do not support this answer"
-                )?;
-            }
         }
         if let Some(ax) = r.principal_axes {
             writeln!(s, "principal axes (columns, body axes):")?;
@@ -514,11 +654,19 @@ impl fmt::Display for ReportText<'_> {
             writeln!(s, "relative Frobenius error vs truth: {e:.3e}")?;
         }
         if let Some(w) = r.residual_consistency {
-            writeln!(
-                s,
-                "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
-                w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
-            )?;
+            if w.ratio > INCONSISTENT_RATIO {
+                writeln!(
+                    s,
+                    "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (beyond {INCONSISTENT_RATIO}; inconsistent only if the answer moves by {SHIFT_Z} σ without it)",
+                    w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
+                )?;
+            } else {
+                writeln!(
+                    s,
+                    "residuals: the most distinct span, t = {:.1}–{:.1} s, has {} the rest's variance (inconsistent beyond {INCONSISTENT_RATIO})",
+                    w.t_start_s, w.t_end_s, crate::text::Times(w.ratio)
+                )?;
+            }
         }
         if let Some(r) = r.gyro_density_ratio {
             writeln!(
@@ -541,6 +689,11 @@ impl fmt::Display for ReportText<'_> {
             }
             for a in &x.advice {
                 writeln!(s, "  warning: {a}")?;
+            }
+        }
+        for w in r.warning_list() {
+            if !matches!(w, Warning::Excitation(_)) {
+                writeln!(s, "warning: {w}")?;
             }
         }
         Ok(())

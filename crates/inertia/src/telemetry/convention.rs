@@ -19,6 +19,9 @@ use nalgebra::Vector3;
 pub const STEPS_NEEDED: usize = 64;
 /// Smallest gyro rate counted, rad/s (a step slower than this says little about frames).
 pub const MIN_RATE_RAD_S: f64 = 2e-3;
+/// Smallest `|cos|` of the angle between the gyro's rate and the attitude's for a step to
+/// count in the gyro-unit check (a random direction passes with probability 5 %).
+pub const SCALE_MIN_COS: f64 = 0.9;
 /// A reading fits when its median relative mismatch is below this.
 pub const FIT: f64 = 0.25;
 
@@ -40,6 +43,12 @@ pub enum Reading {
     ScalarLastConjugated,
     /// The gyro rates have the opposite sign.
     GyroNegated,
+    /// The gyro rates are 180/π times the attitude's: deg/s read as rad/s
+    /// ([`Fix::GyroDegrees`]).
+    GyroDegrees,
+    /// The gyro rates are π/180 times the attitude's: rad/s read as deg/s
+    /// ([`Fix::GyroRadians`]).
+    GyroRadians,
 }
 
 impl Reading {
@@ -59,7 +68,7 @@ impl Reading {
         match self {
             Reading::AsRead => "none needed",
             Reading::Conjugated => {
-                "the quaternions look conjugated (inertial → body, JPL/Shuster): read them as JPL"
+                "the quaternions look conjugated (a Hamilton quaternion mapping inertial → body): read them conjugated"
             }
             Reading::ScalarFirst => {
                 "the quaternion columns look scalar first ([w, x, y, z]): read them scalar first"
@@ -76,6 +85,12 @@ impl Reading {
             Reading::GyroNegated => {
                 "the gyro rates look negated relative to the attitude: check the sign of w_x, w_y, w_z"
             }
+            Reading::GyroDegrees => {
+                "the gyro rates are 180/π = 57.3 times the attitude's rates: they are in deg/s, not rad/s; read them as deg/s"
+            }
+            Reading::GyroRadians => {
+                "the gyro rates are π/180 times the attitude's rates: they are in rad/s, not deg/s; read them as rad/s"
+            }
         }
     }
 
@@ -84,11 +99,13 @@ impl Reading {
     pub fn fixes(&self) -> &'static [Fix] {
         match self {
             Reading::AsRead | Reading::GyroNegated => &[],
-            Reading::Conjugated => &[Fix::Jpl],
+            Reading::GyroDegrees => &[Fix::GyroDegrees],
+            Reading::GyroRadians => &[Fix::GyroRadians],
+            Reading::Conjugated => &[Fix::Conjugate],
             Reading::ScalarFirst => &[Fix::ScalarFirst],
-            Reading::ScalarFirstConjugated => &[Fix::ScalarFirst, Fix::Jpl],
+            Reading::ScalarFirstConjugated => &[Fix::ScalarFirst, Fix::Conjugate],
             Reading::ScalarLast => &[Fix::ScalarLast],
-            Reading::ScalarLastConjugated => &[Fix::ScalarLast, Fix::Jpl],
+            Reading::ScalarLastConjugated => &[Fix::ScalarLast, Fix::Conjugate],
         }
     }
 
@@ -105,7 +122,10 @@ impl Reading {
             Quaternion::from_wxyz([z, w, x, y])
         };
         match self {
-            Reading::AsRead | Reading::GyroNegated => *q,
+            Reading::AsRead
+            | Reading::GyroNegated
+            | Reading::GyroDegrees
+            | Reading::GyroRadians => *q,
             Reading::Conjugated => q.conjugate(),
             Reading::ScalarFirst => sf(q),
             Reading::ScalarFirstConjugated => sf(q).conjugate(),
@@ -141,6 +161,9 @@ pub struct ConventionCheck {
     prev: Option<Sample>,
     mismatch: [[f64; STEPS_NEEDED]; 7],
     steps: usize,
+    /// `|w|/|ω_q|` of steps where the attitude turns clearly (whatever the gyro's unit).
+    scale: [f64; STEPS_NEEDED],
+    scale_steps: usize,
 }
 
 impl Default for ConventionCheck {
@@ -149,6 +172,8 @@ impl Default for ConventionCheck {
             prev: None,
             mismatch: [[0.0; STEPS_NEEDED]; 7],
             steps: 0,
+            scale: [0.0; STEPS_NEEDED],
+            scale_steps: 0,
         }
     }
 }
@@ -156,7 +181,7 @@ impl Default for ConventionCheck {
 impl ConventionCheck {
     /// Feed the next sample (no effect once decided, or without gyro rates).
     pub fn push(&mut self, s: &Sample) {
-        if self.steps >= STEPS_NEEDED {
+        if self.decided() {
             return;
         }
         let prev = self.prev.replace(*s);
@@ -165,6 +190,10 @@ impl ConventionCheck {
             return;
         };
         let wn = w.norm();
+        self.push_scale(&a, s, &w, h);
+        if self.steps >= STEPS_NEEDED {
+            return;
+        }
         if !(h > 0.0 && h.is_finite() && wn >= MIN_RATE_RAD_S && wn.is_finite()) {
             return;
         }
@@ -185,15 +214,76 @@ impl ConventionCheck {
         self.steps += 1;
     }
 
+    /// The scale of the gyro against the attitude over one step: `|w|/|ω_q|` with the
+    /// attitude's rate `ω_q = 2 vec(q_a† q_b)/h`, from steps that turn clearly
+    /// (`|ω_q| ≥` [`MIN_RATE_RAD_S`]), slowly enough for it to be a rate, and **along
+    /// the gyro's axis** (`|cos ∠(w, ω_q)| ≥` [`SCALE_MIN_COS`]; a unit scales `w`, not its
+    /// direction). The last condition keeps out steps whose attitude turns by its noise
+    /// alone (a star tracker's 40″ at 10 Hz is ~3e-3 rad/s), whose `ω_q` points anywhere
+    /// and whose ratio is noise: once their median fell within 10 % of π/180 on honest
+    /// rad/s data, and they hid a real deg/s (tests/integration/gyro_unit.rs).
+    fn push_scale(&mut self, a: &Sample, b: &Sample, w: &Vector3<f64>, h: f64) {
+        let wn = w.norm();
+        if self.scale_steps >= STEPS_NEEDED || !(h > 0.0 && h.is_finite() && wn.is_finite()) {
+            return;
+        }
+        let wq: Vector3<f64> = a.q.conjugate().mul(&b.q).positive_scalar().v * (2.0 / h);
+        let rate = wq.norm();
+        let aligned = wn > 0.0 && rate > 0.0 && w.dot(&wq).abs() >= SCALE_MIN_COS * wn * rate;
+        if rate >= MIN_RATE_RAD_S && rate * h <= 0.2 && aligned {
+            self.scale[self.scale_steps] = wn / rate;
+            self.scale_steps += 1;
+        }
+    }
+
+    /// Whether both the frame check and the scale check have their steps.
+    #[must_use]
+    pub fn decided(&self) -> bool {
+        self.steps >= STEPS_NEEDED && self.scale_steps >= STEPS_NEEDED
+            || self.unit_verdict().is_some()
+    }
+
+    /// A gyro unit of deg/s (or rad/s) against the attitude: the median `|w|/|ω_q|`
+    /// within 10 % of 180/π (or π/180).
+    fn unit_verdict(&self) -> Option<Verdict> {
+        if self.scale_steps < STEPS_NEEDED {
+            return None;
+        }
+        let mut m = self.scale;
+        m.sort_unstable_by(f64::total_cmp);
+        let ratio = m[STEPS_NEEDED / 2];
+        let deg = 180.0 / core::f64::consts::PI;
+        for (reading, factor) in [
+            (Reading::GyroDegrees, deg),
+            (Reading::GyroRadians, 1.0 / deg),
+        ] {
+            if (ratio / factor - 1.0).abs() < 0.1 {
+                return Some(Verdict::Wrong {
+                    reading,
+                    as_read: (ratio - 1.0).abs(),
+                    fixed: (ratio / factor - 1.0).abs(),
+                });
+            }
+        }
+        None
+    }
+
     /// Steps gathered.
     #[must_use]
     pub fn steps(&self) -> usize {
-        self.steps
+        self.steps.max(if self.unit_verdict().is_some() {
+            self.scale_steps
+        } else {
+            0
+        })
     }
 
     /// The verdict on the steps so far.
     #[must_use]
     pub fn verdict(&self) -> Verdict {
+        if let Some(v) = self.unit_verdict() {
+            return v;
+        }
         if self.steps < STEPS_NEEDED {
             return Verdict::Undecided;
         }

@@ -45,7 +45,7 @@
 //! file.
 
 use super::gate::{Field, Gate, GateOptions, RawSample, SampleError};
-pub use super::gate::{QuaternionFormat, ReadStats, DEFAULT_UNIT_TOLERANCE};
+pub use super::gate::{GyroUnit, QuaternionFormat, ReadStats, DEFAULT_UNIT_TOLERANCE};
 use super::line_cap::{LineCap, LineTooLong};
 use super::time_stamp::{Clock, StampError};
 use crate::error_kind::ErrorKind;
@@ -135,6 +135,8 @@ pub struct CsvOptions {
     /// are read. Default `false`. The pipeline stops where the data show a reversed sign
     /// ([`crate::pipeline::PipelineError::ReversedMomentum`]).
     pub negate_rho: bool,
+    /// The unit of the `w_*` columns. Default rad/s.
+    pub gyro_unit: GyroUnit,
 }
 
 impl Default for CsvOptions {
@@ -146,6 +148,7 @@ impl Default for CsvOptions {
             period_tolerance: None,
             delimiter: b',',
             negate_rho: false,
+            gyro_unit: GyroUnit::RadPerS,
         }
     }
 }
@@ -370,6 +373,7 @@ impl<R: Read> TelemetryReader<R> {
             unit_tolerance: options.unit_tolerance,
             period_tolerance: options.period_tolerance,
             negate_rho: options.negate_rho,
+            gyro_unit: options.gyro_unit,
         });
         Ok(Self {
             reader,

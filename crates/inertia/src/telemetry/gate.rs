@@ -7,12 +7,13 @@
 //! 1. each value finite and within the supported range ([`crate::sample::range`]), in the
 //!    order time, quaternion, ρ, τ, ω;
 //! 2. the quaternion read in its [`QuaternionFormat`] (Hamilton scalar last or first, or
-//!    JPL, eq. 1's convention), its norm within [`GateOptions::unit_tolerance`] of 1, then
+//!    JPL, eq. 1's convention, or Hamilton inertial → body), its norm within [`GateOptions::unit_tolerance`] of 1, then
 //!    renormalised (and counted);
 //! 3. across samples ([`Order`]): time increasing, gyro rates given for every sample or
 //!    none, and, in strict mode ([`GateOptions::period_tolerance`]), a uniform step;
 //! 4. ρ (and with it nothing else) negated where the data use the opposite sign
-//!    ([`GateOptions::negate_rho`]).
+//!    ([`GateOptions::negate_rho`]); gyro rates stored in deg/s converted to rad/s
+//!    before their range check ([`GateOptions::gyro_unit`]).
 //!
 //! A front end keeps only its locating (a file's line and column name, an array's name and
 //! row, a C sample's index) and the rendering of the message. A refused sample leaves the
@@ -40,6 +41,30 @@ pub enum QuaternionFormat {
     /// JPL/Shuster (inertial → body attitude matrix, scalar last). Converted with
     /// [`Quaternion::from_jpl_xyzw`].
     Jpl,
+    /// Hamilton, scalar last, but mapping inertial → body (the conjugate of this crate's
+    /// meaning): [`Quaternion::from_hamilton_inertial_to_body_xyzw`].
+    Conjugate,
+}
+
+/// The unit of the gyro rates as stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GyroUnit {
+    /// rad/s (the default).
+    #[default]
+    RadPerS,
+    /// deg/s: converted to rad/s as read, before the range check.
+    DegPerS,
+}
+
+impl GyroUnit {
+    /// The factor that turns a stored rate into rad/s.
+    #[must_use]
+    pub fn to_rad_s(self) -> f64 {
+        match self {
+            Self::RadPerS => 1.0,
+            Self::DegPerS => core::f64::consts::PI / 180.0,
+        }
+    }
 }
 
 /// One sample as a front end read it: the numbers in storage order, unchecked.
@@ -53,7 +78,8 @@ pub struct RawSample {
     pub rho_nms: [f64; 3],
     /// Known external torque, N m (`None`: zero).
     pub tau_nm: Option<[f64; 3]>,
-    /// Gyro rate averaged over the step, rad/s (`None`: not measured).
+    /// Gyro rate averaged over the step, in [`GateOptions::gyro_unit`] (rad/s by
+    /// default; `None`: not measured).
     pub w_rad_s: Option<[f64; 3]>,
 }
 
@@ -254,6 +280,8 @@ pub struct GateOptions {
     /// ρ holds the rotor momentum with the opposite sign of this library's convention:
     /// negate it.
     pub negate_rho: bool,
+    /// The unit of the stored gyro rates. Default rad/s.
+    pub gyro_unit: GyroUnit,
 }
 
 impl Default for GateOptions {
@@ -263,6 +291,7 @@ impl Default for GateOptions {
             unit_tolerance: DEFAULT_UNIT_TOLERANCE,
             period_tolerance: None,
             negate_rho: false,
+            gyro_unit: GyroUnit::RadPerS,
         }
     }
 }
@@ -352,6 +381,7 @@ impl Gate {
             QuaternionFormat::HamiltonScalarLast => Quaternion::from_xyzw(raw.q),
             QuaternionFormat::HamiltonScalarFirst => Quaternion::from_wxyz(raw.q),
             QuaternionFormat::Jpl => Quaternion::from_jpl_xyzw(raw.q),
+            QuaternionFormat::Conjugate => Quaternion::from_hamilton_inertial_to_body_xyzw(raw.q),
         };
         let norm = read.norm();
         let tolerance = self.options.unit_tolerance;
@@ -371,9 +401,10 @@ impl Gate {
             Some(v) => vec3(v, Field::Tau, Quantity::Tau)?,
             None => Vector3::zeros(),
         };
+        let to_rad_s = self.options.gyro_unit.to_rad_s();
         let w = raw
             .w_rad_s
-            .map(|v| vec3(v, Field::Rate, Quantity::Rate))
+            .map(|v| vec3(v.map(|x| x * to_rad_s), Field::Rate, Quantity::Rate))
             .transpose()?;
         self.order.check(t_s, w.is_some())?;
         let mut period_s = self.period_s;

@@ -15,6 +15,7 @@ mod discrete_convergence;
 mod discrete_momentum;
 mod dynamics;
 mod estimators;
+mod gyro_unit;
 mod inertial_torque;
 mod lab_realism;
 mod numeric_range;

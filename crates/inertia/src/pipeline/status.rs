@@ -1,0 +1,120 @@
+//! One status rule for every answer the pipeline hands out (streaming and batch, so the
+//! report, the JSON, the history, Python and C say the same).
+//!
+//! "Determined" is a promise: the truth within 3σ in at least 90 % of cases. So an
+//! answer is determined only when the estimator's own tests passed **and** it has a σ
+//! **and** the model checks below pass:
+//!
+//! * **A σ.** An answer without a standard deviation (an estimator with no uncertainty
+//!   model, a batch form without one, or σ switched off) makes no claim about how close it
+//!   is: [`Observability::NoSigma`] (code `unchecked`).
+//! * **A physical inertia.** The principal moments `J1 ≤ J2 ≤ J3` of a real body satisfy
+//!   `J1 > 0` and `J1 + J2 ≥ J3` (the triangle inequality of the second moments, paper
+//!   eq. 9). A constraint set that does not enforce it (`paper` on the diagonal only,
+//!   `positive-definite`) can return an answer that breaks it; when it breaks it by more
+//!   than [`PHYSICAL_Z`] of its stated σ (`σ(J1 + J2 − J3)` from the principal moments' σ,
+//!   taken as independent), a model check failed: the truth is physical, so an answer
+//!   that far outside the physical set is not within 3σ of it, and the row model or the
+//!   data's conventions do not hold. The answer is not determined
+//!   ([`Observability::ModelCheckFailed`] with [`Unobservable::Unphysical`]), but it and
+//!   its σ stay visible: the project refuses only for rank or conditioning, a convention
+//!   error the gyro proves, or a user's limit, and an unphysical answer is none of them
+//!   (the paper's own J breaks `J1 + J2 ≥ J3` by 4.9e-5 kg m², so an estimator that is
+//!   right to its σ can be here when its σ is smaller than that). Within [`PHYSICAL_Z`] σ
+//!   the answer is consistent with a physical inertia at its accuracy and stays
+//!   determined (the report says so, [`physical_margin`]).
+
+use crate::constraints::Consistency;
+use crate::estimator::observability::{Observability, Unobservable};
+use crate::estimator::Estimate;
+use crate::tensor::matrix_from_j;
+
+/// How many σ of `J1 + J2 − J3` (or of `J1`) an answer may lie beyond the physical set
+/// and still be determined.
+pub const PHYSICAL_Z: f64 = 3.0;
+
+/// A violation smaller than this fraction of `J3` is round-off, not a violation.
+pub const PHYSICAL_ROUND_OFF: f64 = 1e-6;
+
+/// How far an answer lies outside the physical set.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct PhysicalMargin {
+    /// Smallest principal moment `J1`, kg m².
+    pub min_moment_kg_m2: f64,
+    /// `J1 + J2 − J3`, kg m² (negative: the triangle inequality is broken).
+    pub triangle_kg_m2: f64,
+    /// σ of `J1 + J2 − J3` from the principal moments' σ taken as independent (`None`
+    /// without a σ).
+    pub triangle_sigma_kg_m2: Option<f64>,
+    /// The larger of the two violations in units of its σ (`None` without a σ).
+    pub z: Option<f64>,
+}
+
+impl PhysicalMargin {
+    /// Whether the violation exceeds [`PHYSICAL_Z`] σ (or there is no σ to judge it).
+    #[must_use]
+    pub fn significant(&self) -> bool {
+        self.z.is_none_or(|z| z > PHYSICAL_Z)
+    }
+}
+
+/// The physical margin of `e`'s answer when it breaks `J1 > 0` or `J1 + J2 ≥ J3` by more
+/// than round-off; `None` for a physical answer or none.
+#[must_use]
+pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
+    let j = e.j()?;
+    let (mut m, _) = crate::eigen3::symmetric_eigen3(&matrix_from_j(&j));
+    m.as_mut_slice().sort_unstable_by(f64::total_cmp);
+    let triangle = m[0] + m[1] - m[2];
+    let tol = PHYSICAL_ROUND_OFF * m[2].abs();
+    if m[0] > 0.0 && triangle >= -tol {
+        return None;
+    }
+    let triangle_sigma = e.uncertainty.map(|u| {
+        let s = u.principal_sigma_kg_m2;
+        crate::math::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+    });
+    let z = e.uncertainty.zip(triangle_sigma).map(|(u, st)| {
+        let s = u.principal_sigma_kg_m2;
+        let zt = if triangle < -tol { -triangle / st } else { 0.0 };
+        let z1 = if m[0] <= 0.0 { -m[0] / s[0] } else { 0.0 };
+        let z = zt.max(z1);
+        if z.is_nan() {
+            f64::INFINITY
+        } else {
+            z
+        }
+    });
+    Some(PhysicalMargin {
+        min_moment_kg_m2: m[0],
+        triangle_kg_m2: triangle,
+        triangle_sigma_kg_m2: triangle_sigma,
+        z,
+    })
+}
+
+/// Apply the rule ([module docs](self)) to `e`, an answer under the consistency
+/// condition `consistency` (under [`Consistency::Physical`] the answer is physical by
+/// construction, to the solver's tolerance, and only the σ rule applies).
+pub fn settle(e: &mut Estimate, consistency: Consistency) {
+    let judged = consistency != Consistency::Physical
+        && matches!(
+            e.observability,
+            Observability::Determined { .. } | Observability::FromPrior(_)
+        );
+    if judged && e.uncertainty.is_some() {
+        if let Some(p) = physical_margin(e).filter(PhysicalMargin::significant) {
+            e.observability = Observability::ModelCheckFailed(Unobservable::Unphysical {
+                min_moment_kg_m2: p.min_moment_kg_m2,
+                triangle_kg_m2: p.triangle_kg_m2,
+                triangle_sigma_kg_m2: p.triangle_sigma_kg_m2.unwrap_or(f64::INFINITY),
+                z: p.z.unwrap_or(f64::INFINITY),
+            });
+            return;
+        }
+    }
+    if let (Observability::Determined { condition }, None) = (e.observability, e.uncertainty) {
+        e.observability = Observability::NoSigma { condition };
+    }
+}
