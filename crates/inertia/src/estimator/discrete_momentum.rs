@@ -565,6 +565,7 @@ pub fn reduce_batch(
     // blocks ([`super::jackknife`], "Records of few chains"): each delete-one problem
     // the raw rows of every other block, each chain's initial momenta fitted again —
     // independent of the recursive path's innovations.
+    let mut time_block_scale = 1.0;
     let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
         (0..chains.len().min(GROUPS))
             .map(|g| {
@@ -573,8 +574,14 @@ pub fn reduce_batch(
             })
             .collect()
     } else {
-        let ids = time_blocks(chains.iter().map(Vec::len));
-        let count = ids.iter().flatten().max().map_or(0, |m| m + 1);
+        // The same blocks as the recursive path: the last chain's block in progress is
+        // in every delete-one problem and σ is scaled to it, as there.
+        let lengths: Vec<usize> = chains.iter().map(Vec::len).collect();
+        let ids = super::jackknife::time_blocks(&lengths);
+        let count = ids.iter().flatten().flatten().max().map_or(0, |m| m + 1);
+        let pending = ids.iter().flatten().filter(|id| id.is_none()).count();
+        let all = ids.iter().map(Vec::len).sum::<usize>();
+        time_block_scale = crate::math::sqrt((all - pending) as f64 / all.max(1) as f64);
         (0..count)
             .map(|g| {
                 let without: Vec<(Vec<f64>, Vec<f64>)> = chains
@@ -584,7 +591,7 @@ pub fn reduce_batch(
                         let kept: Vec<&AugmentedRow> = chain
                             .iter()
                             .zip(ids)
-                            .filter(|(_, &id)| id != g)
+                            .filter(|(_, &id)| id != Some(g))
                             .map(|(r, _)| r)
                             .collect();
                         reduce_chain(&kept).0
@@ -607,58 +614,10 @@ pub fn reduce_batch(
             nuisance,
         },
         gaps: source.gaps(),
-        jackknife_sigma_kg_m2: estimates.as_deref().and_then(jackknife_sigma),
+        jackknife_sigma_kg_m2: estimates
+            .as_deref()
+            .and_then(jackknife_sigma)
+            .map(|s| s.map(|v| v * time_block_scale)),
         without_torque,
     })
-}
-
-/// The time block of each row block of the chains of the given lengths, as
-/// [`super::jackknife::ChainGroups`] forms them: [`super::jackknife::BLOCK_ROWS`] row
-/// blocks at first, a block also ending with its chain; once there are `2·GROUPS`,
-/// neighbours are merged in pairs and the blocks after them are twice as long.
-/// The last block is filed too.
-#[cfg(feature = "std")]
-fn time_blocks(chains: impl Iterator<Item = usize>) -> std::vec::Vec<std::vec::Vec<usize>> {
-    use super::jackknife::{BLOCK_ROWS, GROUPS};
-    use std::vec::Vec;
-    struct Blocks {
-        ids: Vec<Vec<usize>>,
-        closed: usize,
-        length: usize,
-        in_block: usize,
-    }
-    impl Blocks {
-        fn close(&mut self) {
-            (self.closed, self.in_block) = (self.closed + 1, 0);
-            if self.closed == 2 * GROUPS {
-                for id in self.ids.iter_mut().flatten() {
-                    *id /= 2;
-                }
-                (self.closed, self.length) = (GROUPS, 2 * self.length);
-            }
-        }
-    }
-    let mut b = Blocks {
-        ids: Vec::new(),
-        closed: 0,
-        length: BLOCK_ROWS,
-        in_block: 0,
-    };
-    for n in chains {
-        b.ids.push(Vec::with_capacity(n));
-        for _ in 0..n {
-            if b.in_block == b.length {
-                b.close();
-            }
-            let id = b.closed;
-            if let Some(chain) = b.ids.last_mut() {
-                chain.push(id);
-            }
-            b.in_block += 1;
-        }
-        if b.in_block > 0 {
-            b.close();
-        }
-    }
-    b.ids
 }

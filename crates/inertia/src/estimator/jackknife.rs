@@ -38,8 +38,12 @@
 //! ([`super::augmented_qr`]), uncorrelated under the model and summing to the chain's
 //! information, so deleting a block's deletes its share of the information; errors
 //! correlated over less than a block (vibration, noise bursts, a drift over a fraction of
-//! the record) stay within it and widen the spread of the delete-one answers. Once there
-//! are four chains, the chains are the groups, as above. With exponential forgetting
+//! the record) stay within it and widen the spread of the delete-one answers. This is
+//! not deleting the block's data: the running means keep some of it in the later
+//! innovations. The batch path deletes the raw rows of the same blocks
+//! ([`time_blocks`]) and refits the initial momenta; on simulated throws the recursive
+//! σ was 0.87–3.5 times the batch one (median 1.2). Once there are four completed
+//! chains, the chains are the groups, as above. With exponential forgetting
 //! the groups' weights differ by orders of magnitude and the equal-weight formula does
 //! not hold, so the estimator keeps no groups then and the noise σ is the least-squares
 //! one.
@@ -258,6 +262,55 @@ fn delete_one_sigma(groups: &[SharedQr], constraints: &Constraints) -> Option<[f
     estimates.get(..used).and_then(jackknife_sigma)
 }
 
+/// The time block of each row block of chains of the given lengths (in row blocks), as
+/// [`ChainGroups`] files them when every chain but the last has ended: `Some(block)` for
+/// a closed block, `None` for the last chain's block in progress (which the jackknife
+/// leaves in every delete-one problem and scales to).
+#[cfg(feature = "std")]
+pub(crate) fn time_blocks(chains: &[usize]) -> std::vec::Vec<std::vec::Vec<Option<usize>>> {
+    use std::vec::Vec;
+    let mut ids: Vec<Vec<Option<usize>>> = Vec::new();
+    let (mut closed, mut length, mut in_block) = (0usize, BLOCK_ROWS, 0usize);
+    let close = |ids: &mut Vec<Vec<Option<usize>>>, closed: &mut usize, length: &mut usize| {
+        *closed += 1;
+        if *closed == 2 * GROUPS {
+            for id in ids.iter_mut().flatten().flatten() {
+                *id /= 2;
+            }
+            (*closed, *length) = (GROUPS, 2 * *length);
+        }
+    };
+    for (c, &n) in chains.iter().enumerate() {
+        ids.push(Vec::with_capacity(n));
+        for _ in 0..n {
+            if in_block >= length {
+                close(&mut ids, &mut closed, &mut length);
+                in_block = 0;
+            }
+            let id = closed;
+            if let Some(chain) = ids.last_mut() {
+                chain.push(Some(id));
+            }
+            in_block += 1;
+        }
+        if c + 1 < chains.len() && in_block > 0 {
+            close(&mut ids, &mut closed, &mut length);
+            in_block = 0;
+        }
+    }
+    // The block in progress.
+    let last = ids.iter().flatten().flatten().copied().max();
+    if in_block > 0 {
+        if let (Some(chain), Some(open)) = (ids.last_mut(), last) {
+            for id in chain.iter_mut().rev().take(in_block) {
+                debug_assert_eq!(*id, Some(open));
+                *id = None;
+            }
+        }
+    }
+    ids
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -380,5 +433,35 @@ mod tests {
                 "element {k}"
             );
         }
+    }
+
+    /// Problem: chains of 7, 300, 1, 45 and 530 row blocks. Reference: [`ChainGroups`]
+    /// fed them (every chain ended but the last). [`time_blocks`] gives the same closed
+    /// blocks, in order (rows per block), and the same block in progress.
+    #[test]
+    fn the_batch_time_blocks_are_the_recursive_ones() {
+        let lengths = [7usize, 300, 1, 45, 530];
+        let mut groups = ChainGroups::default();
+        for (c, &n) in lengths.iter().enumerate() {
+            for _ in 0..n {
+                let a = [SVector::<f64, SHARED>::zeros(); 3];
+                groups.chain_mut().add(&(a, [0.0; 3]), &[0.0; 3], 0.0);
+            }
+            if c + 1 < lengths.len() {
+                groups.end_chain();
+            }
+        }
+        let ids = time_blocks(&lengths);
+        let want: std::vec::Vec<usize> = groups.blocks[..groups.closed]
+            .iter()
+            .map(|b| b.rows() / 3)
+            .collect();
+        let got: std::vec::Vec<usize> = (0..want.len())
+            .map(|g| ids.iter().flatten().filter(|&&id| id == Some(g)).count())
+            .collect();
+        assert_eq!(got, want);
+        assert!(ids.iter().flatten().flatten().all(|&id| id < want.len()));
+        let pending = ids.iter().flatten().filter(|id| id.is_none()).count();
+        assert_eq!(pending, groups.block.counts().rows() / 3);
     }
 }

@@ -58,6 +58,9 @@ pub struct Trend<const N: usize> {
     /// Covariance of the error of `[X̂; τ̂]`; `None` after one block (`τ` not yet
     /// fixed).
     p: Option<Covariance>,
+    /// Before `τ` is fixed: the variance of the first block's level, in the rows' white
+    /// variances (1, grown by forgetting).
+    first_var: f64,
     /// `s` of the slot's last block, s.
     last_s: f64,
 }
@@ -79,21 +82,16 @@ impl<const N: usize> Trend<N> {
             tau_a: [SVector::zeros(); 3],
             tau_b: [0.0; 3],
             p: None,
+            first_var: 1.0,
             last_s: s,
         }
     }
 
-    /// The torque `τ̂` at the shared unknowns `y`, N m (`None` before it is fixed).
-    #[must_use]
-    pub fn torque_at(&self, y: &SVector<f64, N>) -> Option<[f64; 3]> {
-        self.p?;
-        Some(core::array::from_fn(|m| {
-            self.tau_a[m].dot(y) - self.tau_b[m]
-        }))
-    }
-
     /// Weigh the state by `λ` (forgetting): the covariance grows by `1/λ`.
     pub fn scale(&mut self, lambda: f64) {
+        if self.p.is_none() {
+            self.first_var /= lambda;
+        }
         self.p = self.p.map(|p| match p {
             Covariance::Full(p) => Covariance::Full(p / lambda),
             Covariance::Kronecker { a, b, c } => Covariance::Kronecker {
@@ -128,10 +126,12 @@ impl<const N: usize> Trend<N> {
                 level_a[m] = a_new[m];
                 level_b[m] = b_new[m];
             }
+            // X̂ is the second block's (variance 1); τ̂'s error is that of the two
+            // levels' difference over Δs, the first's variance grown by any forgetting.
             let kronecker = Covariance::Kronecker {
                 a: 1.0,
                 b: 1.0 / dt,
-                c: 2.0 / (dt * dt),
+                c: (1.0 + self.first_var) / (dt * dt),
             };
             self.p = Some(if *q == Matrix3::zeros() {
                 kronecker
@@ -200,12 +200,14 @@ impl<const N: usize> Trend<N> {
         let (a, b) = (a + dt * (2.0 * b + dt * c), b + dt * c);
         let f = a + 1.0;
         let (w, kx, kt) = (1.0 / crate::math::sqrt(f), a / f, b / f);
+        // `c − b²/f` is ≥ 0 in exact arithmetic: rounding below zero is clamped, only a
+        // non-finite state stops the filter (as in the full path).
         let next = Covariance::Kronecker {
             a: a / f,
             b: b / f,
-            c: c - b * b / f,
+            c: (c - b * b / f).max(0.0),
         };
-        if !(w.is_finite() && a / f >= 0.0 && c - b * b / f >= 0.0) {
+        if !(w.is_finite() && a.is_finite() && b.is_finite() && c.is_finite()) {
             return None;
         }
         let mut rows = [SVector::<f64, N>::zeros(); 3];
@@ -340,6 +342,72 @@ mod tests {
                 (f_rss - d_rss).abs() < 1e-9 * d_rss,
                 "drift {drift} from {from}"
             );
+        }
+    }
+
+    /// Problem: 12 blocks at unequal steps, forgetting `λ` before every block from the
+    /// second on (so between the first and the second too), no drift. Reference: the
+    /// dense weighted least squares over `[y; X₀; τ]`, block k weighted `λ^(K−1−k)`, and
+    /// the filter's rows weighted as the shared state weighs them. Same `y` and residual
+    /// to 1e-9.
+    #[test]
+    fn forgetting_weighs_the_trend_as_the_dense_weighted_fit() {
+        const N: usize = 3;
+        for lambda in [0.7, 0.999] {
+            let blocks = 12;
+            let mut st = 5u64;
+            let a: Vec<[SVector<f64, N>; 3]> = (0..blocks)
+                .map(|_| core::array::from_fn(|_| SVector::from_fn(|_, _| noise(&mut st))))
+                .collect();
+            let b: Vec<[f64; 3]> = (0..blocks)
+                .map(|_| core::array::from_fn(|_| noise(&mut st)))
+                .collect();
+            let s: Vec<f64> = (0..blocks)
+                .map(|k| k as f64 * 0.7 + 0.1 * noise(&mut st))
+                .collect();
+            let (mut la, mut lb) = (a[0], b[0]);
+            let mut trend = Trend::<N>::start(s[0]);
+            let mut rows: Vec<(usize, [SVector<f64, N>; 3], [f64; 3])> = Vec::new();
+            for k in 1..blocks {
+                trend.scale(lambda);
+                if let TrendStep::Row((r, beta)) = trend
+                    .step((&a[k], &b[k]), s[k], (&mut la, &mut lb), &Matrix3::zeros())
+                    .expect("finite")
+                {
+                    rows.push((k, r, beta));
+                }
+            }
+            let weight = |k: usize| lambda.powi((blocks - 1 - k) as i32).sqrt();
+            let (mut fa, mut fb): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+            for (k, r, beta) in &rows {
+                for m in 0..3 {
+                    fa.extend(r[m].iter().map(|v| v * weight(*k)));
+                    fb.push(beta[m] * weight(*k));
+                }
+            }
+            let fa = DMatrix::from_row_slice(fb.len(), N, &fa);
+            let fb = DVector::from_vec(fb);
+            let f_y = fa.clone().svd(true, true).solve(&fb, 1e-14).expect("solve");
+            let f_rss = (&fa * &f_y - &fb).norm_squared();
+            let n = N + 6;
+            let (mut da, mut db): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+            for k in 0..blocks {
+                for m in 0..3 {
+                    let mut r = DVector::zeros(n);
+                    r.rows_mut(0, N).copy_from(&a[k][m]);
+                    r[N + m] = -1.0;
+                    r[N + 3 + m] = -(s[k] - s[0]);
+                    da.extend(r.iter().map(|v| v * weight(k)));
+                    db.push(b[k][m] * weight(k));
+                }
+            }
+            let da = DMatrix::from_row_slice(db.len(), n, &da);
+            let db = DVector::from_vec(db);
+            let x = da.clone().svd(true, true).solve(&db, 1e-14).expect("solve");
+            let d_rss = (&da * &x - &db).norm_squared();
+            let d_y = x.rows(0, N).into_owned();
+            assert!((f_y - &d_y).norm() < 1e-9 * d_y.norm(), "λ {lambda}");
+            assert!((f_rss - d_rss).abs() < 1e-9 * d_rss, "λ {lambda}");
         }
     }
 

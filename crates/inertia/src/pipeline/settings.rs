@@ -221,6 +221,15 @@ impl PipelineSettings {
                 }
             }
         }
+        // The test that chooses the inertial torque compares unweighted fits.
+        if self.inertial_torque == InertialTorque::Auto && self.memory_s.is_some() {
+            return Err(PipelineError::NeedsSetting {
+                setting: "inertial_torque",
+                needs: "memory_s",
+                requirement: "unset",
+                why: "the test that chooses the torque needs unweighted rows (give on or off with a memory)",
+            });
+        }
         let constraints = self.constraints.validate()?;
         // The observability thresholds are checked by the estimators' own settings.
         let o = &self.observability;

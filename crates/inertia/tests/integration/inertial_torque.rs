@@ -140,3 +140,21 @@ fn auto_estimates_the_inertial_torque_where_the_data_need_it() {
         }
     }
 }
+
+/// `auto` compares unweighted fits: with a memory it is refused, naming both settings;
+/// `on` with a memory is accepted.
+#[test]
+fn auto_with_a_memory_is_refused() {
+    let with = |mode| PipelineSettings {
+        inertial_torque: mode,
+        memory_s: Some(60.0),
+        ..PipelineSettings::default()
+    };
+    let e = with(InertialTorque::Auto).validate().map(drop).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("inertial_torque") && text.contains("memory_s"),
+        "{text}"
+    );
+    assert!(with(InertialTorque::On).validate().is_ok());
+}

@@ -34,12 +34,15 @@ fn throw(on: &[LabEffect], seed: u64) -> inertia::sim::SimOutput {
     p.simulate().expect("sim")
 }
 
-/// Problem: a throw without lab effects (0.5 s at 4 kHz, one chain). Reference: the
-/// batch reduction's jackknife over the same time blocks of raw rows, an independent
-/// computation (the recursive one deletes a block's innovations, not its rows, and
-/// leaves out the block in progress). There is a jackknife at all (before time blocks
-/// a one-chain record had none), and the two agree per element within a factor 2.5:
-/// over seeds 1–5 the recursive one was 0.45–1.34 times the batch one, median 0.78.
+/// Problem: a throw without lab effects (0.5 s at 4 kHz, one chain; seed 3, the widest
+/// disagreement of seeds 1–8). Reference: the batch reduction's jackknife over the same
+/// time blocks (`jackknife::time_blocks`, tested to be the recursive path's) deleting
+/// raw rows and fitting the chain's initial momenta again, an independent computation.
+/// The recursive one deletes a block's innovations instead, whose running means keep
+/// some of the block's data in later rows: not the same estimator. There is a jackknife
+/// at all (before time blocks, a one-chain record had none), and the two agree per
+/// element within a factor 4: over seeds 1–8 the recursive one was 0.87–3.5 times the
+/// batch one, median 1.2 (the recursive is the wider).
 #[test]
 fn recursive_and_batch_time_block_jackknives_agree() {
     let run = throw(&[], 3);
@@ -54,7 +57,7 @@ fn recursive_and_batch_time_block_jackknives_agree() {
         .expect("batch jackknife");
     for k in 0..6 {
         let ratio = rec[k] / bat[k];
-        assert!((0.4..=2.5).contains(&ratio), "element {k}: {ratio}");
+        assert!((0.5..=4.0).contains(&ratio), "element {k}: {ratio}");
     }
 }
 

@@ -85,6 +85,7 @@ pub(super) fn run_batch(
         samples,
         config: c,
         reduced: &reduced,
+        fits: &fits,
         chosen,
         from_s,
         tested,
@@ -119,6 +120,9 @@ struct BatchRun<'a> {
     config: &'a PipelineConfig,
     /// Every candidate's rows and their reduction.
     reduced: &'a [(MomentumRowSettings, BatchReduction)],
+    /// Their fits as the choice saw them: a model the inertial torque's test rejected
+    /// has an infinite variance ([`test_inertial_torque`]) and is no alternative.
+    fits: &'a [(f64, f64, Option<f64>)],
     chosen: usize,
     /// The shortest chain of an alternative ([`alternatives_from_s`]).
     from_s: f64,
@@ -200,7 +204,9 @@ impl Evidence for BatchRun<'_> {
             .reduced
             .iter()
             .enumerate()
-            .filter(|&(i, (r, _))| i != self.chosen && in_running(r, self.from_s))
+            .filter(|&(i, (r, _))| {
+                i != self.chosen && in_running(r, self.from_s) && self.fits[i].0.is_finite()
+            })
             .map(|(_, (_, b))| b.qr);
         model_spread(
             &self.tested,
@@ -233,6 +239,7 @@ impl Evidence for BatchRun<'_> {
         for (i, (r, b)) in reduced.iter().enumerate() {
             if i == self.chosen
                 || !in_running(r, self.from_s)
+                || !self.fits[i].0.is_finite()
                 || !(b.qr.residual_variance() <= COMPARABLE_FIT * best_variance)
             {
                 continue;

@@ -174,6 +174,8 @@ impl DiscreteMomentum {
             let c = &self.candidates[i];
             if i == self.chosen
                 || !self.standing.live(i)
+                // A model the inertial torque's test rejected (`select::test_inertial_torque`).
+                || !self.fits.get(i).is_some_and(|f| f.0.is_finite())
                 || !in_running(c.row_settings(), self.from_s)
                 || c.qr().rows() < 6
                 || !(c.qr().residual_variance() <= COMPARABLE_FIT * best_variance)

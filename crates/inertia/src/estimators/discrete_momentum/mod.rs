@@ -531,7 +531,10 @@ impl Evidence for Streaming<'_> {
             .iter()
             .enumerate()
             .filter(|&(i, c)| {
-                i != run.chosen && run.standing.live(i) && in_running(c.row_settings(), run.from_s)
+                i != run.chosen
+                    && run.standing.live(i)
+                    && run.fits.get(i).is_some_and(|f| f.0.is_finite())
+                    && in_running(c.row_settings(), run.from_s)
             })
             .map(|(_, c)| c.qr().reduced());
         model_spread(
