@@ -220,7 +220,8 @@ pub struct SimulateArgs {
         long,
         value_name = "DEG",
         default_value_t = 0.0,
-        allow_hyphen_values = true
+        allow_hyphen_values = true,
+        requires = "gravity_gradient_altitude_km"
     )]
     pub orbit_inclination_deg: f64,
     /// Constant unknown body-frame torque, N m, e.g. `1e-5:0:0` (not in tau_*).

@@ -225,6 +225,12 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
         r.wheels.misalignment_deg = v;
     }
     if let Some(km) = a.gravity_gradient_altitude_km {
+        if !(km >= 0.0) {
+            return Err(input(format!(
+                "--gravity-gradient-altitude-km {}: must be >= 0 (an orbit above the surface)",
+                Num(km)
+            )));
+        }
         r.environment.orbit = Some(Orbit {
             inclination_deg: a.orbit_inclination_deg,
             ..Orbit::circular(km * 1e3)
@@ -273,7 +279,7 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     let truth = (!stdout && !special)
         .then(|| Pending::create(&truth_file))
         .transpose()?;
-    let out = sc.simulate(&common).map_err(input)?;
+    let out = sc.simulate(&common).map_err(sim_error)?;
     match csv {
         Some((pending, mut w)) => {
             write_csv(&mut w, &out).map_err(|e| write_failed(&a.output, e))?;
@@ -305,4 +311,48 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         Num(common.dt_s * common.realism.telemetry_every as f64),
     );
     Ok(())
+}
+
+/// The `simulate` option behind a simulator setting, so that its error names what the user
+/// typed (`None`: a setting no option sets on its own).
+fn option_of(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "dt_s" => "--dt",
+        "samples" => "--duration (with --dt)",
+        "telemetry_every" => "--telemetry-dt",
+        "gyro_noise_deg_s_rthz" => "--gyro-noise or --gyro-arw-deg-rthr",
+        "disturbance_nm_rthz" => "--disturbance",
+        "gyro.bias_deg_h" => "--gyro-bias-deg-h",
+        "gyro.bias_instability_deg_h" => "--gyro-bias-instability-deg-h",
+        "gyro.bias_correlation_s" => "--gyro-bias-correlation-s",
+        "star_tracker.noise_arcsec" => "--star-tracker-arcsec",
+        "star_tracker.boresight_body" => "--star-tracker-boresight",
+        "star_tracker.rate_hz" => "--star-tracker-hz",
+        "commands.rate_hz" => "--controller-hz",
+        "commands.phase_s" => "--command-phase",
+        "wheels.quantization_nms" => "--wheel-quantization-nms",
+        "wheels.noise_nms" => "--wheel-noise-nms",
+        "wheels.skew_s" => "--wheel-skew-s",
+        "wheels.scale_error" => "--wheel-scale-error",
+        "wheels.misalignment_deg" => "--wheel-misalignment-deg",
+        "wheels.hold_hz" => "--wheel-hold-hz",
+        "environment.orbit.altitude_m" => "--gravity-gradient-altitude-km",
+        "environment.orbit.inclination_deg" => "--orbit-inclination-deg",
+        "environment.constant_torque_nm" => "--constant-torque-nm",
+        "environment.inertial_torque_nm" => "--inertial-torque-nm",
+        "environment.damping_nms" => "--drag-nms",
+        "vibration.amplitude_rad_s" => "--gyro-vibration-rad-s",
+        "vibration.rotor_spin_inertia_kg_m2" => "--rotor-spin-inertia-kg-m2",
+        _ => return None,
+    })
+}
+
+/// A simulator error in the command line's words: the option first, the setting (in the
+/// simulator's units) beside it.
+fn sim_error(e: inertia::sim::SimError) -> CliError {
+    let inertia::sim::SimError::InvalidSetting { field, .. } = &e;
+    match option_of(field) {
+        Some(option) => input(format!("{option}: {e}")),
+        None => input(e),
+    }
 }

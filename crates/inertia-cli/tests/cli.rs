@@ -2,6 +2,8 @@
 
 #[path = "cli/bad_inputs.rs"]
 mod bad_inputs;
+#[path = "cli/simulate_options.rs"]
+mod simulate_options;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
