@@ -232,6 +232,9 @@ typedef struct InertiaSettings {
   double attitude_drift_deg_rth;
   // One of `InertiaInertialTorque` (discrete momentum). Default off.
   uint32_t inertial_torque;
+  // Relative σ of the wheel momentum's scale (their spin inertia known to ±this), a
+  // consider parameter that widens σ; 0 (default) for none. Heap only.
+  double rotor_scale_sigma;
 } InertiaSettings;
 
 // One telemetry sample at time `t_s` (README "Estimating your own telemetry").

@@ -138,6 +138,9 @@ pub struct InertiaSettings {
     pub attitude_drift_deg_rth: f64,
     /// One of `InertiaInertialTorque` (discrete momentum). Default off.
     pub inertial_torque: u32,
+    /// Relative σ of the wheel momentum's scale (their spin inertia known to ±this), a
+    /// consider parameter that widens σ; 0 (default) for none. Heap only.
+    pub rotor_scale_sigma: f64,
 }
 
 /// What the C settings ask for, without the heap (no estimator name string).
@@ -154,6 +157,7 @@ pub(crate) struct Plan {
     rotation_source: Option<RotationSource>,
     rho_model: RhoModel,
     inertial_torque: InertialTorque,
+    rotor_scale_sigma: Option<f64>,
     max_chain_s: Option<f64>,
     glitches: GlitchPolicy,
 }
@@ -284,6 +288,10 @@ impl Plan {
                 ],
             )?,
             inertial_torque: choice("inertial_torque", s.inertial_torque, &InertialTorque::ALL)?,
+            rotor_scale_sigma: {
+                finite("rotor_scale_sigma", s.rotor_scale_sigma)?;
+                (s.rotor_scale_sigma != 0.0).then_some(s.rotor_scale_sigma)
+            },
             max_chain_s: optional_positive("max_chain_s", s.max_chain_s)?,
             glitches: choice(
                 "glitches",
@@ -318,6 +326,7 @@ impl Plan {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
+            rotor_scale_sigma: self.rotor_scale_sigma,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,
@@ -344,6 +353,14 @@ impl Plan {
             return Err(fail(
                 InertiaStatus::NeedsHeap,
                 format_args!("resampling cannot run in caller storage: use inertia_estimator_new"),
+            ));
+        }
+        if self.rotor_scale_sigma.is_some() {
+            return Err(fail(
+                InertiaStatus::NeedsHeap,
+                format_args!(
+                    "rotor_scale_sigma cannot run in caller storage: use inertia_estimator_new"
+                ),
             ));
         }
         // The row-model settings at `PipelineSettings::default()`'s values (not built here:
@@ -424,5 +441,6 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         glitches: InertiaGlitchPolicy::Stop as u32,
         attitude_drift_deg_rth: 0.0,
         inertial_torque: InertiaInertialTorque::Off as u32,
+        rotor_scale_sigma: 0.0,
     }
 }

@@ -401,6 +401,12 @@ pub struct EstimateArgs {
     /// file's `sigma_kg_m2`.
     #[arg(long, value_name = "P", requires = "prior")]
     pub prior_sigma: Option<String>,
+    /// Relative standard deviation of the wheel momentum's scale, common to every wheel
+    /// (their spin inertia known to ±P): `2%` or `0.02`. It widens σ by P·|Ĵ| per element
+    /// (the data fix J's scale only as well as the wheels'), and an answer whose relative
+    /// σ then exceeds the threshold is not determined.
+    #[arg(long, value_name = "P")]
+    pub rotor_scale_sigma: Option<String>,
     /// How products of inertia are written in `--prior`, `--nominal` and `--bound Jij`
     /// (i ≠ j): `tensor` (J12 = −Σ m x y, this tool's convention) or `cad` (I_xy = +Σ m x y,
     /// what CAD tools report). Default tensor; a `--prior`/`--nominal` file's own

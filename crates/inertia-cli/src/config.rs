@@ -172,18 +172,18 @@ pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), Cli
     })
 }
 
-/// Parse `10%` or `0.1`.
-pub fn parse_fraction(s: &str) -> Result<f64, CliError> {
+/// Parse `10%` or `0.1` given to `option`.
+pub fn parse_fraction(option: &str, s: &str) -> Result<f64, CliError> {
     let t = s.trim();
     let v = match t.strip_suffix('%') {
         Some(p) => p.trim().parse::<f64>().map(|v| v / 100.0),
         None => t.parse::<f64>(),
     }
-    .map_err(|_| input(format!("--tolerance {s:?}: expected e.g. 10% or 0.1")))?;
+    .map_err(|_| input(format!("{option} {s:?}: expected e.g. 10% or 0.1")))?;
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(input(format!("--tolerance {s:?}: must be finite and >= 0")))
+        Err(input(format!("{option} {s:?}: must be finite and >= 0")))
     }
 }
 
@@ -242,7 +242,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
     let nominal = match (&a.nominal, &a.tolerance) {
         (Some(p), Some(t)) => Some((
             InertiaFile::read_known(p, a.products, "--products")?.inertia_kg_m2,
-            parse_fraction(t)?,
+            parse_fraction("--tolerance", t)?,
         )),
         _ => None,
     };
@@ -299,6 +299,11 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         },
         torque_bias: !a.no_torque_bias,
         inertial_torque: a.inertial_torque.parse().map_err(settings_error)?,
+        rotor_scale_sigma: a
+            .rotor_scale_sigma
+            .as_deref()
+            .map(|s| parse_fraction("--rotor-scale-sigma", s))
+            .transpose()?,
         max_chain_s: (a.chain != 0.0).then_some(a.chain),
         glitches: match a.glitches {
             GlitchArg::Stop => GlitchPolicy::Stop,
@@ -320,6 +325,7 @@ fn option_of(field: &str) -> &str {
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",
         "inertial_torque" => "--inertial-torque",
+        "rotor_scale_sigma" => "--rotor-scale-sigma",
         "max_chain_s" => "--chain",
         "attitude_drift_deg_rth" => "--attitude-drift",
         other => other,

@@ -513,6 +513,7 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
             _ => RhoModel::Auto,
         },
         torque_bias: kw.bool("torque_bias", true)?,
+        rotor_scale_sigma: kw.f64("rotor_scale_sigma")?,
         inertial_torque: match kw.choice("inertial_torque", &InertialTorque::NAMES)? {
             Some(name) => name
                 .parse()

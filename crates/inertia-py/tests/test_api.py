@@ -295,3 +295,19 @@ def test_warnings_are_the_reports_and_never_contradict_the_status():
         assert e.warnings == [w["message"] for w in e.report["warnings"]]
         lines = [l.strip()[len("warning: "):] for l in e.text.splitlines() if l.strip().startswith("warning: ")]
         assert lines == e.warnings
+
+
+def test_rotor_scale_sigma_widens_sigma_and_inertial_torque_is_a_setting(slew):
+    """The wheels' stated scale uncertainty is a consider parameter: the same J, each
+    element's σ √(σ² + (r ĵ)²); the inertial torque's modes are the library's names."""
+    tel, _ = slew
+    base = inertia.estimate(tel)
+    r = 0.02
+    wide = inertia.estimate(tel, rotor_scale_sigma=r)
+    assert np.array_equal(wide.j, base.j)
+    assert np.allclose(wide.sigma, np.sqrt(base.sigma**2 + (r * base.j) ** 2), rtol=1e-12)
+    assert inertia.estimate(tel, inertial_torque="on").status == "determined"
+    with pytest.raises(ValueError, match="inertial_torque"):
+        inertia.estimate(tel, inertial_torque="sometimes")
+    with pytest.raises(ValueError, match="rotor_scale_sigma"):
+        inertia.estimate(tel, rotor_scale_sigma=1.5)

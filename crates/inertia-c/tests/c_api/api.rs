@@ -156,6 +156,22 @@ fn bad_settings_name_the_setting() {
         ),
         (
             InertiaSettings {
+                rotor_scale_sigma: f64::NAN,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::NotFinite,
+            "rotor_scale_sigma",
+        ),
+        (
+            InertiaSettings {
+                rotor_scale_sigma: 1.5,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "rotor_scale_sigma",
+        ),
+        (
+            InertiaSettings {
                 inertial_torque: 3,
                 ..inertia_settings_default()
             },

@@ -155,6 +155,20 @@ fn settings_reach_the_estimator() {
         ..variational()
     });
     assert_eq!((base.has_sigma, no_sigma.has_sigma), (1, 0));
+    // A consider parameter moves σ, not J: each element's σ is √(σ² + (r ĵ)²).
+    let r = 0.02;
+    let scaled = final_j(&InertiaSettings {
+        rotor_scale_sigma: r,
+        ..variational()
+    });
+    assert_eq!(scaled.j, base.j);
+    for k in 0..6 {
+        let want = (base.sigma[k].powi(2) + (r * base.j[k]).powi(2)).sqrt();
+        assert!(
+            (scaled.sigma[k] - want).abs() <= 1e-12 * want,
+            "element {k}"
+        );
+    }
 }
 
 /// A wheel momentum of the opposite sign stops both engines at the same sample, with the

@@ -103,9 +103,10 @@ class Estimate:
         inertia: J, kg m², 3×3 (``None`` when the data cannot determine J).
         j: ``[J11, J22, J33, J12, J13, J23]``, kg m² (products are tensor entries,
             ``J12 = −Σ m x y``).
-        sigma: one standard deviation of each element of ``j``, kg m² (noise and
-            discretisation bias), or ``None`` for estimators without an uncertainty
-            model.
+        sigma: one standard deviation of each element of ``j``, kg m² (noise,
+            discretisation bias and, when ``rotor_scale_sigma`` was given, the wheels'
+            scale: ``report["rotor_scale_sigma_kg_m2"]``), or ``None`` for estimators
+            without an uncertainty model.
         status: ``"determined"``, ``"from_prior"``, ``"not_observable"``,
             ``"unchecked"`` (no observability test, or no σ) or ``"model_check_failed"``
             (an answer with its σ that breaks J1 > 0 or J1 + J2 ≥ J3 beyond 3σ).
@@ -418,7 +419,8 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
 _SETTINGS = (
     "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
     "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
-    "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque", "chain",
+    "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque",
+    "rotor_scale_sigma", "chain",
     "glitches",
     "solver", "uncertainty",
 )
@@ -466,6 +468,7 @@ def estimate(
     rho_model: str = "auto",
     torque_bias: bool = True,
     inertial_torque: str = "off",
+    rotor_scale_sigma: Optional[float] = None,
     chain: float = 30.0,
     glitches: str = "stop",
     solver: str = "native",
@@ -528,6 +531,8 @@ def estimate(
             ``"held"``, ``"plain"``. torque_bias: estimate an unknown constant torque.
             inertial_torque: a torque constant in the inertial frame, per chain: ``"off"``,
             ``"on"`` or ``"auto"`` (a nested χ² test decides; ``report["row_model"]``).
+            rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
+            inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
             chain: momentum chain, s (0: chains end only at gaps). glitches: ``"stop"``
             or ``"keep"``. solver: ``"native"``. uncertainty: compute σ.
         batch: one batch solve instead of the recursive estimator (``--batch``).
@@ -622,6 +627,7 @@ class Estimator:
         rho_model: str = "auto",
         torque_bias: bool = True,
         inertial_torque: str = "off",
+        rotor_scale_sigma: Optional[float] = None,
         chain: float = 30.0,
         glitches: str = "stop",
         solver: str = "native",

@@ -199,7 +199,7 @@ impl core::fmt::Display for Unobservable {
                 if relative_sigma.is_finite() {
                     write!(
                         f,
-                        "the data barely excite the dynamics: relative standard deviation of J {relative_sigma:.2e} > {threshold}"
+                        "relative standard deviation of J {relative_sigma:.2e} > {threshold}: the data barely excite the dynamics, or a stated uncertainty (the wheels' scale) exceeds it"
                     )
                 } else {
                     write!(

@@ -34,12 +34,37 @@ pub struct Uncertainty {
     pub noise_kg_m2: [f64; 6],
     /// Its discretisation-bias part `|b̂|`, kg m² (zero without the half-rate estimate).
     pub bias_kg_m2: [f64; 6],
+    /// Its consider part from the rotor momentum's scale uncertainty, `r · |ĵ|`, kg m²
+    /// (zero unless given, [`Uncertainty::with_rotor_scale`]).
+    pub rotor_scale_kg_m2: [f64; 6],
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
     pub principal_sigma_kg_m2: [f64; 3],
 }
 
 impl Uncertainty {
+    /// This σ widened by a relative uncertainty `r` of the rotor momentum's scale (a
+    /// consider parameter): the momentum rows are linear in `ρ`, so without a known torque
+    /// a scale error `ε` of `ρ` scales the answer by `1 + ε` exactly, and to first order
+    /// `ĵ` moves by `ε ĵ` (with a known torque, by the rotor-driven part of `ĵ`, which
+    /// `ĵ` stands for here). Each element's σ becomes `√(σ² + (r ĵ_k)²)` and each
+    /// principal moment's `√(σ² + (r m_i)²)`; `j` is the answer.
+    #[must_use]
+    pub fn with_rotor_scale(&self, j: &InertiaVector, r: f64) -> Uncertainty {
+        let add = |s: f64, x: f64| crate::math::sqrt(s * s + (r * x) * (r * x));
+        let (m, _) = crate::eigen3::symmetric_eigen3(&matrix_from_j(j));
+        let mut m = [m[0], m[1], m[2]];
+        m.sort_unstable_by(f64::total_cmp);
+        Uncertainty {
+            sigma_kg_m2: core::array::from_fn(|k| add(self.sigma_kg_m2[k], j[k])),
+            rotor_scale_kg_m2: core::array::from_fn(|k| crate::math::abs(r * j[k])),
+            principal_sigma_kg_m2: core::array::from_fn(|i| {
+                add(self.principal_sigma_kg_m2[i], m[i])
+            }),
+            ..*self
+        }
+    }
+
     /// Standard deviation of `‖Ĵ − J‖_F`, kg m², with the elements independent: each
     /// product of inertia appears twice in J.
     #[must_use]
@@ -125,6 +150,7 @@ pub fn with_bias_at(
         sigma_kg_m2: sigma,
         noise_kg_m2: *noise,
         bias_kg_m2: bias,
+        rotor_scale_kg_m2: [0.0; 6],
         principal_sigma_kg_m2: principal,
     }
 }

@@ -384,13 +384,13 @@ impl Pipeline {
         ));
         self.checks.push(index, s, self.config.glitches)?;
         self.input_samples += 1;
-        let consistency = self.config.constraints().set().consistency;
         let Self {
             resampler,
             estimator,
             estimator_samples,
             last,
             checks,
+            config,
             ..
         } = self;
         let mut feed = |u: &Sample| -> Result<(), PipelineError> {
@@ -402,7 +402,7 @@ impl Pipeline {
                     source,
                 })?;
             if let Some(mut e) = e {
-                status::settle(&mut e, consistency);
+                status::apply(&mut e, config);
                 checks.estimate(index, &e)?;
                 *last = Some(e);
                 on_estimate(&e);
@@ -545,7 +545,7 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
     }
     checks::convention_error(&check)?;
     let mut out = run(samples, config)?;
-    status::settle(&mut out.estimate, config.constraints().set().consistency);
+    status::apply(&mut out.estimate, config);
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
 }

@@ -100,6 +100,9 @@ pub struct Report {
     pub j: Option<[f64; 6]>,
     /// Standard deviation per element, kg m².
     pub sigma: Option<[f64; 6]>,
+    /// Its part from the wheel momentum's stated scale uncertainty (a consider parameter,
+    /// `rotor_scale_sigma`), kg m²; `null` without one.
+    pub rotor_scale_sigma_kg_m2: Option<[f64; 6]>,
     /// Principal moments, ascending, kg m².
     pub principal_moments: Option<[f64; 3]>,
     /// Their standard deviations, kg m².
@@ -279,6 +282,10 @@ impl Report {
             inertia: m.as_ref().map(rows),
             j: estimate.j().map(|j| core::array::from_fn(|k| j[k])),
             sigma: estimate.sigma_kg_m2(),
+            rotor_scale_sigma_kg_m2: estimate
+                .uncertainty
+                .map(|u| u.rotor_scale_kg_m2)
+                .filter(|p| p.iter().any(|&v| v > 0.0)),
             principal_moments: pr.map(|(v, _)| [v[0], v[1], v[2]]),
             principal_moments_sigma: estimate.uncertainty.map(|u| u.principal_sigma_kg_m2),
             principal_axes: pr.map(|(_, ax)| rows(&ax)),
@@ -551,12 +558,21 @@ impl fmt::Display for ReportText<'_> {
             writeln!(s, "  [ {:>12.6} {:>12.6} {:>12.6} ]", r[0], r[1], r[2])?;
         }
         if let Some(sig) = r.sigma {
-            writeln!(
-                s,
-                "elements, ± one standard deviation (noise and discretisation bias) [kg m²]:"
-            )?;
+            let parts = if r.rotor_scale_sigma_kg_m2.is_some() {
+                "noise, discretisation bias and the wheels' stated scale"
+            } else {
+                "noise and discretisation bias"
+            };
+            writeln!(s, "elements, ± one standard deviation ({parts}) [kg m²]:")?;
             for (k, name) in COMPONENT_NAMES.iter().enumerate() {
-                writeln!(s, "  {name} = {:>12.6} ± {:.2e}", j[k], sig[k])?;
+                match r.rotor_scale_sigma_kg_m2 {
+                    Some(p) => writeln!(
+                        s,
+                        "  {name} = {:>12.6} ± {:.2e} (scale {:.2e})",
+                        j[k], sig[k], p[k]
+                    )?,
+                    None => writeln!(s, "  {name} = {:>12.6} ± {:.2e}", j[k], sig[k])?,
+                }
             }
         }
         if let Some(pm) = r.principal_moments {

@@ -36,6 +36,12 @@ pub struct PipelineSettings {
     /// Attach a standard deviation to each estimate where the estimator has an
     /// uncertainty model (default `true`; costs about 10 % of throughput).
     pub uncertainty: bool,
+    /// Relative standard deviation of the rotor momentum's scale, common to every wheel
+    /// (the wheels' spin inertia, or the speed-to-momentum factor, known to ±this): a
+    /// consider parameter that widens σ by `this · |ĵ|` per element ([`super::status`]),
+    /// since the momentum rows fix J's scale only as well as ρ's. `None` (default): ρ's
+    /// scale taken as exact.
+    pub rotor_scale_sigma: Option<f64>,
     /// Thresholds of the observability test.
     pub observability: ObservabilitySettings,
     /// Source of the incremental rotations (discrete momentum estimator). `None`
@@ -89,6 +95,7 @@ impl Default for PipelineSettings {
             memory_s: None,
             resample_s: None,
             gyro_noise_deg_s_rthz: None,
+            rotor_scale_sigma: None,
             uncertainty: true,
             observability: ObservabilitySettings::default(),
             rotation_source: None,
@@ -113,6 +120,7 @@ pub struct PipelineConfig {
     pub(crate) resample_s: Option<f64>,
     pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
     pub(crate) uncertainty: bool,
+    pub(crate) rotor_scale_sigma: Option<f64>,
     pub(crate) observability: ObservabilitySettings,
     pub(crate) rotation_source: Option<RotationSource>,
     pub(crate) rho_model: RhoModel,
@@ -172,6 +180,23 @@ impl PipelineSettings {
                 requirement: "on",
                 why: "the weighted rows' answer is given unless the unweighted rows' bias σ exceeds their noise σ",
             });
+        }
+        if let Some(r) = self.rotor_scale_sigma {
+            if !(r.is_finite() && (0.0..1.0).contains(&r)) {
+                return Err(PipelineError::InvalidSetting {
+                    field: "rotor_scale_sigma",
+                    value: r,
+                    expected: "a finite relative σ in [0, 1)",
+                });
+            }
+            if !(self.uncertainty && estimator.capabilities.uncertainty) {
+                return Err(PipelineError::NeedsSetting {
+                    setting: "rotor_scale_sigma",
+                    needs: "uncertainty",
+                    requirement: "on",
+                    why: "it widens σ, which the estimator must give",
+                });
+            }
         }
         if let Some(g) = self.gyro_noise_deg_s_rthz {
             if !(g.is_finite() && g >= 0.0) {
@@ -256,6 +281,7 @@ impl PipelineSettings {
             resample_s: self.resample_s,
             gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
             uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
+            rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
             observability: self.observability,
             rotation_source: self.rotation_source,
             rho_model: self.rho_model,
@@ -334,6 +360,12 @@ impl PipelineConfig {
     #[must_use]
     pub fn torque_bias(&self) -> bool {
         self.torque_bias
+    }
+
+    /// Relative σ of the rotor momentum's scale (a consider parameter), if any.
+    #[must_use]
+    pub fn rotor_scale_sigma(&self) -> Option<f64> {
+        self.rotor_scale_sigma
     }
 
     /// Whether an unknown constant inertial-frame torque is estimated.

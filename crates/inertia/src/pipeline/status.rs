@@ -23,7 +23,16 @@
 //!   right to its σ can be here when its σ is smaller than that). Within [`PHYSICAL_Z`] σ
 //!   the answer is consistent with a physical inertia at its accuracy and stays
 //!   determined (the report says so, [`physical_margin`]).
+//! * **What the user said.** A relative uncertainty of the rotor momentum's scale
+//!   ([`super::PipelineSettings::rotor_scale_sigma`], the wheels' spin inertia known to
+//!   ±r) is a consider parameter: σ is widened by `r |ĵ|` per element
+//!   ([`crate::estimator::uncertainty::Uncertainty::with_rotor_scale`]) before the rules
+//!   above are applied, and a determined answer whose widened relative σ
+//!   (`σ_F/‖Ĵ‖_F`) exceeds the observability threshold `max_relative_sigma` is not
+//!   determined ([`Unobservable::Uncertain`]): the data cannot give J's scale better than
+//!   the wheels'.
 
+use super::PipelineConfig;
 use crate::constraints::Consistency;
 use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::Estimate;
@@ -94,7 +103,36 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
     })
 }
 
-/// Apply the rule ([module docs](self)) to `e`, an answer under the consistency
+/// Apply every rule ([module docs](self)) to `e`, an answer of a run with `config`: the
+/// rotor scale's consider term where one is given ([`widen_for_rotor_scale`]), then
+/// [`settle`].
+pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
+    if let Some(r) = config.rotor_scale_sigma {
+        widen_for_rotor_scale(e, r, config.observability.max_relative_sigma);
+    }
+    settle(e, config.constraints().set().consistency);
+}
+
+/// Widen `e`'s σ by the rotor momentum's scale uncertainty `r` (relative) and take
+/// "determined" back where the widened relative σ `σ_F/‖Ĵ‖_F` exceeds `threshold`
+/// (module docs, "What the user said"); the answer is kept.
+pub fn widen_for_rotor_scale(e: &mut Estimate, r: f64, threshold: f64) {
+    let (Some(u), Some(j)) = (e.uncertainty, e.j()) else {
+        return;
+    };
+    let u = u.with_rotor_scale(&j, r);
+    e.uncertainty = Some(u);
+    let relative_sigma = u.frobenius_sigma_kg_m2() / matrix_from_j(&j).norm();
+    if matches!(e.observability, Observability::Determined { .. }) && !(relative_sigma <= threshold)
+    {
+        e.observability = Observability::NotObservable(Unobservable::Uncertain {
+            relative_sigma,
+            threshold,
+        });
+    }
+}
+
+/// Apply the status rules ([module docs](self)) to `e`, an answer under the consistency
 /// condition `consistency` (under [`Consistency::Physical`] the answer is physical by
 /// construction, to the solver's tolerance, and only the σ rule applies).
 pub fn settle(e: &mut Estimate, consistency: Consistency) {
