@@ -327,6 +327,9 @@ impl Plan {
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
             rotor_scale_sigma: self.rotor_scale_sigma,
+            // C has no estimator that filters (the equation-error baseline is not one of
+            // `InertiaEstimatorKind`).
+            filter_cutoff_hz: None,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,

@@ -407,6 +407,10 @@ pub struct EstimateArgs {
     /// σ then exceeds the threshold is not determined.
     #[arg(long, value_name = "P")]
     pub rotor_scale_sigma: Option<String>,
+    /// Low-pass cutoff, Hz, of the equation-error baseline's differentiating filter
+    /// (default: a twentieth of the sample rate).
+    #[arg(long, value_name = "HZ")]
+    pub filter_cutoff_hz: Option<f64>,
     /// How products of inertia are written in `--prior`, `--nominal` and `--bound Jij`
     /// (i ≠ j): `tensor` (J12 = −Σ m x y, this tool's convention) or `cad` (I_xy = +Σ m x y,
     /// what CAD tools report). Default tensor; a `--prior`/`--nominal` file's own

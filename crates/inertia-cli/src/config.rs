@@ -304,6 +304,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
             .as_deref()
             .map(|s| parse_fraction("--rotor-scale-sigma", s))
             .transpose()?,
+        filter_cutoff_hz: a.filter_cutoff_hz,
         max_chain_s: (a.chain != 0.0).then_some(a.chain),
         glitches: match a.glitches {
             GlitchArg::Stop => GlitchPolicy::Stop,
@@ -326,6 +327,7 @@ fn option_of(field: &str) -> &str {
         "torque_bias" => "--no-torque-bias",
         "inertial_torque" => "--inertial-torque",
         "rotor_scale_sigma" => "--rotor-scale-sigma",
+        "filter_cutoff_hz" => "--filter-cutoff-hz",
         "max_chain_s" => "--chain",
         "attitude_drift_deg_rth" => "--attitude-drift",
         other => other,

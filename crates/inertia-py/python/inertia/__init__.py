@@ -420,7 +420,7 @@ _SETTINGS = (
     "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
     "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
     "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque",
-    "rotor_scale_sigma", "chain",
+    "rotor_scale_sigma", "filter_cutoff_hz", "chain",
     "glitches",
     "solver", "uncertainty",
 )
@@ -469,6 +469,7 @@ def estimate(
     torque_bias: bool = True,
     inertial_torque: str = "off",
     rotor_scale_sigma: Optional[float] = None,
+    filter_cutoff_hz: Optional[float] = None,
     chain: float = 30.0,
     glitches: str = "stop",
     solver: str = "native",
@@ -533,6 +534,7 @@ def estimate(
             ``"on"`` or ``"auto"`` (a nested χ² test decides; ``report["row_model"]``).
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
+            filter_cutoff_hz: the equation-error baseline's low-pass cutoff, Hz.
             chain: momentum chain, s (0: chains end only at gaps). glitches: ``"stop"``
             or ``"keep"``. solver: ``"native"``. uncertainty: compute σ.
         batch: one batch solve instead of the recursive estimator (``--batch``).
@@ -628,6 +630,7 @@ class Estimator:
         torque_bias: bool = True,
         inertial_torque: str = "off",
         rotor_scale_sigma: Optional[float] = None,
+        filter_cutoff_hz: Optional[float] = None,
         chain: float = 30.0,
         glitches: str = "stop",
         solver: str = "native",

@@ -18,6 +18,7 @@ pub(crate) const MOMENTUM: EstimatorEntry = EstimatorEntry {
         compensation: false,
         uncertainty: false,
         row_model: false,
+        filter: false,
     },
     build,
     batch: None,

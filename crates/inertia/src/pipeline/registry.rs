@@ -100,6 +100,8 @@ pub struct Capabilities {
     pub uncertainty: bool,
     /// It takes the row-model settings (rotation source, model of ρ, torque bias).
     pub row_model: bool,
+    /// It differentiates low-pass-filtered signals (takes `filter_cutoff_hz`).
+    pub filter: bool,
 }
 
 impl Capabilities {

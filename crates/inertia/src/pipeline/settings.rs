@@ -42,6 +42,9 @@ pub struct PipelineSettings {
     /// since the momentum rows fix J's scale only as well as ρ's. `None` (default): ρ's
     /// scale taken as exact.
     pub rotor_scale_sigma: Option<f64>,
+    /// The low-pass cutoff, Hz, of an estimator that differentiates filtered signals (the
+    /// equation-error baseline). `None` (default): the estimator's own default.
+    pub filter_cutoff_hz: Option<f64>,
     /// Thresholds of the observability test.
     pub observability: ObservabilitySettings,
     /// Source of the incremental rotations (discrete momentum estimator). `None`
@@ -96,6 +99,7 @@ impl Default for PipelineSettings {
             resample_s: None,
             gyro_noise_deg_s_rthz: None,
             rotor_scale_sigma: None,
+            filter_cutoff_hz: None,
             uncertainty: true,
             observability: ObservabilitySettings::default(),
             rotation_source: None,
@@ -121,6 +125,7 @@ pub struct PipelineConfig {
     pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
     pub(crate) uncertainty: bool,
     pub(crate) rotor_scale_sigma: Option<f64>,
+    pub(crate) filter_cutoff_hz: Option<f64>,
     pub(crate) observability: ObservabilitySettings,
     pub(crate) rotation_source: Option<RotationSource>,
     pub(crate) rho_model: RhoModel,
@@ -195,6 +200,15 @@ impl PipelineSettings {
                     needs: "uncertainty",
                     requirement: "on",
                     why: "it widens σ, which the estimator must give",
+                });
+            }
+        }
+        if let Some(f) = self.filter_cutoff_hz {
+            positive("filter_cutoff_hz", Some(f), "a finite cutoff > 0 Hz")?;
+            if !estimator.capabilities.filter {
+                return Err(PipelineError::NotApplicable {
+                    setting: "filter_cutoff_hz",
+                    estimator: estimator.name,
                 });
             }
         }
@@ -282,6 +296,7 @@ impl PipelineSettings {
             gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
             uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
             rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
+            filter_cutoff_hz: self.filter_cutoff_hz,
             observability: self.observability,
             rotation_source: self.rotation_source,
             rho_model: self.rho_model,

@@ -81,6 +81,7 @@ pub(crate) const DISCRETE_MOMENTUM: EstimatorEntry = EstimatorEntry {
         compensation: true,
         uncertainty: true,
         row_model: true,
+        filter: false,
     },
     build,
     batch: Some(batch::run_batch),

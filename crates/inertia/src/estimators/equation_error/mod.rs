@@ -60,6 +60,7 @@ pub(crate) const EQUATION_ERROR: EstimatorEntry = EstimatorEntry {
         compensation: false,
         uncertainty: true,
         row_model: false,
+        filter: true,
     },
     build,
     batch: None,
@@ -351,6 +352,7 @@ fn settings(c: &PipelineConfig) -> Result<EquationErrorSettings, PipelineError> 
     }
     Ok(EquationErrorSettings {
         solve_every: c.solve_every,
+        cutoff_hz: c.filter_cutoff_hz,
         ..EquationErrorSettings::default()
     })
 }
