@@ -133,21 +133,7 @@ impl MomentumRls {
     pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         let index = self.samples;
         self.samples += 1;
-        let row_error = |source| EstimatorError::Row {
-            sample: index,
-            source,
-        };
-        let rate = s.omega_rad_s.ok_or(row_error(RowError::MissingGyroRate))?;
-        if !rate
-            .iter()
-            .chain(s.rho_nms.iter())
-            .chain(s.tau_nm.iter())
-            .all(|v| v.is_finite())
-        {
-            return Err(row_error(RowError::NonFinite {
-                what: "gyro rate, rotor momentum or torque",
-            }));
-        }
+        let rate = gyro_sample(s, index)?;
         let c = s.q.to_matrix();
         let out = if let Some((prev, prev_rate)) = self.prev {
             let dt = s.t_s - prev.t_s;
@@ -231,4 +217,27 @@ impl MomentumRls {
     pub fn initial_momentum(&self) -> Vector3<f64> {
         Vector3::new(self.x[6], self.x[7], self.x[8])
     }
+}
+
+/// The gyro rate of sample `index`, checking what an estimator of gyro rates uses: a rate
+/// present ([`RowError::MissingGyroRate`]) and finite time, rate, rotor momentum and
+/// torque ([`RowError::NonFinite`]).
+pub(crate) fn gyro_sample(s: &Sample, index: usize) -> Result<Vector3<f64>, EstimatorError> {
+    let row_error = |source| EstimatorError::Row {
+        sample: index,
+        source,
+    };
+    let rate = s.omega_rad_s.ok_or(row_error(RowError::MissingGyroRate))?;
+    if !rate
+        .iter()
+        .chain(s.rho_nms.iter())
+        .chain(s.tau_nm.iter())
+        .chain(core::iter::once(&s.t_s))
+        .all(|v| v.is_finite())
+    {
+        return Err(row_error(RowError::NonFinite {
+            what: "time, gyro rate, rotor momentum or torque",
+        }));
+    }
+    Ok(rate)
 }

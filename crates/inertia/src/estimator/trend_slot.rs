@@ -234,12 +234,14 @@ mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
 
-    /// A deterministic pseudo-random number in [−1, 1).
-    fn noise(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((*state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    /// The least-squares solution of the `rhs.len()` rows of `n` columns in `rows`
+    /// (row-major): its first `lead` unknowns and the residual sum of squares.
+    fn least_squares(rows: &[f64], rhs: Vec<f64>, n: usize, lead: usize) -> (DVector<f64>, f64) {
+        let a = DMatrix::from_row_slice(rhs.len(), n, rows);
+        let b = DVector::from_vec(rhs);
+        let x = a.clone().svd(true, true).solve(&b, 1e-14).expect("solve");
+        let rss = (&a * &x - &b).norm_squared();
+        (x.rows(0, lead).into_owned(), rss)
     }
 
     /// The filter's rows are the dense generalised least-squares problem: for blocks
@@ -253,20 +255,20 @@ mod tests {
         const N: usize = 4;
         for (drift, from) in [(0.0, 0), (0.3, 0), (0.3, 7)] {
             let blocks = 14;
-            let mut st = 11u64;
+            let mut rnd = crate::testing::uniform(11);
             let a: Vec<[SVector<f64, N>; 3]> = (0..blocks)
-                .map(|_| core::array::from_fn(|_| SVector::from_fn(|_, _| noise(&mut st))))
+                .map(|_| core::array::from_fn(|_| SVector::from_fn(|_, _| rnd())))
                 .collect();
             let b: Vec<[f64; 3]> = (0..blocks)
-                .map(|_| core::array::from_fn(|_| noise(&mut st)))
+                .map(|_| core::array::from_fn(|_| rnd()))
                 .collect();
             let mut s = vec![0.0];
             for k in 1..blocks {
-                s.push(s[k - 1] + 0.5 + 0.4 * noise(&mut st).abs());
+                s.push(s[k - 1] + 0.5 + 0.4 * rnd().abs());
             }
             let qs: Vec<Matrix3<f64>> = (0..blocks)
                 .map(|k| {
-                    let m = Matrix3::from_fn(|_, _| noise(&mut st)) * drift;
+                    let m = Matrix3::from_fn(|_, _| rnd()) * drift;
                     m * m.transpose() * f64::from(u8::from(k >= from))
                 })
                 .collect();
@@ -290,10 +292,7 @@ mod tests {
                     }
                 }
             }
-            let fa = DMatrix::from_row_slice(fb.len(), N, &fa);
-            let fb = DVector::from_vec(fb);
-            let f_y = fa.clone().svd(true, true).solve(&fb, 1e-14).expect("solve");
-            let f_rss = (&fa * &f_y - &fb).norm_squared();
+            let (f_y, f_rss) = least_squares(&fa, fb, N, N);
             // The dense problem: unknowns [y; X₀; τ; w_1..w_{K−1}], the w rows whitened
             // by their covariance (zero covariance: w fixed at zero, left out).
             let nw = 3 * drifting.len();
@@ -329,11 +328,7 @@ mod tests {
                     rhs.push(0.0);
                 }
             }
-            let da = DMatrix::from_row_slice(rhs.len(), n, &rows);
-            let db = DVector::from_vec(rhs);
-            let x = da.clone().svd(true, true).solve(&db, 1e-14).expect("solve");
-            let d_rss = (&da * &x - &db).norm_squared();
-            let d_y = x.rows(0, N).into_owned();
+            let (d_y, d_rss) = least_squares(&rows, rhs, n, N);
             assert!(
                 (f_y - &d_y).norm() < 1e-9 * d_y.norm(),
                 "drift {drift} from {from}"
@@ -355,16 +350,14 @@ mod tests {
         const N: usize = 3;
         for lambda in [0.7, 0.999] {
             let blocks = 12;
-            let mut st = 5u64;
+            let mut rnd = crate::testing::uniform(5);
             let a: Vec<[SVector<f64, N>; 3]> = (0..blocks)
-                .map(|_| core::array::from_fn(|_| SVector::from_fn(|_, _| noise(&mut st))))
+                .map(|_| core::array::from_fn(|_| SVector::from_fn(|_, _| rnd())))
                 .collect();
             let b: Vec<[f64; 3]> = (0..blocks)
-                .map(|_| core::array::from_fn(|_| noise(&mut st)))
+                .map(|_| core::array::from_fn(|_| rnd()))
                 .collect();
-            let s: Vec<f64> = (0..blocks)
-                .map(|k| k as f64 * 0.7 + 0.1 * noise(&mut st))
-                .collect();
+            let s: Vec<f64> = (0..blocks).map(|k| k as f64 * 0.7 + 0.1 * rnd()).collect();
             let (mut la, mut lb) = (a[0], b[0]);
             let mut trend = Trend::<N>::start(s[0]);
             let mut rows: Vec<(usize, [SVector<f64, N>; 3], [f64; 3])> = Vec::new();
@@ -385,10 +378,7 @@ mod tests {
                     fb.push(beta[m] * weight(*k));
                 }
             }
-            let fa = DMatrix::from_row_slice(fb.len(), N, &fa);
-            let fb = DVector::from_vec(fb);
-            let f_y = fa.clone().svd(true, true).solve(&fb, 1e-14).expect("solve");
-            let f_rss = (&fa * &f_y - &fb).norm_squared();
+            let (f_y, f_rss) = least_squares(&fa, fb, N, N);
             let n = N + 6;
             let (mut da, mut db): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
             for k in 0..blocks {
@@ -401,11 +391,7 @@ mod tests {
                     db.push(b[k][m] * weight(k));
                 }
             }
-            let da = DMatrix::from_row_slice(db.len(), n, &da);
-            let db = DVector::from_vec(db);
-            let x = da.clone().svd(true, true).solve(&db, 1e-14).expect("solve");
-            let d_rss = (&da * &x - &db).norm_squared();
-            let d_y = x.rows(0, N).into_owned();
+            let (d_y, d_rss) = least_squares(&da, db, n, N);
             assert!((f_y - &d_y).norm() < 1e-9 * d_y.norm(), "λ {lambda}");
             assert!((f_rss - d_rss).abs() < 1e-9 * d_rss, "λ {lambda}");
         }

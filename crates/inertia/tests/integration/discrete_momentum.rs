@@ -68,6 +68,32 @@ fn paper_rows_are_rotated_differences_of_interval_momenta() {
     }
 }
 
+/// The paper's slew with `common`'s noise and an external torque `torque(t, state)`
+/// (body axes, N m) acting on it and left out of the telemetry.
+pub(crate) fn slew_with_hidden_torque(
+    common: &Common,
+    torque: impl Fn(f64, &GyrostatState) -> Vector3<f64> + Send + Sync + 'static,
+) -> inertia::sim::SimOutput {
+    let sc = Scenario::slew();
+    let cfg = sc.config(common);
+    let Scenario::Slew(plan) = &sc else {
+        unreachable!()
+    };
+    let ctrl = inertia::sim::control::SlewController::new(
+        plan.nominal_inertia_kg_m2,
+        cfg.initial.q,
+        plan.slews.clone(),
+        plan.natural_freq_rad_s,
+        plan.damping,
+    )
+    .expect("controller");
+    let mut run = simulate(&cfg, &ctrl, &torque).expect("sim");
+    for s in &mut run.samples {
+        s.tau_nm = Vector3::zeros();
+    }
+    run
+}
+
 /// The paper's slew for its first `duration_s`, with `common`'s noise.
 pub(crate) fn slew_for(duration_s: f64, common: Common) -> inertia::sim::SimOutput {
     Scenario::slew()
@@ -215,25 +241,7 @@ fn recovers_j_on_the_paper_scenarios_without_gyro_noise() {
 fn an_unknown_constant_torque_is_estimated_and_does_not_bias_j() {
     // Simulate with a constant torque, then hide it from the telemetry.
     let tau_b = Vector3::new(1e-5, -2e-5, 1.5e-5);
-    let sc = Scenario::slew();
-    let common = Common::noise_free();
-    let cfg = sc.config(&common);
-    let Scenario::Slew(plan) = &sc else {
-        unreachable!()
-    };
-    let ctrl = inertia::sim::control::SlewController::new(
-        plan.nominal_inertia_kg_m2,
-        cfg.initial.q,
-        plan.slews.clone(),
-        plan.natural_freq_rad_s,
-        plan.damping,
-    )
-    .expect("controller");
-    let constant = move |_t: f64, _x: &GyrostatState| tau_b;
-    let mut run = simulate(&cfg, &ctrl, &constant).expect("sim");
-    for s in &mut run.samples {
-        s.tau_nm = Vector3::zeros();
-    }
+    let run = slew_with_hidden_torque(&Common::noise_free(), move |_, _| tau_b);
     let rows = |torque_bias| MomentumRowSettings {
         stencil: Stencil::Smooth,
         torque_bias,

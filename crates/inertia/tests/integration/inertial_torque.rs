@@ -6,38 +6,23 @@
 use inertia::dynamics::GyrostatState;
 use inertia::estimator::momentum_rows::{MomentumRowSettings, Stencil};
 use inertia::pipeline::{self, InertialTorque, Pipeline, PipelineSettings};
-use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::simulate;
+use inertia::sim::scenario::Common;
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::Vector3;
 
-use crate::discrete_momentum::{assert_recursive_matches_batch, final_error, slew_for};
+use crate::discrete_momentum::{
+    assert_recursive_matches_batch, final_error, slew_for, slew_with_hidden_torque,
+};
 
-/// The paper's slew, noise-free, with a constant torque fixed in the inertial frame
-/// (`C τ_body = τ_I`) acting and left out of the telemetry.
+/// The paper's slew with `common`'s noise and a constant torque fixed in the inertial
+/// frame (`C τ_body = τ_I`) acting and left out of the telemetry.
 fn slew_with_inertial_torque(
     tau_inertial_nm: Vector3<f64>,
     common: &Common,
 ) -> inertia::sim::SimOutput {
-    let sc = Scenario::slew();
-    let cfg = sc.config(common);
-    let Scenario::Slew(plan) = &sc else {
-        unreachable!()
-    };
-    let ctrl = inertia::sim::control::SlewController::new(
-        plan.nominal_inertia_kg_m2,
-        cfg.initial.q,
-        plan.slews.clone(),
-        plan.natural_freq_rad_s,
-        plan.damping,
-    )
-    .expect("controller");
-    let inertial = move |_t: f64, x: &GyrostatState| x.q.conjugate().rotate(&tau_inertial_nm);
-    let mut run = simulate(&cfg, &ctrl, &inertial).expect("sim");
-    for s in &mut run.samples {
-        s.tau_nm = Vector3::zeros();
-    }
-    run
+    slew_with_hidden_torque(common, move |_t: f64, x: &GyrostatState| {
+        x.q.conjugate().rotate(&tau_inertial_nm)
+    })
 }
 
 /// Problem: the slew with a hidden inertial torque of 2–3e-5 N m (about the body-frame

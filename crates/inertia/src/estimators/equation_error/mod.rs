@@ -36,7 +36,8 @@ pub(crate) mod filter;
 mod tests;
 
 use crate::attitude::skew;
-use crate::discrete::{g_matrix, RowError};
+use crate::discrete::g_matrix;
+use crate::estimator::momentum::gyro_sample;
 use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::registry::{Capabilities, Estimator, EstimatorEntry};
@@ -153,22 +154,7 @@ impl EquationError {
     pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         let index = self.samples;
         self.samples += 1;
-        let row_error = |source| EstimatorError::Row {
-            sample: index,
-            source,
-        };
-        let rate = s.omega_rad_s.ok_or(row_error(RowError::MissingGyroRate))?;
-        if !rate
-            .iter()
-            .chain(s.rho_nms.iter())
-            .chain(s.tau_nm.iter())
-            .chain(core::iter::once(&s.t_s))
-            .all(|v| v.is_finite())
-        {
-            return Err(row_error(RowError::NonFinite {
-                what: "time, gyro rate, rotor momentum or torque",
-            }));
-        }
+        let rate = gyro_sample(s, index)?;
         let theta = match (self.window.back().copied(), self.last_rate) {
             (Some(prev), Some(prev_rate)) => {
                 let step = s.t_s - prev.t_s;

@@ -3,6 +3,7 @@
 
 use super::filter::SavitzkyGolay;
 use super::*;
+use crate::discrete::RowError;
 use crate::sim::presets::{LabEffect, Preset};
 use crate::sim::SimOutput;
 use crate::tensor::{matrix_from_j, relative_frobenius_error};
