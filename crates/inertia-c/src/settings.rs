@@ -333,6 +333,9 @@ impl Plan {
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches,
+            // The wheel-speed time tag needs the whole record before the first estimate:
+            // not in the C API, which estimates as samples arrive.
+            wheel_delay: inertia::estimator::wheel_delay::WheelDelay::Off,
         }
     }
 

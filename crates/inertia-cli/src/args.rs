@@ -473,6 +473,18 @@ pub struct EstimateArgs {
     #[arg(long, value_name = "MODE", default_value = "off",
           value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
     pub inertial_torque: String,
+    /// The wheel-speed telemetry's time tag: the speeds are read δ later than their time
+    /// stamps. `off` (default), the delay in seconds (e.g. `0.05`; negative: early), or
+    /// `estimate` (the residuals' minimum over ±min(0.25 s, a tenth of the record), with
+    /// σ; its σ widens each element's). Any estimator; the run then estimates once, at
+    /// the end of the input. Speeds held between updates lag by half the update period.
+    #[arg(
+        long,
+        value_name = "S|estimate",
+        default_value = "off",
+        allow_hyphen_values = true
+    )]
+    pub wheel_delay: String,
     /// Short momentum chain, s (discrete-momentum estimator): the conserved momentum is
     /// re-anchored after this long, which bounds the effect of a drifting attitude
     /// (gyro-propagated attitude); chains a quarter and 4x as long and one chain over the

@@ -299,6 +299,8 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         },
         torque_bias: !a.no_torque_bias,
         inertial_torque: a.inertial_torque.parse().map_err(settings_error)?,
+        wheel_delay: inertia::pipeline::parse_wheel_delay(&a.wheel_delay)
+            .map_err(settings_error)?,
         rotor_scale_sigma: a
             .rotor_scale_sigma
             .as_deref()
@@ -326,6 +328,7 @@ fn option_of(field: &str) -> &str {
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",
         "inertial_torque" => "--inertial-torque",
+        "wheel_delay" => "--wheel-delay",
         "rotor_scale_sigma" => "--rotor-scale-sigma",
         "filter_cutoff_hz" => "--filter-cutoff-hz",
         "max_chain_s" => "--chain",

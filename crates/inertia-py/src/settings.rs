@@ -118,6 +118,23 @@ impl<'py> Kwargs<'py> {
             .map(|v| v.unwrap_or(default))
     }
 
+    /// A value given as a string or a number, as text (a number's shortest repr).
+    pub fn text_or_number(&self, name: &str) -> PyResult<Option<String>> {
+        self.take(name)?
+            .map(|v| {
+                if v.is_instance_of::<PyString>() {
+                    return v.extract::<String>();
+                }
+                v.extract::<f64>().map(|x| format!("{x:?}")).map_err(|_| {
+                    type_error(format!(
+                        "{name}: expected a string or a number, got {}",
+                        type_name(&v)
+                    ))
+                })
+            })
+            .transpose()
+    }
+
     pub fn string(&self, name: &str) -> PyResult<Option<String>> {
         self.take(name)?
             .map(|v| {
@@ -520,6 +537,11 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
                 .parse()
                 .map_err(|e: PipelineError| value_error(e.to_string()))?,
             None => InertialTorque::default(),
+        },
+        wheel_delay: match kw.text_or_number("wheel_delay")? {
+            Some(t) => inertia::pipeline::parse_wheel_delay(&t)
+                .map_err(|e: PipelineError| value_error(e.to_string()))?,
+            None => Default::default(),
         },
         max_chain_s: (chain != 0.0).then_some(chain),
         glitches: match kw.choice("glitches", &["stop", "keep"])? {

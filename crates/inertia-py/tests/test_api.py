@@ -311,3 +311,23 @@ def test_rotor_scale_sigma_widens_sigma_and_inertial_torque_is_a_setting(slew):
         inertia.estimate(tel, inertial_torque="sometimes")
     with pytest.raises(ValueError, match="rotor_scale_sigma"):
         inertia.estimate(tel, rotor_scale_sigma=1.5)
+
+
+def test_wheel_delay_shifts_the_speeds_and_is_reported(slew):
+    """The wheel speeds' time tag: off by default; given, the report says so; estimated
+    on on-time data, it is near zero (within 3σ) and its σ widens each element's."""
+    tel, _ = slew
+    base = inertia.estimate(tel)
+    assert base.report["wheel_delay"] is None
+    given = inertia.estimate(tel, wheel_delay=0.01)
+    assert given.report["wheel_delay"]["delay_s"] == 0.01
+    assert not given.report["wheel_delay"]["estimated"]
+    assert not np.array_equal(given.j, base.j)
+    est = inertia.estimate(tel, wheel_delay="estimate")
+    d = est.report["wheel_delay"]
+    assert d["estimated"] and abs(d["delay_s"]) <= 3 * d["sigma_s"]
+    assert np.all(est.sigma >= base.sigma * (1 - 1e-9))
+    with pytest.raises(ValueError, match="wheel_delay"):
+        inertia.estimate(tel, wheel_delay="late")
+    with pytest.raises(TypeError, match="wheel_delay"):
+        inertia.Estimator(wheel_delay=0.01)

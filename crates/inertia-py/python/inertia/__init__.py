@@ -420,10 +420,12 @@ _SETTINGS = (
     "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
     "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
     "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque",
-    "rotor_scale_sigma", "filter_cutoff_hz", "chain",
+    "rotor_scale_sigma", "filter_cutoff_hz", "chain", "wheel_delay",
     "glitches",
     "solver", "uncertainty",
 )
+#: What :class:`Estimator` takes: the time tag of the wheel speeds needs the whole record.
+_STREAM_SETTINGS = tuple(n for n in _SETTINGS if n != "wheel_delay")
 #: How the data are read.
 _CONVENTIONS = (
     "scalar_first", "jpl", "conjugate", "gyro_unit", "negate_rho", "unit_tolerance",
@@ -471,6 +473,7 @@ def estimate(
     rotor_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
     chain: float = 30.0,
+    wheel_delay: Union[None, str, float] = None,
     glitches: str = "stop",
     solver: str = "native",
     uncertainty: bool = True,
@@ -535,7 +538,10 @@ def estimate(
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
             filter_cutoff_hz: the equation-error baseline's low-pass cutoff, Hz.
-            chain: momentum chain, s (0: chains end only at gaps). glitches: ``"stop"``
+            wheel_delay: the wheel speeds' time tag: ``None`` (off), the delay in s
+            (the speeds are read that much later), or ``"estimate"`` (with σ, which widens
+            each element's; ``report["wheel_delay"]``). chain: momentum chain, s (0:
+            chains end only at gaps). glitches: ``"stop"``
             or ``"keep"``. solver: ``"native"``. uncertainty: compute σ.
         batch: one batch solve instead of the recursive estimator (``--batch``).
         history: keep every estimate (``Estimate.history``, the CLI's ``-o``).
@@ -643,7 +649,7 @@ class Estimator:
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> None:
-        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_SETTINGS, *_CONVENTIONS)))
+        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_STREAM_SETTINGS, *_CONVENTIONS)))
 
     def push(self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
         """Push one sample: ``t`` s, ``q`` (4,), ``rho`` (3,) N m s, ``tau`` (3,) N m,

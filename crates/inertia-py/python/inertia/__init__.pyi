@@ -124,6 +124,7 @@ def estimate(
     rotor_scale_sigma: Optional[float] = ...,
     filter_cutoff_hz: Optional[float] = ...,
     chain: float = ...,
+    wheel_delay: Union[None, str, float] = ...,
     glitches: str = ...,
     solver: str = ...,
     uncertainty: bool = ...,

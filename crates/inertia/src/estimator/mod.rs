@@ -35,6 +35,8 @@ pub mod shared_qr;
 pub mod svd_tracker;
 pub mod trend_slot;
 pub mod uncertainty;
+#[cfg(feature = "std")]
+pub mod wheel_delay;
 
 use crate::discrete::RowError;
 use crate::solver::{Solution, SolveError};

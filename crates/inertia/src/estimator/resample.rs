@@ -24,7 +24,7 @@ pub struct Resampler {
     next_t: Option<f64>,
 }
 
-fn lagrange_weights(t: &[f64; 4], x: f64) -> [f64; 4] {
+pub(crate) fn lagrange_weights(t: &[f64; 4], x: f64) -> [f64; 4] {
     core::array::from_fn(|i| {
         let mut w = 1.0;
         for (k, tk) in t.iter().enumerate() {

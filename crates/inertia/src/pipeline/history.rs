@@ -310,6 +310,7 @@ mod tests {
             noise_kg_m2: [0.0; 6],
             bias_kg_m2: [0.0; 6],
             rotor_scale_kg_m2: [0.0; 6],
+            time_tag_kg_m2: [0.0; 6],
             principal_sigma_kg_m2: [0.0; 3],
         });
         let mut out = std::vec::Vec::new();

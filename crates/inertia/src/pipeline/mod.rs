@@ -61,7 +61,9 @@ pub use checks::AttitudeChecks;
 pub use registry::{BatchOutput, Capabilities, Estimator};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
 pub use sdp::Constrained;
-pub use settings::{InertialTorque, PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S};
+pub use settings::{
+    parse_wheel_delay, InertialTorque, PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S,
+};
 
 use crate::constraints::ConstraintError;
 use crate::estimator::excitation::Excitation;

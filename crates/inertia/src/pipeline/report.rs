@@ -106,6 +106,10 @@ pub struct Report {
     /// Its part from the wheel momentum's stated scale uncertainty (a consider parameter,
     /// `rotor_scale_sigma`), kg m²; `null` without one.
     pub rotor_scale_sigma_kg_m2: Option<[f64; 6]>,
+    /// The wheel-speed time tag applied ([`crate::estimator::wheel_delay`]): `δ` with its
+    /// σ, whether estimated, and its consider part of `sigma` per element, kg m²;
+    /// `null` without one.
+    pub wheel_delay: Option<WheelDelayEntry>,
     /// Principal moments, ascending, kg m².
     pub principal_moments: Option<[f64; 3]>,
     /// Their standard deviations, kg m².
@@ -154,6 +158,8 @@ pub struct Report {
     /// ([`Warning`]). None contradicts the status ([`super::status`]).
     pub warnings: std::vec::Vec<WarningEntry>,
     #[serde(skip)]
+    wheel_delay_error: Option<crate::estimator::wheel_delay::DelayError>,
+    #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
     physical: Option<PhysicalMargin>,
@@ -175,6 +181,22 @@ pub enum Warning {
     AttitudeGyroDisagree(f64),
     /// What the excitation report advises.
     Excitation(String),
+    /// The wheel-speed time tag was to be estimated and could not be: the speeds were
+    /// read as time-tagged.
+    WheelDelayNotEstimated(crate::estimator::wheel_delay::DelayError),
+}
+
+/// The wheel-speed time tag as the report carries it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WheelDelayEntry {
+    /// `δ`, s: the speeds were read this much later than their time stamps.
+    pub delay_s: f64,
+    /// Its standard deviation, s (zero when given).
+    pub sigma_s: f64,
+    /// Whether it was estimated from the data.
+    pub estimated: bool,
+    /// Its consider part of σ per element, `|∂ĵ/∂δ| σ_δ`, kg m².
+    pub sigma_kg_m2: [f64; 6],
 }
 
 /// A [`Warning`] as the JSON report carries it.
@@ -195,6 +217,7 @@ impl Warning {
             Warning::SpanStandsOut(..) => "span_stands_out",
             Warning::AttitudeGyroDisagree(_) => "attitude_gyro_disagree",
             Warning::Excitation(_) => "excitation",
+            Warning::WheelDelayNotEstimated(_) => "wheel_delay_not_estimated",
         }
     }
 }
@@ -238,6 +261,9 @@ impl fmt::Display for Warning {
                 "the attitude and the gyro rates disagree (median relative mismatch of the body rates {m:.2}) and no reading of the quaternions or the rates fits: different frames, time tags or units"
             ),
             Warning::Excitation(a) => f.write_str(a),
+            Warning::WheelDelayNotEstimated(e) => {
+                write!(f, "{e}; the wheel speeds are read as time-tagged")
+            }
         }
     }
 }
@@ -310,6 +336,8 @@ impl Report {
             drift_weighted: None,
             attitude_is_gyro_integral: None,
             warnings: std::vec::Vec::new(),
+            wheel_delay: None,
+            wheel_delay_error: None,
             observability: estimate.observability,
             physical: super::status::physical_margin(estimate),
             attitude: None,
@@ -340,7 +368,36 @@ impl Report {
         if let Some(x) = &self.excitation {
             w.extend(x.advice.iter().cloned().map(Warning::Excitation));
         }
+        if let Some(e) = self.wheel_delay_error {
+            w.push(Warning::WheelDelayNotEstimated(e));
+        }
         w
+    }
+
+    /// With the wheel-speed time tag the run applied, or why it could not be estimated.
+    #[must_use]
+    pub fn with_wheel_delay(
+        mut self,
+        delay: Option<
+            &Result<
+                crate::estimator::wheel_delay::DelayFit,
+                crate::estimator::wheel_delay::DelayError,
+            >,
+        >,
+    ) -> Self {
+        match delay {
+            Some(Ok(f)) => {
+                self.wheel_delay = Some(WheelDelayEntry {
+                    delay_s: f.delay_s,
+                    sigma_s: f.sigma_s,
+                    estimated: f.estimated,
+                    sigma_kg_m2: f.consider_kg_m2(),
+                });
+            }
+            Some(Err(e)) => self.wheel_delay_error = Some(*e),
+            None => {}
+        }
+        self.refreshed()
     }
 
     fn attitude_disagreement(&self) -> Option<f64> {

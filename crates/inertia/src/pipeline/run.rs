@@ -20,6 +20,7 @@
 
 use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError, MAX_RESAMPLE_FACTOR};
 use crate::error_kind::ErrorKind;
+use crate::estimator::wheel_delay::{self, DelayError, DelayFit, WheelDelay};
 use crate::estimator::Estimate;
 use crate::fix::Fix;
 use crate::sample::Sample;
@@ -226,6 +227,11 @@ pub struct Run {
     /// `(time, index)` of the last [`RECENT`] samples.
     recent: VecDeque<(f64, usize)>,
     stopped: Option<std::string::String>,
+    /// Streaming with a wheel-speed time tag to apply: the samples, kept until
+    /// [`Self::finish`] reads the speeds `δ` later ([`crate::estimator::wheel_delay`]).
+    held: Option<Vec<Sample>>,
+    /// The time tag applied at [`Self::finish`], or why it could not be estimated.
+    delay: Option<Result<DelayFit, DelayError>>,
 }
 
 impl core::fmt::Debug for Run {
@@ -259,6 +265,8 @@ impl Run {
             order: Order::default(),
             recent: VecDeque::with_capacity(RECENT),
             stopped: None,
+            held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
+            delay: None,
         })
     }
 
@@ -332,6 +340,10 @@ impl Run {
         }
         self.recent.push_back((s.t_s, index));
         self.input += 1;
+        if let Some(held) = &mut self.held {
+            held.push(*s);
+            return Ok(());
+        }
         match &mut self.mode {
             Mode::Batch { samples, .. } => {
                 samples.push(*s);
@@ -370,6 +382,32 @@ impl Run {
                 read,
             },
         };
+        if let Some(mut held) = self.held.take() {
+            self.apply_delay(&mut held);
+            let Mode::Streaming(p) = &mut self.mode else {
+                unreachable!("only a streaming run holds its samples")
+            };
+            **p = Pipeline::from_config(self.config).map_err(|e| RunError {
+                sample: None,
+                kind: RunErrorKind::Pipeline(e),
+            })?;
+            for (index, s) in held.iter().enumerate() {
+                if let Err(e) = p.push_each(s, &mut on_estimate) {
+                    let e = RunError::at(index, RunErrorKind::Pipeline(e));
+                    self.stopped = Some(std::string::ToString::to_string(&e));
+                    return Err(e);
+                }
+            }
+        }
+        if let Mode::Batch { samples, out: None } = &mut self.mode {
+            if self.config.wheel_delay != WheelDelay::Off && self.delay.is_none() {
+                let mut taken = core::mem::take(samples);
+                self.apply_delay(&mut taken);
+                if let Mode::Batch { samples, .. } = &mut self.mode {
+                    *samples = taken;
+                }
+            }
+        }
         match &mut self.mode {
             Mode::Streaming(p) => match p.last() {
                 Some(_) => Ok(()),
@@ -401,6 +439,30 @@ impl Run {
                 Ok(())
             }
         }
+    }
+
+    /// Find or take the wheel-speed time tag and read the speeds of `samples` that much
+    /// later; its consider term goes into the configuration ([`super::status`]). A tag
+    /// that cannot be estimated is left at zero, and the reason kept
+    /// ([`Self::wheel_delay`]).
+    fn apply_delay(&mut self, samples: &mut [Sample]) {
+        let fit = match self.config.wheel_delay {
+            WheelDelay::Off => return,
+            WheelDelay::KnownS(d) => Ok(DelayFit::known(d)),
+            WheelDelay::Estimate => wheel_delay::estimate(samples),
+        };
+        if let Ok(f) = &fit {
+            wheel_delay::shift_rho(samples, f.delay_s);
+            self.config.wheel_delay_consider = Some(f.consider_kg_m2());
+        }
+        self.delay = Some(fit);
+    }
+
+    /// The wheel-speed time tag applied (`None` without one asked, or before
+    /// [`Self::finish`]), or why it could not be estimated.
+    #[must_use]
+    pub fn wheel_delay(&self) -> Option<&Result<DelayFit, DelayError>> {
+        self.delay.as_ref()
     }
 
     /// Input samples accepted.
@@ -456,13 +518,17 @@ impl Run {
                 super::report::Report::of_batch(out.as_ref()?, &self.config, samples.len())
             }
         };
-        Some(report.with_input(super::report::InputSummary {
-            file: file.into(),
-            sample_period_s: self.sample_period_s(),
-            renormalised: stats.renormalised,
-            sign_flips: stats.sign_flips,
-            min_step_s: stats.min_step_s,
-            max_step_s: stats.max_step_s,
-        }))
+        Some(
+            report
+                .with_wheel_delay(self.delay.as_ref())
+                .with_input(super::report::InputSummary {
+                    file: file.into(),
+                    sample_period_s: self.sample_period_s(),
+                    renormalised: stats.renormalised,
+                    sign_flips: stats.sign_flips,
+                    min_step_s: stats.min_step_s,
+                    max_step_s: stats.max_step_s,
+                }),
+        )
     }
 }

@@ -6,6 +6,7 @@ use super::PipelineError;
 use crate::constraints::{ConstraintSet, Constraints};
 use crate::estimator::momentum_rows::{RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
+use crate::estimator::wheel_delay::{self, WheelDelay};
 use crate::telemetry::glitch::GlitchPolicy;
 
 /// Settings of an estimation run. Every field has a documented default
@@ -83,6 +84,11 @@ pub struct PipelineSettings {
     /// ([`crate::telemetry::glitch`]; telemetry with gyro rates). Default
     /// [`GlitchPolicy::Stop`].
     pub glitches: GlitchPolicy,
+    /// The wheel-speed telemetry's time tag ([`crate::estimator::wheel_delay`]): the
+    /// speeds are read `δ` later than their time stamps, `δ` given or estimated, and its
+    /// σ widens the answer's (a consider term). Any estimator. The run then keeps every
+    /// sample and estimates at the end of the input. Default [`WheelDelay::Off`].
+    pub wheel_delay: WheelDelay,
 }
 
 /// Default longest momentum chain, s.
@@ -109,6 +115,7 @@ impl Default for PipelineSettings {
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
             glitches: GlitchPolicy::Stop,
+            wheel_delay: WheelDelay::Off,
         }
     }
 }
@@ -134,6 +141,9 @@ pub struct PipelineConfig {
     pub(crate) max_chain_s: Option<f64>,
     pub(crate) attitude_drift_deg_rth: Option<f64>,
     pub(crate) glitches: GlitchPolicy,
+    pub(crate) wheel_delay: WheelDelay,
+    /// The time tag's consider term per element, kg m², once a run has applied it.
+    pub(crate) wheel_delay_consider: Option<[f64; 6]>,
 }
 
 fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
@@ -269,6 +279,15 @@ impl PipelineSettings {
                 why: "the test that chooses the torque needs unweighted rows (give on or off with a memory)",
             });
         }
+        if let WheelDelay::KnownS(d) = self.wheel_delay {
+            if !(d.is_finite() && d.abs() <= wheel_delay::MAX_HALF_RANGE_S) {
+                return Err(PipelineError::InvalidSetting {
+                    field: "wheel_delay",
+                    value: d,
+                    expected: "a finite time tag of at most 0.25 s either way",
+                });
+            }
+        }
         let constraints = self.constraints.validate()?;
         // The observability thresholds are checked by the estimators' own settings.
         let o = &self.observability;
@@ -305,6 +324,8 @@ impl PipelineSettings {
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift_deg_rth,
             glitches: self.glitches,
+            wheel_delay: self.wheel_delay,
+            wheel_delay_consider: None,
         })
     }
 }
@@ -446,6 +467,16 @@ impl InertialTorque {
             InertialTorque::Auto => "auto",
         }
     }
+}
+
+/// The wheel-speed time tag setting from its text: `off`, `estimate`, or the delay in
+/// seconds ([`WheelDelay`]).
+pub fn parse_wheel_delay(s: &str) -> Result<WheelDelay, PipelineError> {
+    s.trim().parse().map_err(|()| PipelineError::UnknownChoice {
+        setting: "wheel_delay",
+        value: s.into(),
+        expected: "off, estimate, or the delay in seconds",
+    })
 }
 
 impl core::str::FromStr for InertialTorque {

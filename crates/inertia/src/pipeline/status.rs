@@ -104,9 +104,15 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 }
 
 /// Apply every rule ([module docs](self)) to `e`, an answer of a run with `config`: the
-/// rotor scale's consider term where one is given ([`widen_for_rotor_scale`]), then
-/// [`settle`].
+/// wheel-speed time tag's consider term where one was applied
+/// ([`crate::estimator::wheel_delay`]), the rotor scale's where one is given
+/// ([`widen_for_rotor_scale`]), then [`settle`].
 pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
+    if let Some(c) = config.wheel_delay_consider {
+        if let (Some(u), Some(j)) = (e.uncertainty, e.j()) {
+            e.uncertainty = Some(u.with_time_tag(&j, &c));
+        }
+    }
     if let Some(r) = config.rotor_scale_sigma {
         widen_for_rotor_scale(e, r, config.observability.max_relative_sigma);
     }

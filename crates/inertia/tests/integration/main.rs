@@ -27,3 +27,4 @@ mod sim_realism;
 mod solver_agreement;
 mod solver_random;
 mod uncertainty;
+mod wheel_delay;

@@ -160,6 +160,19 @@ impl fmt::Display for ReportText<'_> {
                 p.threshold()
             )?;
         }
+        if let Some(d) = r.wheel_delay {
+            let how = if d.estimated {
+                format!(
+                    "estimated: {:.3e} ± {:.1e} s, its σ in each element's σ up to {:.1e} kg m²",
+                    d.delay_s,
+                    d.sigma_s,
+                    d.sigma_kg_m2.iter().fold(0.0f64, |a, &b| a.max(b))
+                )
+            } else {
+                format!("given: {:.3e} s", d.delay_s)
+            };
+            writeln!(s, "wheel speeds read later than time-tagged by δ ({how})")?;
+        }
         if let Some(t) = r.torque_bias_nm {
             let test = r
                 .torque_test

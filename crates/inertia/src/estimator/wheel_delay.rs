@@ -1,0 +1,491 @@
+//! The wheel-speed telemetry's time tag: `ρ` telemetered `δ` late, `ρ_meas(t) = ρ(t − δ)`,
+//! known or estimated, and the consider term its uncertainty adds to σ (issue #31).
+//!
+//! # Why a shift and not a column
+//!
+//! To first order `ρ(t) = ρ_meas(t + δ) ≈ ρ_meas(t) + δ ρ̇(t)`, so `δ` could be one more
+//! unknown of the momentum rows ([`crate::discrete_momentum`]) with the column
+//! `C_k N(φ_k) ρ̇̄_k`. But wheel speeds are often held between telemetry updates (a
+//! staircase), whose `ρ̇` is a train of spikes: the column must then come from a smoothed
+//! `ρ̇`, and on the lab throw ([`crate::sim::presets`], speed held at 100 Hz, so 5 ms late
+//! on average) the rows corrected by `5 ms × ρ̇` smoothed over four updates are 2.7e-3
+//! off, against 5e-4 for the same rows with `ρ` read 5 ms later by interpolation: the
+//! estimate leans on the spin-up's corners, where a smoothed `ρ̇` is wrong. So the time
+//! tag is applied exactly, as a shift of the speed telemetry ([`shift_rho`]), and
+//! estimated by profiling ([`estimate`]).
+//!
+//! # The profile
+//!
+//! For each trial `δ` the record's `ρ` is read at `t + δ` (the cubic through the four
+//! nearest samples, held at the record's ends) and the plain discrete momentum rows are fitted by
+//! least squares in `[τ_b; j]`, with each chain's initial momentum `L̄₀` and a torque
+//! fixed in the inertial frame `τ_I` minimised out per chain
+//! ([`crate::estimator::momentum_rows`], "Inertial torque"): a disturbance of either kind
+//! must not pass for a time tag. `δ̂` minimises the residual sum of squares `RSS(δ)`: on
+//! a grid of [`GRID`] steps each side over `±H`, `H = min(`[`MAX_HALF_RANGE_S`]`, T/10)`
+//! for a record of `T` s, refined by golden section within a grid step of the best
+//! node. Only rows whose samples keep `t ± H` inside the record are fitted, so every
+//! trial fits the same rows.
+//!
+//! # σ
+//!
+//! `δ̂`'s standard deviation is the sandwich over time blocks: with `r_k` the rows'
+//! residuals at `δ̂` and `d_k = ∂r_k/∂δ` with `[τ_b; j]` and each chain's unknowns
+//! minimised out (the least-squares residual of the column `d` on the same regressors),
+//! `var δ̂ = B/(B−1) · Σ_b (Σ_{k∈b} d_k r_k)² / (Σ_k d_k²)²` over `B` = [`BLOCKS`]
+//! contiguous blocks of rows, so residuals correlated within a block count once. Its
+//! effect on the answer, the consider term, is `|∂ĵ/∂δ| σ_δ` per element, `∂ĵ/∂δ` from
+//! the same fit at `δ̂ ± ` a tenth of a grid step ([`DelayFit::consider_kg_m2`]).
+
+use crate::attitude::incremental_rotation;
+use crate::discrete_momentum::IntervalMomentum;
+use crate::sample::{is_gap, Sample};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use std::vec::Vec;
+
+/// Largest time tag searched, s, each side of zero.
+pub const MAX_HALF_RANGE_S: f64 = 0.25;
+
+/// Grid steps each side of zero in the search.
+pub const GRID: usize = 20;
+
+/// Contiguous blocks of rows in the sandwich σ of `δ̂`.
+pub const BLOCKS: usize = 16;
+
+/// What the run knows of the wheel-speed telemetry's time tag.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum WheelDelay {
+    /// Taken as right (default).
+    #[default]
+    Off,
+    /// Known: `ρ` telemetered this many seconds late (negative: early).
+    KnownS(f64),
+    /// Estimated from the data ([`estimate`]).
+    Estimate,
+}
+
+impl WheelDelay {
+    /// The names a front end accepts besides a number of seconds.
+    pub const NAMES: [&'static str; 2] = ["off", "estimate"];
+}
+
+impl core::str::FromStr for WheelDelay {
+    type Err = ();
+
+    /// `off`, `estimate`, or the delay in seconds (finite).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "off" => Ok(WheelDelay::Off),
+            "estimate" => Ok(WheelDelay::Estimate),
+            _ => match s.parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(WheelDelay::KnownS(x)),
+                _ => Err(()),
+            },
+        }
+    }
+}
+
+/// The wheel-speed time tag a run applied.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct DelayFit {
+    /// `δ`, s: `ρ` was read at `t + δ`.
+    pub delay_s: f64,
+    /// Its standard deviation, s (zero when given).
+    pub sigma_s: f64,
+    /// Whether it was estimated ([`estimate`]) or given.
+    pub estimated: bool,
+    /// The half-width of the search, s (zero when given).
+    pub half_range_s: f64,
+    /// `∂ĵ/∂δ`, kg m² / s, of the profile's fit (zero when given).
+    pub dj_ds: [f64; 6],
+}
+
+impl DelayFit {
+    /// A time tag the user gave.
+    #[must_use]
+    pub fn known(delay_s: f64) -> Self {
+        Self {
+            delay_s,
+            sigma_s: 0.0,
+            estimated: false,
+            half_range_s: 0.0,
+            dj_ds: [0.0; 6],
+        }
+    }
+
+    /// The consider term per element, `|∂ĵ/∂δ| σ_δ`, kg m².
+    #[must_use]
+    pub fn consider_kg_m2(&self) -> [f64; 6] {
+        core::array::from_fn(|k| (self.dj_ds[k] * self.sigma_s).abs())
+    }
+}
+
+/// Why the time tag could not be estimated.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum DelayError {
+    /// Too few rows inside the search window, or no rotor momentum change among them.
+    #[error("the wheel-speed time tag cannot be estimated from these data: {0}")]
+    NotEstimable(&'static str),
+}
+
+/// Read every sample's `ρ` at `t + delay_s`: the cubic through the four nearest samples
+/// (linear in the first and last interval), the first or last value beyond the record's
+/// ends.
+pub fn shift_rho(samples: &mut [Sample], delay_s: f64) {
+    if delay_s == 0.0 || samples.is_empty() {
+        return;
+    }
+    let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
+    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    for (k, s) in samples.iter_mut().enumerate() {
+        s.rho_nms = interpolate(&t, &rho, k, t[k] + delay_s);
+    }
+}
+
+/// `ρ` at time `x`, interpolated, starting the search at sample `k`.
+fn interpolate(t: &[f64], rho: &[Vector3<f64>], k: usize, x: f64) -> Vector3<f64> {
+    let n = t.len();
+    if x <= t[0] {
+        return rho[0];
+    }
+    if x >= t[n - 1] {
+        return rho[n - 1];
+    }
+    // The interval [t_i, t_{i+1}] holding x, searched from k (the shift is small).
+    let mut i = k.min(n - 2);
+    while t[i] > x {
+        i -= 1;
+    }
+    while t[i + 1] < x {
+        i += 1;
+    }
+    if i == 0 || i + 2 >= n {
+        let w = (x - t[i]) / (t[i + 1] - t[i]);
+        return rho[i] * (1.0 - w) + rho[i + 1] * w;
+    }
+    // The cubic through the four nearest samples (as the resampler's): smooth in x
+    // across the samples, so the profile in δ has no kink where x crosses one.
+    let w = super::resample::lagrange_weights(&[t[i - 1], t[i], t[i + 1], t[i + 2]], x);
+    rho[i - 1] * w[0] + rho[i] * w[1] + rho[i + 1] * w[2] + rho[i + 2] * w[3]
+}
+
+/// Regressors of one scalar row: `[τ_b (3); j (6)]`, each chain's `[L̄₀_m, τ_I,m]`, the
+/// right-hand side.
+const X: usize = 9;
+const W: usize = X + 3;
+
+/// One chain's cross-products per component `m`, over `[x (9); −1; −s; y]`.
+type Moments = [SMatrix<f64, W, W>; 3];
+
+/// One interval's rows: the chain it belongs to, `−S_k` (the body torque's columns),
+/// `A_k` (j's), the inertial torque's coefficient `s_k`, the right-hand side.
+type Block = (usize, Matrix3<f64>, SMatrix<f64, 3, 6>, f64, Vector3<f64>);
+
+/// The rows of the window at one trial `δ`, one 3-row block per interval.
+struct Rows {
+    blocks: Vec<Block>,
+    chains: usize,
+}
+
+fn rows(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Rows {
+    let (lo, hi) = window;
+    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
+    let rho_at = |k: usize| interpolate(&t, &rho, k, t[k] + delay_s);
+    let mut out = Rows {
+        blocks: Vec::with_capacity(hi - lo),
+        chains: 0,
+    };
+    let (mut s, mut tsum, mut si) = (Matrix3::zeros(), Vector3::zeros(), 0.0);
+    let mut chain_start = true;
+    let mut prev_h: Option<f64> = None;
+    for k in lo..hi {
+        let (b, e) = (&samples[k], &samples[k + 1]);
+        let h = e.t_s - b.t_s;
+        let phi = incremental_rotation(&b.q, &e.q);
+        let restart = prev_h.is_some_and(|p| is_gap(p, h)) || !(phi.norm() < 0.5);
+        if restart {
+            chain_start = true;
+            prev_h = None;
+            continue;
+        }
+        let c = b.q.to_matrix();
+        if chain_start {
+            out.chains += 1;
+            (s, tsum, si) = (Matrix3::zeros(), Vector3::zeros(), 0.0);
+            chain_start = false;
+        } else if let Some(p) = prev_h {
+            let hbar = 0.5 * (p + h);
+            s += c * hbar;
+            tsum += c * b.tau_nm * hbar;
+            si += hbar;
+        }
+        prev_h = Some(h);
+        let m = IntervalMomentum::new(&c, &phi, &(0.5 * (rho_at(k) + rho_at(k + 1))), h);
+        out.blocks.push((out.chains - 1, -s, m.a, si, m.b + tsum));
+    }
+    out
+}
+
+/// The least-squares fit of one trial: `[τ_b; j]`, the RSS, the rows' degrees of freedom.
+struct Fit {
+    theta: SVector<f64, X>,
+    /// Per chain and component: `[L̄₀_m, τ_I,m]`.
+    nuisance: Vec<[nalgebra::Vector2<f64>; 3]>,
+    rss: f64,
+    dof: f64,
+}
+
+/// Fit the rows' right-hand sides `y` (one 3-vector per block).
+fn fit(r: &Rows, y: &[Vector3<f64>]) -> Option<Fit> {
+    let mut per_chain: Vec<Moments> = vec![[SMatrix::zeros(); 3]; r.chains];
+    let mut count = vec![0usize; r.chains];
+    for ((chain, ms, a, si, _), yk) in r.blocks.iter().zip(y) {
+        count[*chain] += 1;
+        for m in 0..3 {
+            let mut w = SVector::<f64, W>::zeros();
+            for i in 0..3 {
+                w[i] = ms[(m, i)];
+            }
+            for i in 0..6 {
+                w[3 + i] = a[(m, i)];
+            }
+            w[X] = -1.0;
+            w[X + 1] = -si;
+            w[X + 2] = yk[m];
+            per_chain[*chain][m] += w * w.transpose();
+        }
+    }
+    let mut n = SMatrix::<f64, X, X>::zeros();
+    let mut rhs = SVector::<f64, X>::zeros();
+    let mut yy = 0.0;
+    let mut rows = 0usize;
+    let mut used = Vec::with_capacity(r.chains);
+    for (mom, &c) in per_chain.iter().zip(&count) {
+        // A chain of fewer than 3 intervals fits its two unknowns per component exactly.
+        let ok = c >= 3;
+        used.push(ok);
+        if !ok {
+            continue;
+        }
+        rows += 3 * c;
+        for m in mom {
+            let zz = m.fixed_view::<2, 2>(X, X).into_owned();
+            let zi = zz.try_inverse()?;
+            let xz = m.fixed_view::<X, 2>(0, X);
+            let yz = m.fixed_view::<1, 2>(X + 2, X);
+            n += m.fixed_view::<X, X>(0, 0) - xz * zi * xz.transpose();
+            rhs += m.fixed_view::<X, 1>(0, X + 2) - xz * zi * yz.transpose();
+            yy += m[(X + 2, X + 2)] - (yz * zi * yz.transpose())[(0, 0)];
+        }
+    }
+    // Equilibrate before the Cholesky factor: the columns differ in scale by orders.
+    let d = SVector::<f64, X>::from_fn(|i, _| {
+        let v = n[(i, i)];
+        if v > 0.0 {
+            1.0 / v.sqrt()
+        } else {
+            0.0
+        }
+    });
+    if d.iter().any(|&x| x == 0.0) {
+        return None;
+    }
+    let ns = SMatrix::<f64, X, X>::from_fn(|i, j| n[(i, j)] * d[i] * d[j]);
+    let chol = ns.cholesky()?;
+    let theta = chol.solve(&rhs.component_mul(&d)).component_mul(&d);
+    let rss = (yy - rhs.dot(&theta)).max(0.0);
+    let nuisance = per_chain
+        .iter()
+        .zip(&used)
+        .map(|(mom, &ok)| {
+            core::array::from_fn(|m| {
+                if !ok {
+                    return nalgebra::Vector2::zeros();
+                }
+                let mm = &mom[m];
+                let zz = mm.fixed_view::<2, 2>(X, X).into_owned();
+                let zi = zz.try_inverse().unwrap_or_else(nalgebra::Matrix2::zeros);
+                let zy = mm.fixed_view::<2, 1>(X, X + 2).into_owned();
+                let zx = mm.fixed_view::<2, X>(X, 0).into_owned();
+                zi * (zy - zx * theta)
+            })
+        })
+        .collect();
+    let dof = rows as f64 - X as f64 - 6.0 * used.iter().filter(|&&u| u).count() as f64;
+    Some(Fit {
+        theta,
+        nuisance,
+        rss,
+        dof,
+    })
+}
+
+fn rhs(r: &Rows) -> Vec<Vector3<f64>> {
+    r.blocks.iter().map(|b| b.4).collect()
+}
+
+/// `RSS(δ)` and `ĵ(δ)`, or `None` where the fit is singular.
+fn profile(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Option<(f64, Fit)> {
+    let r = rows(samples, window, delay_s);
+    let f = fit(&r, &rhs(&r))?;
+    Some((f.rss, f))
+}
+
+/// Residuals of `y` per block under `f`.
+fn residuals(r: &Rows, y: &[Vector3<f64>], f: &Fit) -> Vec<Vector3<f64>> {
+    r.blocks
+        .iter()
+        .zip(y)
+        .map(|((chain, ms, a, si, _), yk)| {
+            Vector3::from_fn(|m, _| {
+                let mut pred = 0.0;
+                for i in 0..3 {
+                    pred += ms[(m, i)] * f.theta[i];
+                }
+                for i in 0..6 {
+                    pred += a[(m, i)] * f.theta[3 + i];
+                }
+                let nu = f.nuisance[*chain][m];
+                pred += -nu[0] - si * nu[1];
+                yk[m] - pred
+            })
+        })
+        .collect()
+}
+
+/// The vertex `x` of the least-squares parabola through `(x, y)` points, where it opens
+/// upwards and lies within their span.
+fn parabola_vertex(p: &[(f64, f64)]) -> Option<f64> {
+    let mut n = nalgebra::Matrix3::<f64>::zeros();
+    let mut r = Vector3::<f64>::zeros();
+    for &(x, y) in p {
+        let v = Vector3::new(1.0, x, x * x);
+        n += v * v.transpose();
+        r += v * y;
+    }
+    let c = n.cholesky()?.solve(&r);
+    let (lo, hi) = p
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+            (a.min(q.0), b.max(q.0))
+        });
+    let x = -c[1] / (2.0 * c[2]);
+    (c[2] > 0.0 && x >= lo && x <= hi).then_some(x)
+}
+
+/// Estimate the wheel-speed telemetry's time tag from `samples` ([module docs](self)).
+pub fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
+    let n = samples.len();
+    if n < 8 {
+        return Err(DelayError::NotEstimable("too few samples"));
+    }
+    let (t0, t1) = (samples[0].t_s, samples[n - 1].t_s);
+    let half = MAX_HALF_RANGE_S.min((t1 - t0) / 10.0);
+    let lo = samples.partition_point(|s| s.t_s < t0 + half);
+    let hi = samples
+        .partition_point(|s| s.t_s <= t1 - half)
+        .saturating_sub(1);
+    if hi < lo + 8 {
+        return Err(DelayError::NotEstimable(
+            "too few samples inside the search window",
+        ));
+    }
+    let window = (lo, hi);
+    let rho0 = samples[lo].rho_nms;
+    if samples[lo..=hi].iter().all(|s| s.rho_nms == rho0) {
+        return Err(DelayError::NotEstimable(
+            "the rotor momentum does not change",
+        ));
+    }
+    let step = half / GRID as f64;
+    let eval = |d: f64| profile(samples, window, d).map_or(f64::INFINITY, |p| p.0);
+    let grid: Vec<(f64, f64)> = (0..=2 * GRID)
+        .map(|i| {
+            let d = -half + step * i as f64;
+            (d, eval(d))
+        })
+        .collect();
+    let (best, &(d_best, rss_best)) = grid
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .ok_or(DelayError::NotEstimable("no trial"))?;
+    if !rss_best.is_finite() {
+        return Err(DelayError::NotEstimable(
+            "the rows do not determine the inertia",
+        ));
+    }
+    if best == 0 || best == 2 * GRID {
+        return Err(DelayError::NotEstimable(
+            "the best time tag lies at the edge of the search",
+        ));
+    }
+    // A fine grid over two coarse steps each side of the best node, and the vertex of
+    // the least-squares parabola through it: the profile wiggles at the scale of the
+    // sample period where the speed telemetry is held, and the parabola smooths that.
+    let fine: Vec<(f64, f64)> = (0..=2 * GRID)
+        .map(|i| {
+            let x = (i as f64 - GRID as f64) / GRID as f64 * 2.0;
+            (x, eval(d_best + x * step))
+        })
+        .filter(|p| p.1.is_finite())
+        .collect();
+    let delay = d_best + step * parabola_vertex(&fine).unwrap_or(0.0);
+    let r = rows(samples, window, delay);
+    let y = rhs(&r);
+    let f = fit(&r, &y).ok_or(DelayError::NotEstimable("singular fit"))?;
+    // ∂r/∂δ at fixed unknowns, then residualised on the regressors (the same fit).
+    let eps = step;
+    let (rp, rm) = (
+        rows(samples, window, delay + eps),
+        rows(samples, window, delay - eps),
+    );
+    let col: Vec<Vector3<f64>> = rhs(&rp)
+        .iter()
+        .zip(rhs(&rm).iter())
+        .map(|(p, m)| (p - m) / (2.0 * eps))
+        .collect();
+    let fd_col = fit(&r, &col).ok_or(DelayError::NotEstimable("singular fit"))?;
+    let dcol = residuals(&r, &col, &fd_col);
+    let res = residuals(&r, &y, &f);
+    let info: f64 = dcol.iter().map(|v| v.norm_squared()).sum();
+    let y_energy: f64 = y.iter().map(|v| v.norm_squared()).sum();
+    if !(info * half * half > 1e-12 * y_energy) {
+        return Err(DelayError::NotEstimable(
+            "the rotor momentum does not change",
+        ));
+    }
+    let per = r.blocks.len().div_ceil(BLOCKS).max(1);
+    let scores: Vec<f64> = dcol
+        .chunks(per)
+        .zip(res.chunks(per))
+        .map(|(dc, rc)| dc.iter().zip(rc).map(|(a, b)| a.dot(b)).sum())
+        .collect();
+    let nb = scores.len() as f64;
+    let var = if nb > 1.0 {
+        nb / (nb - 1.0) * scores.iter().map(|s| s * s).sum::<f64>() / (info * info)
+    } else {
+        f.rss / f.dof.max(1.0) / info
+    };
+    let jp = profile(samples, window, delay + eps).map(|p| p.1.theta);
+    let jm = profile(samples, window, delay - eps).map(|p| p.1.theta);
+    let dj_ds = match (jp, jm) {
+        (Some(p), Some(m)) => core::array::from_fn(|k| (p[3 + k] - m[3 + k]) / (2.0 * eps)),
+        _ => [0.0; 6],
+    };
+    Ok(DelayFit {
+        delay_s: delay,
+        sigma_s: var.sqrt(),
+        estimated: true,
+        half_range_s: half,
+        dj_ds,
+    })
+}
+
+#[cfg(test)]
+mod tests;
