@@ -70,7 +70,8 @@
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
 //! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto` its
 //! `--inertial-torque` (unset: `off`). `DIGITS=1` prints the medians with
-//! four significant digits.
+//! four significant digits. `WHEEL_DELAY=off|SECONDS|estimate` sets the lab cells' wheel
+//! speed time tag (every estimator; unset: off).
 
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::observability::{Observability, Unobservable};

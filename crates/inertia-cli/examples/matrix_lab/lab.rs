@@ -3,7 +3,8 @@
 //! effects, none, each alone and all but each, running the default estimator, the momentum
 //! RLS and the filtered equation-error baseline side by side on the same telemetry.
 //!
-//! Each estimator runs through `Pipeline` with a solve every 50 samples and the default
+//! Each estimator runs through `Run` (`WHEEL_DELAY=off|SECONDS|estimate`: the wheel speeds'
+//! time tag, for every estimator; off when unset) with a solve every 50 samples and the default
 //! (physical) constraint set (the device's J is physical; the RLS and the equation-error
 //! baseline take none). The table gives, per estimator, the median and 95 % final relative
 //! Frobenius error, and for those with a σ the fraction of runs with the truth within ±3σ
@@ -13,8 +14,9 @@
 //! telemetry's 100 Hz staircase: the baseline at its best on the throw, not at its
 //! default (a twentieth of the sample rate, 200 Hz here, which lets both through).
 
+use inertia::estimator::wheel_delay::WheelDelay;
 use inertia::estimator::Estimate;
-use inertia::pipeline::{Pipeline, PipelineSettings};
+use inertia::pipeline::{PipelineSettings, Run};
 use inertia::sample::Sample;
 use inertia::sim::presets::{LabEffect, Preset};
 use inertia::tensor::{j_from_matrix, relative_frobenius_error};
@@ -72,20 +74,34 @@ pub fn cells() -> Vec<LabCell> {
     cells
 }
 
+/// The wheel speeds' time tag from `WHEEL_DELAY` (`off`, seconds or `estimate`; every
+/// estimator), off when unset.
+fn wheel_delay_from_env() -> WheelDelay {
+    std::env::var("WHEEL_DELAY")
+        .ok()
+        .and_then(|v| inertia::pipeline::parse_wheel_delay(&v).ok())
+        .unwrap_or_default()
+}
+
 fn estimate(samples: &[Sample], name: &str) -> Option<Estimate> {
-    let mut p = Pipeline::new(&PipelineSettings {
+    let config = PipelineSettings {
         estimator: name.into(),
         solve_every: 50,
         uncertainty: true,
         inertial_torque: super::inertial_torque_from_env(name),
         filter_cutoff_hz: (name == "equation-error").then_some(LAB_CUTOFF_HZ),
+        wheel_delay: wheel_delay_from_env(),
         ..PipelineSettings::default()
-    })
-    .ok()?;
-    for s in samples {
-        p.push(s).ok()?;
     }
-    p.last().copied()
+    .validate()
+    .ok()?;
+    let mut run = Run::new(config, false).ok()?;
+    let mut last = None;
+    for s in samples {
+        run.push(s, |e| last = Some(*e)).ok()?;
+    }
+    run.finish(|e| last = Some(*e)).ok()?;
+    last
 }
 
 /// One run: the truth and each estimator's final estimate.

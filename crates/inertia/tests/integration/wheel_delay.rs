@@ -88,12 +88,21 @@ fn a_given_or_estimated_time_tag_matches_on_time_telemetry() {
     let truth = on_time.inertia_kg_m2;
     let reference = error(&run(&on_time.samples, WheelDelay::Off, false).0, &truth);
     let uncorrected = error(&run(&late.samples, WheelDelay::Off, false).0, &truth);
-    let given = error(&run(&late.samples, WheelDelay::KnownS(0.05), false).0, &truth);
+    let given = error(
+        &run(&late.samples, WheelDelay::KnownS(0.05), false).0,
+        &truth,
+    );
     let (estimated, r) = run(&late.samples, WheelDelay::Estimate, false);
     let (batch, _) = run(&late.samples, WheelDelay::Estimate, true);
     let fit = r.wheel_delay().expect("applied").expect("estimated");
-    assert!((fit.delay_s - 0.05).abs() < 3.0 * fit.sigma_s + 1e-4, "{fit:?}");
-    assert!(uncorrected > 10.0 * reference, "{uncorrected} vs {reference}");
+    assert!(
+        (fit.delay_s - 0.05).abs() < 3.0 * fit.sigma_s + 1e-4,
+        "{fit:?}"
+    );
+    assert!(
+        uncorrected > 10.0 * reference,
+        "{uncorrected} vs {reference}"
+    );
     assert!(given < 2.0 * reference, "given: {given} vs {reference}");
     for (what, e) in [
         ("estimated", error(&estimated, &truth)),
@@ -116,7 +125,13 @@ fn refuses_a_wild_time_tag_and_reports_one_it_cannot_estimate() {
         .validate()
         .expect_err("refused");
         assert!(
-            matches!(e, PipelineError::InvalidSetting { field: "wheel_delay", .. }),
+            matches!(
+                e,
+                PipelineError::InvalidSetting {
+                    field: "wheel_delay",
+                    ..
+                }
+            ),
             "{e:?}"
         );
     }
