@@ -144,7 +144,7 @@ impl Quaternion {
     /// Squared norm.
     #[must_use]
     #[inline]
-    pub fn norm_squared(&self) -> f64 {
+    pub(crate) fn norm_squared(&self) -> f64 {
         self.v.norm_squared() + self.s * self.s
     }
 

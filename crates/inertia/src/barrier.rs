@@ -32,23 +32,23 @@ use nalgebra::{Matrix3, SMatrix, SVector};
 
 /// A problem instance (borrowed constraint arrays): objective `‖A x − b‖² + cᵀx`.
 #[derive(Debug, Clone, Copy)]
-pub struct Problem<'a, const N: usize> {
+pub(crate) struct Problem<'a, const N: usize> {
     /// Least-squares matrix (e.g. the upper-triangular `R`).
-    pub a: SMatrix<f64, N, N>,
+    pub(crate) a: SMatrix<f64, N, N>,
     /// Least-squares right-hand side.
-    pub b: SVector<f64, N>,
+    pub(crate) b: SVector<f64, N>,
     /// Linear term.
-    pub c: SVector<f64, N>,
+    pub(crate) c: SVector<f64, N>,
     /// LMIs.
-    pub lmis: &'a [Lmi<N>],
+    pub(crate) lmis: &'a [Lmi<N>],
     /// Linear inequalities.
-    pub lins: &'a [Lin<N>],
+    pub(crate) lins: &'a [Lin<N>],
 }
 
 impl<const N: usize> Problem<'_, N> {
     /// The objective `‖A x − b‖² + cᵀx`.
     #[must_use]
-    pub fn objective(&self, x: &SVector<f64, N>) -> f64 {
+    pub(crate) fn objective(&self, x: &SVector<f64, N>) -> f64 {
         (self.a * x - self.b).norm_squared() + self.c.dot(x)
     }
 }
@@ -96,7 +96,7 @@ impl Default for BarrierSettings {
 
 /// Failure of the barrier method.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BarrierError {
+pub(crate) enum BarrierError {
     /// The start point is not strictly feasible.
     NotInterior,
     /// Newton's system could not be solved (non-finite data or a singular Hessian).
@@ -105,28 +105,31 @@ pub enum BarrierError {
 
 /// The result: point, barrier parameter and work done.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BarrierOutput<const N: usize> {
+pub(crate) struct BarrierOutput<const N: usize> {
     /// The (approximately central) point.
-    pub x: SVector<f64, N>,
+    pub(crate) x: SVector<f64, N>,
     /// Final barrier parameter.
-    pub t: f64,
+    pub(crate) t: f64,
     /// Newton steps taken.
-    pub newton_steps: u32,
+    pub(crate) newton_steps: u32,
     /// Duality gap bound `m/t`.
-    pub gap: f64,
+    pub(crate) gap: f64,
     /// Relative dual residual `‖∇f(x) − Σ_i 𝒜_i*(Z_i) − Σ_l λ_l a_l‖∞ / max(1, ‖∇f(x)‖∞)`
     /// for the dual point corrected by the last Newton step `d` (`Z_i = (F_i⁻¹ −
     /// F_i⁻¹ ΔF_i F_i⁻¹)/t`, `λ_l = (1 − a_lᵀd/s_l)/(t s_l)`, dual feasible while the
     /// Newton decrement is below 1). By the Newton equation this residual is exactly
     /// `‖∇²f d‖∞ = ‖2AᵀA d‖∞`.
-    pub dual_residual: f64,
+    pub(crate) dual_residual: f64,
     /// `false` when the step cap was hit before the gap tolerance.
-    pub converged: bool,
+    pub(crate) converged: bool,
 }
 
 /// `true` when every constraint holds strictly at `x`.
 #[must_use]
-pub fn strictly_feasible<const N: usize>(problem: &Problem<'_, N>, x: &SVector<f64, N>) -> bool {
+pub(crate) fn strictly_feasible<const N: usize>(
+    problem: &Problem<'_, N>,
+    x: &SVector<f64, N>,
+) -> bool {
     problem.lmis.iter().all(|l| l.eval(x).cholesky().is_some())
         && problem.lins.iter().all(|l| l.eval(x) > 0.0)
 }
@@ -314,7 +317,7 @@ const MAX_OUTER_ROUNDS: u32 = 2_000;
 /// A centering that stalls (step cap, or round-off at a point within ~1e-12 of the
 /// boundary) ends the method at the last completed central point, whose gap `m/t` is
 /// reported; `converged` says whether that gap met the tolerance.
-pub fn solve<const N: usize>(
+pub(crate) fn solve<const N: usize>(
     problem: &Problem<'_, N>,
     x0: &SVector<f64, N>,
     settings: &BarrierSettings,

@@ -42,11 +42,11 @@ use nalgebra::{Matrix3, Matrix3x6, Vector3};
 /// Largest accepted `|φ|`. `|φ| = sin(θ/2)` for a step rotation θ, so `|φ| → 1` as the
 /// step approaches 180°, where eq. 37 breaks down and the direction of rotation becomes
 /// ambiguous. 0.99 is a step of about 164°.
-pub const MAX_PHI_NORM: f64 = 0.99;
+pub(crate) const MAX_PHI_NORM: f64 = 0.99;
 
 /// Tolerance on `| |q| − 1 |` for attitude quaternions handed to the row builder.
 /// Telemetry readers renormalise within their own documented tolerance first.
-pub const UNIT_NORM_TOLERANCE: f64 = 1e-9;
+pub(crate) const UNIT_NORM_TOLERANCE: f64 = 1e-9;
 
 /// Why a row could not be formed.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
@@ -87,7 +87,7 @@ pub enum RowError {
 /// `G(φ)` of eq. 47: `J φ = G(φ) j`.
 #[must_use]
 #[inline]
-pub fn g_matrix(phi: &Vector3<f64>) -> Matrix3x6<f64> {
+pub(crate) fn g_matrix(phi: &Vector3<f64>) -> Matrix3x6<f64> {
     let (a, b, c) = (phi.x, phi.y, phi.z);
     Matrix3x6::new(
         a, 0.0, 0.0, b, c, 0.0, //
@@ -99,21 +99,21 @@ pub fn g_matrix(phi: &Vector3<f64>) -> Matrix3x6<f64> {
 /// `√(1 − φ·φ)`, the scalar part of `f` in eq. 37.
 #[must_use]
 #[inline]
-pub fn phi_scalar(phi: &Vector3<f64>) -> f64 {
+pub(crate) fn phi_scalar(phi: &Vector3<f64>) -> f64 {
     sqrt((1.0 - phi.norm_squared()).max(0.0))
 }
 
 /// `M(φ) = √(1 − φ·φ) I − S(φ)` (eq. 50).
 #[must_use]
 #[inline]
-pub fn m_matrix(phi: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn m_matrix(phi: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() * phi_scalar(phi) - skew(phi)
 }
 
 /// `N(φ) = √(1 − φ·φ) I + S(φ)` (eq. 51).
 #[must_use]
 #[inline]
-pub fn n_matrix(phi: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn n_matrix(phi: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::identity() * phi_scalar(phi) + skew(phi)
 }
 
@@ -154,7 +154,7 @@ pub struct RowInput {
 }
 
 /// Check the incremental rotation of the step `[t0_s, t1_s]` against [`MAX_PHI_NORM`].
-pub fn check_phi(phi: &Vector3<f64>, t0_s: f64, t1_s: f64) -> Result<(), RowError> {
+pub(crate) fn check_phi(phi: &Vector3<f64>, t0_s: f64, t1_s: f64) -> Result<(), RowError> {
     let n = phi.norm();
     if !n.is_finite() {
         return Err(RowError::NonFinite {
@@ -174,7 +174,7 @@ pub fn check_phi(phi: &Vector3<f64>, t0_s: f64, t1_s: f64) -> Result<(), RowErro
 }
 
 /// Check that a quaternion is unit to [`UNIT_NORM_TOLERANCE`].
-pub fn check_unit(q: &Quaternion, node: usize) -> Result<(), RowError> {
+pub(crate) fn check_unit(q: &Quaternion, node: usize) -> Result<(), RowError> {
     let norm = q.norm();
     if !norm.is_finite() || abs(norm - 1.0) > UNIT_NORM_TOLERANCE {
         return Err(RowError::NonUnitQuaternion { node, norm });

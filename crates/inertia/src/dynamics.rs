@@ -45,7 +45,7 @@ impl GyrostatState {
 /// `ω̇` from eq. 26: `J⁻¹ (τ − ω × (J ω + ρ) − ρ̇)`.
 #[must_use]
 #[inline]
-pub fn omega_dot(
+pub(crate) fn omega_dot(
     j: &Matrix3<f64>,
     j_inv: &Matrix3<f64>,
     omega: &Vector3<f64>,
@@ -59,7 +59,7 @@ pub fn omega_dot(
 /// `q̇ = ½ q ω̂` (eq. 24).
 #[must_use]
 #[inline]
-pub fn quaternion_rate(q: &Quaternion, omega: &Vector3<f64>) -> Quaternion {
+pub(crate) fn quaternion_rate(q: &Quaternion, omega: &Vector3<f64>) -> Quaternion {
     let d = q.mul(&Quaternion::pure(omega));
     Quaternion::new(0.5 * d.v, 0.5 * d.s)
 }

@@ -15,7 +15,7 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Eigenvalues ascending and the matching orthonormal eigenvectors.
 #[must_use]
-pub fn symmetric_eigen3(f: &Matrix3<f64>) -> (Vector3<f64>, [Vector3<f64>; 3]) {
+pub(crate) fn symmetric_eigen3(f: &Matrix3<f64>) -> (Vector3<f64>, [Vector3<f64>; 3]) {
     let q = f.trace() * (1.0 / 3.0);
     let p1 = f[(0, 1)] * f[(0, 1)] + f[(0, 2)] * f[(0, 2)] + f[(1, 2)] * f[(1, 2)];
     let d = Vector3::new(f[(0, 0)] - q, f[(1, 1)] - q, f[(2, 2)] - q);

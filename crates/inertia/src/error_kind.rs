@@ -19,7 +19,7 @@ macro_rules! kinds {
 
         impl ErrorKind {
             /// Every kind, in declaration order.
-            pub const ALL: &'static [ErrorKind] = &[$(ErrorKind::$v,)*];
+            pub(crate) const ALL: &'static [ErrorKind] = &[$(ErrorKind::$v,)*];
 
             /// The stable snake-case name.
             #[must_use]

@@ -12,7 +12,7 @@ use nalgebra::{SMatrix, SVector};
 /// Remove the row `wᵀ` (right-hand side 0) from `[R | z]` by hyperbolic rotations: afterwards
 /// `RᵀR` has lost `w wᵀ` and `Rᵀz` is unchanged. Returns `false`, leaving `r` and `z`
 /// partly updated, when `RᵀR − w wᵀ` is not positive definite. Never forms `RᵀR`.
-pub fn downdate_row<const N: usize>(
+pub(crate) fn downdate_row<const N: usize>(
     r: &mut SMatrix<f64, N, N>,
     z: &mut SVector<f64, N>,
     w: &SVector<f64, N>,
@@ -47,7 +47,7 @@ pub fn downdate_row<const N: usize>(
 
 /// Fold `a` (and optionally the right-hand side `(z, β)`) into `r`. Returns the leftover
 /// of `β` (0 without a right-hand side).
-pub fn fold_row<const N: usize>(
+pub(crate) fn fold_row<const N: usize>(
     r: &mut SMatrix<f64, N, N>,
     a: &SVector<f64, N>,
     mut rhs: Option<(&mut SVector<f64, N>, f64)>,
@@ -73,7 +73,7 @@ pub fn fold_row<const N: usize>(
 /// of other rows at other pivots, or of another factor, may be interleaved
 /// ([`wavefront`], [`crate::estimator::augmented_qr`]).
 #[inline]
-pub fn rotate_transposed<const N: usize>(
+pub(crate) fn rotate_transposed<const N: usize>(
     rt: &mut SMatrix<f64, N, N>,
     a: &mut SVector<f64, N>,
     z: &mut SVector<f64, N>,
@@ -129,7 +129,7 @@ fn rotate<const N: usize, const TRANSPOSED: bool>(
 /// row depend on each other through `√` and a division per pivot; interleaving rows that
 /// do not lets the processor overlap them.
 #[inline(always)]
-pub fn wavefront(
+pub(crate) fn wavefront(
     pivots: core::ops::Range<usize>,
     rows: usize,
     mut rotate: impl FnMut(usize, usize),
@@ -146,7 +146,7 @@ pub fn wavefront(
 /// Solve `RᵀR d = g` for upper-triangular `R` by two triangular solves. `None` when a
 /// diagonal entry is zero or the result is not finite.
 #[must_use]
-pub fn solve_normal<const N: usize>(
+pub(crate) fn solve_normal<const N: usize>(
     r: &SMatrix<f64, N, N>,
     g: &SVector<f64, N>,
 ) -> Option<SVector<f64, N>> {

@@ -24,7 +24,7 @@ use nalgebra::{SMatrix, SVector};
 /// of independent states may be interleaved, so that the processor overlaps their `√`
 /// and divisions, on which each pivot waits.
 #[inline(always)]
-pub fn reflect_transposed<const N: usize, const M: usize>(
+pub(crate) fn reflect_transposed<const N: usize, const M: usize>(
     rt: &mut SMatrix<f64, N, N>,
     z: &mut SVector<f64, N>,
     a: &mut [SVector<f64, N>; M],
@@ -82,7 +82,7 @@ mod tests {
     /// Fold the rows `a` with right-hand sides `beta` into `(Rᵀ, z)` at the pivots `pivots`
     /// (the rows must be zero before `pivots.start`; `Rᵀ` stored, so that each row of `R` is
     /// contiguous). Afterwards `a` is zero in `pivots` and `beta` holds the block's leftover.
-    pub fn fold_block_transposed<const N: usize, const M: usize>(
+    pub(crate) fn fold_block_transposed<const N: usize, const M: usize>(
         rt: &mut SMatrix<f64, N, N>,
         z: &mut SVector<f64, N>,
         a: &mut [SVector<f64, N>; M],

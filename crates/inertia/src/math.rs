@@ -7,23 +7,23 @@
 #[cfg(feature = "std")]
 mod imp {
     #[inline]
-    pub fn sqrt(x: f64) -> f64 {
+    pub(crate) fn sqrt(x: f64) -> f64 {
         x.sqrt()
     }
     #[inline]
-    pub fn sin(x: f64) -> f64 {
+    pub(crate) fn sin(x: f64) -> f64 {
         x.sin()
     }
     #[inline]
-    pub fn cos(x: f64) -> f64 {
+    pub(crate) fn cos(x: f64) -> f64 {
         x.cos()
     }
     #[inline]
-    pub fn atan2(y: f64, x: f64) -> f64 {
+    pub(crate) fn atan2(y: f64, x: f64) -> f64 {
         y.atan2(x)
     }
     #[inline]
-    pub fn ln(x: f64) -> f64 {
+    pub(crate) fn ln(x: f64) -> f64 {
         x.ln()
     }
 }
@@ -31,23 +31,23 @@ mod imp {
 #[cfg(not(feature = "std"))]
 mod imp {
     #[inline]
-    pub fn sqrt(x: f64) -> f64 {
+    pub(crate) fn sqrt(x: f64) -> f64 {
         libm::sqrt(x)
     }
     #[inline]
-    pub fn sin(x: f64) -> f64 {
+    pub(crate) fn sin(x: f64) -> f64 {
         libm::sin(x)
     }
     #[inline]
-    pub fn cos(x: f64) -> f64 {
+    pub(crate) fn cos(x: f64) -> f64 {
         libm::cos(x)
     }
     #[inline]
-    pub fn atan2(y: f64, x: f64) -> f64 {
+    pub(crate) fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
     }
     #[inline]
-    pub fn ln(x: f64) -> f64 {
+    pub(crate) fn ln(x: f64) -> f64 {
         libm::log(x)
     }
 }

@@ -45,7 +45,7 @@ pub fn is_gap(previous_step_s: f64, step_s: f64) -> bool {
 /// reader (naming file, line and column) and by the pipeline ([`check_range`]).
 pub mod range {
     /// Largest |t|, s (about 317 years: Unix time fits).
-    pub const TIME_S: f64 = 1e10;
+    pub(crate) const TIME_S: f64 = 1e10;
     /// Largest |ρ| component, N m s (the ISS's four CMGs hold about 2e4 together).
     pub const RHO_NMS: f64 = 1e6;
     /// Largest |τ| component, N m.
@@ -54,7 +54,7 @@ pub mod range {
     pub const RATE_RAD_S: f64 = 100.0;
     /// Largest deviation of the quaternion's norm from 1 (the CSV reader renormalises
     /// within [`crate::telemetry::csv::DEFAULT_UNIT_TOLERANCE`] by default).
-    pub const QUATERNION_NORM: f64 = 1e-3;
+    pub(crate) const QUATERNION_NORM: f64 = 1e-3;
 }
 
 /// Which value of a sample is outside the [`range`].
@@ -114,7 +114,7 @@ pub struct OutOfRange {
 }
 
 /// `Ok` when `value` is within the range of `quantity` (NaN never is).
-pub fn check_value(quantity: Quantity, value: f64) -> Result<(), OutOfRange> {
+pub(crate) fn check_value(quantity: Quantity, value: f64) -> Result<(), OutOfRange> {
     if crate::math::abs(value) <= quantity.limit().0 {
         Ok(())
     } else {

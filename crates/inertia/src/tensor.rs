@@ -68,13 +68,13 @@ impl Component {
 
     /// `(row, col)` in `J`.
     #[must_use]
-    pub const fn position(self) -> (usize, usize) {
+    pub(crate) const fn position(self) -> (usize, usize) {
         COMPONENT_INDEX[self as usize]
     }
 
     /// Whether this is a product of inertia.
     #[must_use]
-    pub const fn is_product(self) -> bool {
+    pub(crate) const fn is_product(self) -> bool {
         self.index() >= 3
     }
 

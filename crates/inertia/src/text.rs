@@ -2,13 +2,16 @@
 //!
 //! Every error message of the crate formats floats with [`Num`] (at most 12 significant
 //! digits, so `299.8999999999997` prints as `299.9` and `1e308` as `1e308`) and quotes
-//! user text with [`Quoted`] or [`Clipped`] (at most [`MAX_QUOTED_CHARS`] characters and
+//! user text with `Quoted` or [`Clipped`] (at most `MAX_QUOTED_CHARS` (80) characters and
 //! an ellipsis), so that no input makes a message long.
+
+// The crate-internal helpers here serve the std front ends (pipeline, CSV reader).
+#![cfg_attr(not(feature = "std"), allow(dead_code))]
 
 use core::fmt::{self, Write};
 
 /// The most characters of user text a message quotes.
-pub const MAX_QUOTED_CHARS: usize = 80;
+pub(crate) const MAX_QUOTED_CHARS: usize = 80;
 
 /// A float in at most 12 significant digits, trailing zeros removed; fixed notation for
 /// magnitudes in `[1e-4, 1e12)`, scientific otherwise (`1e308`, `2.5e-7`).
@@ -78,7 +81,7 @@ impl fmt::Display for Num {
 
 /// A count and a noun, plural unless the count is 1: `1 gap`, `0 gaps`, `2 sign flips`.
 #[derive(Debug, Clone, Copy)]
-pub struct Counted<'a>(pub usize, pub &'a str);
+pub(crate) struct Counted<'a>(pub usize, pub &'a str);
 
 impl fmt::Display for Counted<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -99,7 +102,7 @@ fn prefix(s: &str, max_chars: usize) -> (&str, bool) {
 /// User text in double quotes with escapes (like `{:?}`), cut after
 /// [`MAX_QUOTED_CHARS`] characters: `"abc…" (12345 bytes)`.
 #[derive(Debug, Clone, Copy)]
-pub struct Quoted<'a>(pub &'a str);
+pub(crate) struct Quoted<'a>(pub &'a str);
 
 impl fmt::Display for Quoted<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -113,7 +116,7 @@ impl fmt::Display for Quoted<'_> {
     }
 }
 
-/// Text cut after a number of characters (default [`MAX_QUOTED_CHARS`]) with
+/// Text cut after a number of characters (default `MAX_QUOTED_CHARS`, 80) with
 /// `… (N bytes)`, and with line breaks shown as spaces: one line, bounded length.
 #[derive(Debug, Clone, Copy)]
 pub struct Clipped<'a> {
@@ -124,7 +127,7 @@ pub struct Clipped<'a> {
 impl<'a> Clipped<'a> {
     /// At most [`MAX_QUOTED_CHARS`] characters of `text`.
     #[must_use]
-    pub fn new(text: &'a str) -> Self {
+    pub(crate) fn new(text: &'a str) -> Self {
         Self::with_limit(text, MAX_QUOTED_CHARS)
     }
 
@@ -190,12 +193,21 @@ mod tests {
         let wide = "é".repeat(200);
         assert!(std::format!("{}", Clipped::new(&wide)).starts_with("éé"));
     }
+
+    /// Fuzz finding: a residual span against a rest that fits exactly has an infinite
+    /// variance ratio, which the status printed as `inf`.
+    #[test]
+    fn infinite_ratio_is_worded() {
+        let t = std::format!("{}", Times(f64::INFINITY));
+        assert!(!t.contains("inf") && t.contains("fits exactly"), "{t}");
+        assert_eq!(std::format!("{}", Times(12.0)), "1.2e1 times");
+    }
 }
 
 /// A variance ratio as `"{r:.1e} times"`, and for an infinite one (the reference
 /// variance is zero: the rest fits exactly) words instead of `inf`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Times(pub f64);
+pub(crate) struct Times(pub(crate) f64);
 
 impl fmt::Display for Times {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

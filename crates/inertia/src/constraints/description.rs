@@ -5,21 +5,21 @@
 use nalgebra::{Matrix3, SVector};
 
 /// Most linear inequalities in a validated constraint set (3 triangle + 12 bounds).
-pub const MAX_LIN: usize = 16;
+pub(crate) const MAX_LIN: usize = 16;
 
 /// A 3×3 LMI `F0 + Σ_k x_k F_k ⪰ 0` in `N` variables.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lmi<const N: usize> {
+pub(crate) struct Lmi<const N: usize> {
     /// Constant term.
-    pub f0: Matrix3<f64>,
+    pub(crate) f0: Matrix3<f64>,
     /// Coefficient of each variable.
-    pub fk: [Matrix3<f64>; N],
+    pub(crate) fk: [Matrix3<f64>; N],
 }
 
 impl<const N: usize> Lmi<N> {
     /// The zero LMI.
     #[must_use]
-    pub fn zero() -> Self {
+    pub(crate) fn zero() -> Self {
         Self {
             f0: Matrix3::zeros(),
             fk: [Matrix3::zeros(); N],
@@ -29,7 +29,7 @@ impl<const N: usize> Lmi<N> {
     /// `F0 + Σ x_k F_k`.
     #[must_use]
     #[inline]
-    pub fn eval(&self, x: &SVector<f64, N>) -> Matrix3<f64> {
+    pub(crate) fn eval(&self, x: &SVector<f64, N>) -> Matrix3<f64> {
         let mut m = self.f0;
         for k in 0..N {
             m += self.fk[k] * x[k];
@@ -40,17 +40,17 @@ impl<const N: usize> Lmi<N> {
 
 /// A linear inequality `aᵀ x ≥ b` in `N` variables.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Lin<const N: usize> {
+pub(crate) struct Lin<const N: usize> {
     /// Coefficients.
-    pub a: SVector<f64, N>,
+    pub(crate) a: SVector<f64, N>,
     /// Right-hand side.
-    pub b: f64,
+    pub(crate) b: f64,
 }
 
 impl<const N: usize> Lin<N> {
     /// The zero inequality `0 ≥ 0`.
     #[must_use]
-    pub fn zero() -> Self {
+    pub(crate) fn zero() -> Self {
         Self {
             a: SVector::zeros(),
             b: 0.0,
@@ -60,7 +60,7 @@ impl<const N: usize> Lin<N> {
     /// The slack `aᵀ x − b` (≥ 0 when satisfied).
     #[must_use]
     #[inline]
-    pub fn eval(&self, x: &SVector<f64, N>) -> f64 {
+    pub(crate) fn eval(&self, x: &SVector<f64, N>) -> f64 {
         self.a.dot(x) - self.b
     }
 }

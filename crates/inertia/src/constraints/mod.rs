@@ -20,7 +20,7 @@
 //! constraints and validation fails with the best margin achievable. The interior point
 //! also starts every interior-point solve.
 
-pub mod description;
+pub(crate) mod description;
 mod validated;
 
 use validated::basis;
@@ -48,7 +48,7 @@ pub enum Consistency {
 
 /// Relative tolerance within which an answer counts as sitting on a bound
 /// ([`ConstraintSet::active_bounds`]): `1e-9 · max(|b|, 1e-3 kg m²)`.
-pub const ACTIVE_TOLERANCE: f64 = 1e-9;
+pub(crate) const ACTIVE_TOLERANCE: f64 = 1e-9;
 
 fn active_tolerance(v: f64) -> f64 {
     ACTIVE_TOLERANCE * crate::math::abs(v).max(1e-3)
@@ -133,7 +133,7 @@ pub enum ProductConvention {
 impl ProductConvention {
     /// The tensor entry (`J_ik`) of a product written in this convention.
     #[must_use]
-    pub fn to_tensor(self, product: f64) -> f64 {
+    pub(crate) fn to_tensor(self, product: f64) -> f64 {
         match self {
             ProductConvention::Tensor => product,
             ProductConvention::Cad => -product,
@@ -385,7 +385,7 @@ impl ConstraintSet {
 
     /// The elements fixed by an equality (`lower == upper`), with their values.
     #[must_use]
-    pub fn fixed(&self) -> [Option<f64>; 6] {
+    pub(crate) fn fixed(&self) -> [Option<f64>; 6] {
         core::array::from_fn(|k| match (self.lower_kg_m2[k], self.upper_kg_m2[k]) {
             (Some(l), Some(u)) if l == u => Some(l),
             _ => None,
@@ -427,7 +427,7 @@ impl ConstraintSet {
     /// `true` when any element bound is set (a-priori knowledge that can pin one open
     /// direction of J).
     #[must_use]
-    pub fn has_bounds(&self) -> bool {
+    pub(crate) fn has_bounds(&self) -> bool {
         self.lower_kg_m2
             .iter()
             .chain(&self.upper_kg_m2)
@@ -440,7 +440,7 @@ impl ConstraintSet {
     /// feasible scale: only such a bound (or a Gaussian prior) gives it one. Equalities at
     /// zero (`--diagonal`) do not.
     #[must_use]
-    pub fn has_scale_bound(&self) -> bool {
+    pub(crate) fn has_scale_bound(&self) -> bool {
         self.lower_kg_m2.iter().flatten().any(|&l| l > 0.0)
             || self.upper_kg_m2.iter().flatten().any(|&u| u < 0.0)
     }

@@ -19,7 +19,7 @@ pub(super) fn basis() -> [Matrix3<f64>; 6] {
 }
 
 /// A validated constraint set in the form the solvers use: up to two 3×3 LMIs
-/// `F0 + Σ j_k F_k ⪰ 0` and up to [`MAX_LIN`] linear inequalities `aᵀ j ≥ b`.
+/// `F0 + Σ j_k F_k ⪰ 0` and up to `MAX_LIN` (16) linear inequalities `aᵀ j ≥ b`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Constraints {
     pub(super) set: ConstraintSet,
@@ -52,7 +52,7 @@ impl Constraints {
 
     /// `j` with its fixed elements set to their values.
     #[must_use]
-    pub fn with_fixed(&self, j: &InertiaVector) -> InertiaVector {
+    pub(crate) fn with_fixed(&self, j: &InertiaVector) -> InertiaVector {
         let mut out = *j;
         for (o, v) in out.iter_mut().zip(&self.fixed) {
             if let Some(v) = v {
@@ -70,13 +70,13 @@ impl Constraints {
 
     /// The LMIs `F0 + Σ j_k F_k ⪰ 0`.
     #[must_use]
-    pub fn lmis(&self) -> &[Lmi<6>] {
+    pub(crate) fn lmis(&self) -> &[Lmi<6>] {
         &self.lmis[..self.n_lmi]
     }
 
     /// The linear inequalities `aᵀ j ≥ b`.
     #[must_use]
-    pub fn lins(&self) -> &[Lin<6>] {
+    pub(crate) fn lins(&self) -> &[Lin<6>] {
         &self.lins[..self.n_lin]
     }
 
@@ -84,12 +84,6 @@ impl Constraints {
     #[must_use]
     pub fn interior(&self) -> &InertiaVector {
         &self.interior
-    }
-
-    /// Total barrier degree `m` (3 per LMI, 1 per linear inequality).
-    #[must_use]
-    pub fn degree(&self) -> usize {
-        3 * self.n_lmi + self.n_lin
     }
 
     /// Smallest margin of `j`: the least eigenvalue of every LMI and the least linear slack

@@ -21,7 +21,7 @@
 use super::SimError;
 
 /// The most command ticks allowed in one integration node period.
-pub const MAX_TICKS_PER_NODE: f64 = 1000.0;
+pub(crate) const MAX_TICKS_PER_NODE: f64 = 1000.0;
 
 /// Zero-order hold of the wheel torque commands.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,19 +44,19 @@ impl CommandHold {
 
     /// Controller period `1/rate_hz`, s.
     #[must_use]
-    pub fn period_s(&self) -> f64 {
+    pub(crate) fn period_s(&self) -> f64 {
         1.0 / self.rate_hz
     }
 
     /// Time of tick `j`, s, for a run starting at `t0_s`.
     #[must_use]
-    pub fn tick_s(&self, t0_s: f64, j: u64) -> f64 {
+    pub(crate) fn tick_s(&self, t0_s: f64, j: u64) -> f64 {
         t0_s + self.phase_s + j as f64 * self.period_s()
     }
 
     /// Check the rate and the phase; `dt_s` is the integration node period, which may
     /// hold at most [`MAX_TICKS_PER_NODE`] ticks.
-    pub fn validate(&self, dt_s: f64) -> Result<(), SimError> {
+    pub(crate) fn validate(&self, dt_s: f64) -> Result<(), SimError> {
         if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
             return Err(SimError::InvalidSetting {
                 field: "commands.rate_hz",
@@ -89,7 +89,7 @@ pub(crate) struct Ticker {
     t0_s: f64,
     next: u64,
     /// Time of tick `next`, s.
-    pub next_s: f64,
+    pub(crate) next_s: f64,
 }
 
 impl Ticker {

@@ -124,7 +124,7 @@ impl SlewController {
 
     /// Reference attitude, body rate and acceleration (reference axes) at `t_s`.
     #[must_use]
-    pub fn reference(&self, t_s: f64) -> (Quaternion, Vector3<f64>, Vector3<f64>) {
+    pub(crate) fn reference(&self, t_s: f64) -> (Quaternion, Vector3<f64>, Vector3<f64>) {
         let mut out = (self.q0, Vector3::zeros(), Vector3::zeros());
         for (s, q_start) in self.slews.iter().zip(&self.starts) {
             if t_s < s.start_s {

@@ -108,7 +108,7 @@ impl Orbit {
     }
 
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         let bad = |field, value| {
             Err(SimError::InvalidSetting {
                 field,
@@ -198,7 +198,7 @@ impl Environment {
     }
 
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if let Some(o) = &self.orbit {
             o.validate()?;
         }

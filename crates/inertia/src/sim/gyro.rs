@@ -26,7 +26,7 @@
 //! whose only errors are the gyro's.
 //!
 //! Noise streams: ChaCha8 seeded with the run's seed, stream 1 for the random walk (as
-//! [`super::sensors::IntegratingGyro`], so the default output is unchanged) and stream 4
+//! the plain integrating gyro of the paper's model, so the default output is unchanged) and stream 4
 //! for the bias instability.
 
 use super::sensors::{normal, DEG};
@@ -77,7 +77,7 @@ impl Default for GyroErrors {
 impl GyroErrors {
     /// Whether any bias is modelled.
     #[must_use]
-    pub fn is_active(&self) -> bool {
+    pub(crate) fn is_active(&self) -> bool {
         self.bias_deg_h != Vector3::zeros() || self.bias_instability_deg_h > 0.0
     }
 
@@ -85,12 +85,12 @@ impl GyroErrors {
     /// Gauss–Markov bias, `B √(2/τ_c)`, rad/s/√s (what a filter that models the bias as
     /// a random walk should assume).
     #[must_use]
-    pub fn rate_random_walk_rad_s_rts(&self) -> f64 {
+    pub(crate) fn rate_random_walk_rad_s_rts(&self) -> f64 {
         deg_h_to_rad_s(self.bias_instability_deg_h) * (2.0 / self.bias_correlation_s).sqrt()
     }
 
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if !self.bias_deg_h.iter().all(|v| v.is_finite()) {
             return Err(SimError::InvalidSetting {
                 field: "gyro.bias_deg_h",

@@ -13,9 +13,9 @@
 //!   `Q = [[(σ_v² Δt + σ_u² Δt³/3) I, −½σ_u² Δt² I], [−½σ_u² Δt² I, σ_u² Δt I]]`, where
 //!   `σ_v` is the gyro's angle random walk (rad/√s) and `σ_u` the bias random walk
 //!   (rad/s/√s; the truth's Gauss–Markov instability enters through
-//!   [`super::GyroErrors::rate_random_walk_rad_s_rts`]).
+//!   `GyroErrors::rate_random_walk_rad_s_rts`).
 //! * **Update** with a star-tracker attitude `q̃`: residual `z = log(q̂† q̃)` (≈ δθ + v),
-//!   `H = [I 0]`, noise covariance [`super::StarTracker::covariance_rad2`]; gain
+//!   `H = [I 0]`, noise covariance `StarTracker::covariance_rad2`; gain
 //!   `K = P Hᵀ (H P Hᵀ + R_st)⁻¹`, Joseph-form covariance update, then the reset
 //!   `q̂ ← q̂ exp(δθ̂)`, `b̂ ← b̂ + δb̂`.
 //! * **Initialisation:** `q̂` = the first star-tracker measurement, `b̂ = 0`,
@@ -48,7 +48,7 @@ impl Default for MekfSettings {
 
 impl MekfSettings {
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if !(self.initial_bias_sigma_deg_h.is_finite() && self.initial_bias_sigma_deg_h > 0.0) {
             return Err(SimError::InvalidSetting {
                 field: "mekf.initial_bias_sigma_deg_h",
@@ -62,7 +62,7 @@ impl MekfSettings {
 
 /// The filter.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Mekf {
+pub(crate) struct Mekf {
     q: Quaternion,
     bias_rad_s: Vector3<f64>,
     p: Matrix6<f64>,
@@ -76,7 +76,7 @@ impl Mekf {
     /// (rad², body axes), gyro angle random walk `arw_rad_rts` (rad/√s), bias random walk
     /// `rrw_rad_s_rts` (rad/s/√s) and `settings`.
     #[must_use]
-    pub fn new(
+    pub(crate) fn new(
         q0: Quaternion,
         r_st: Matrix3<f64>,
         arw_rad_rts: f64,
@@ -100,25 +100,25 @@ impl Mekf {
 
     /// The attitude estimate (body → inertial).
     #[must_use]
-    pub fn attitude(&self) -> Quaternion {
+    pub(crate) fn attitude(&self) -> Quaternion {
         self.q
     }
 
     /// The bias estimate, rad/s.
     #[must_use]
-    pub fn bias_rad_s(&self) -> Vector3<f64> {
+    pub(crate) fn bias_rad_s(&self) -> Vector3<f64> {
         self.bias_rad_s
     }
 
     /// The error covariance `P` (δθ in rad, δb in rad/s).
     #[must_use]
-    pub fn covariance(&self) -> Matrix6<f64> {
+    pub(crate) fn covariance(&self) -> Matrix6<f64> {
         self.p
     }
 
     /// Propagate over `dt_s` with the measured delta angle (rad). Returns the
     /// bias-corrected increment `Δθ̃ − b̂ Δt` it propagated with.
-    pub fn propagate(&mut self, measured_angle: &Vector3<f64>, dt_s: f64) -> Vector3<f64> {
+    pub(crate) fn propagate(&mut self, measured_angle: &Vector3<f64>, dt_s: f64) -> Vector3<f64> {
         let theta = measured_angle - self.bias_rad_s * dt_s;
         let inc = Quaternion::exp(&theta);
         self.q = self.q.mul(&inc).normalize().unwrap_or(self.q);
@@ -144,7 +144,7 @@ impl Mekf {
 
     /// Update with a star-tracker attitude. A singular innovation covariance (not
     /// reachable with validated settings) leaves the filter unchanged.
-    pub fn update(&mut self, measured: &Quaternion) {
+    pub(crate) fn update(&mut self, measured: &Quaternion) {
         let z = self.q.conjugate().mul(measured).log();
         let s = self.p.fixed_view::<3, 3>(0, 0) + self.r_st;
         let Some(s_inv) = s.try_inverse() else {

@@ -10,7 +10,7 @@
 //!   variance `σ²/Δ`, so the momentum it imparts over a time T has standard deviation
 //!   `σ √T` per axis. It is not reported in telemetry.
 //!
-//! Sensors ([`sensors`]): an integrating gyro with white rate noise (deg/s/√Hz); the
+//! Sensors ([`gyro`]): an integrating gyro with white rate noise (deg/s/√Hz); the
 //! measured attitude is propagated from the noisy increments, so `φ_k` carries the gyro
 //! noise. Rotor momentum is sampled at the nodes without noise. Everything is seeded and
 //! reproducible: ChaCha8 streams, one for the disturbance and one for the gyro.
@@ -107,7 +107,7 @@ pub enum InertiaChange {
 impl InertiaChange {
     /// The inertia at `t_s`, given the initial one.
     #[must_use]
-    pub fn inertia_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
+    pub(crate) fn inertia_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
         match *self {
             InertiaChange::Step { at_s, to_kg_m2 } => {
                 if t_s >= at_s {
@@ -129,7 +129,7 @@ impl InertiaChange {
 
     /// `J̇` at `t_s` (zero for a step).
     #[must_use]
-    pub fn rate_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
+    pub(crate) fn rate_at(&self, initial: &Matrix3<f64>, t_s: f64) -> Matrix3<f64> {
         match *self {
             InertiaChange::Ramp {
                 start_s,
@@ -177,8 +177,7 @@ pub const MAX_SAMPLES: usize = 10_000_000;
 
 impl SimConfig {
     /// Number of nodes for a duration: `round(duration/dt) + 1`, saturating (a NaN or
-    /// negative ratio gives 1; [`SimConfig::validate`] refuses more than
-    /// [`MAX_SAMPLES`]).
+    /// negative ratio gives 1; a simulation refuses more than [`MAX_SAMPLES`]).
     #[must_use]
     pub fn samples_for(duration_s: f64, dt_s: f64) -> usize {
         ((duration_s / dt_s).round() as usize).saturating_add(1)
@@ -257,7 +256,7 @@ pub enum SimError {
 
 impl SimConfig {
     /// Check every setting.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         let bad = |field, value, why| Err(SimError::InvalidSetting { field, value, why });
         if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
             return bad("dt_s", self.dt_s, "must be finite and > 0");

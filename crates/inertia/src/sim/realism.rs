@@ -77,7 +77,7 @@ impl Default for Realism {
 impl Realism {
     /// The number of integration intervals between star-tracker updates of the MEKF,
     /// for integration step `dt_s`.
-    pub fn tracker_every(&self, dt_s: f64) -> Result<usize, SimError> {
+    pub(crate) fn tracker_every(&self, dt_s: f64) -> Result<usize, SimError> {
         let Some(rate) = self.star_tracker.rate_hz else {
             return Ok(self.telemetry_every);
         };
@@ -94,7 +94,7 @@ impl Realism {
     }
 
     /// Check every setting; `dt_s` is the integration step.
-    pub fn validate(&self, dt_s: f64) -> Result<(), SimError> {
+    pub(crate) fn validate(&self, dt_s: f64) -> Result<(), SimError> {
         if self.telemetry_every == 0 {
             return Err(SimError::InvalidSetting {
                 field: "telemetry_every",

@@ -20,10 +20,10 @@ use crate::tensor::paper_j_true;
 use nalgebra::{Matrix3, Vector3};
 
 /// How much [`physical_j_true`] adds to every principal moment of the paper's J, kg m².
-pub const PHYSICAL_SHIFT_KG_M2: f64 = 1e-4;
+pub(crate) const PHYSICAL_SHIFT_KG_M2: f64 = 1e-4;
 
 /// The paper's J made physical with the least change of one kind: `J + δ I` with `δ` =
-/// [`PHYSICAL_SHIFT_KG_M2`] raises every principal moment by δ and so `J1 + J2 − J3` by
+/// `PHYSICAL_SHIFT_KG_M2` (1e-4 kg m²) raises every principal moment by δ and so `J1 + J2 − J3` by
 /// δ, from −4.9e-5 to +5.1e-5 kg m² (the axes and the products of inertia unchanged;
 /// the diagonal moves by 1e-4 of J11).
 #[must_use]

@@ -70,14 +70,14 @@ impl StarTracker {
 
     /// The body-frame covariance of the error rotation `δθ`, rad².
     #[must_use]
-    pub fn covariance_rad2(&self) -> Matrix3<f64> {
+    pub(crate) fn covariance_rad2(&self) -> Matrix3<f64> {
         let e = self.axes();
         let s = self.noise_arcsec * ARCSEC;
         e * Matrix3::from_diagonal(&s.component_mul(&s)) * e.transpose()
     }
 
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if !self.noise_arcsec.iter().all(|v| v.is_finite() && *v >= 0.0) {
             return Err(SimError::InvalidSetting {
                 field: "star_tracker.noise_arcsec",

@@ -50,12 +50,12 @@ impl RotorVibration {
 
     /// The rotor speed for rotor momentum `rho_nms`, rad/s.
     #[must_use]
-    pub fn rotor_speed_rad_s(&self, rho_nms: &Vector3<f64>) -> f64 {
+    pub(crate) fn rotor_speed_rad_s(&self, rho_nms: &Vector3<f64>) -> f64 {
         rho_nms.norm() / self.rotor_spin_inertia_kg_m2
     }
 
     /// Check every field.
-    pub fn validate(&self) -> Result<(), SimError> {
+    pub(crate) fn validate(&self) -> Result<(), SimError> {
         if !self.amplitude_rad_s.iter().all(|v| v.is_finite()) {
             return Err(SimError::InvalidSetting {
                 field: "vibration.amplitude_rad_s",

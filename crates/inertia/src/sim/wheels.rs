@@ -71,7 +71,7 @@ impl Default for WheelTelemetry {
 impl WheelTelemetry {
     /// The fixed map `C_m diag(1 + ε)` from true to telemetered ρ.
     #[must_use]
-    pub fn map(&self) -> Matrix3<f64> {
+    pub(crate) fn map(&self) -> Matrix3<f64> {
         Quaternion::exp(&(self.misalignment_deg * DEG)).to_matrix()
             * Matrix3::from_diagonal(&self.scale_error.add_scalar(1.0))
     }
@@ -83,7 +83,7 @@ impl WheelTelemetry {
     }
 
     /// The number m of telemetry samples per wheel-speed update (1 without a hold).
-    pub fn hold_every(&self, telemetry_dt_s: f64) -> Result<usize, SimError> {
+    pub(crate) fn hold_every(&self, telemetry_dt_s: f64) -> Result<usize, SimError> {
         let Some(rate) = self.hold_hz else {
             return Ok(1);
         };
@@ -100,7 +100,7 @@ impl WheelTelemetry {
     }
 
     /// Check every field; `telemetry_dt_s` bounds the skew.
-    pub fn validate(&self, telemetry_dt_s: f64) -> Result<(), SimError> {
+    pub(crate) fn validate(&self, telemetry_dt_s: f64) -> Result<(), SimError> {
         let bad = |field, value, why| Err(SimError::InvalidSetting { field, value, why });
         if !(self.quantization_nms.is_finite() && self.quantization_nms >= 0.0) {
             return bad(
@@ -181,12 +181,12 @@ impl WheelSensor {
 /// One integration substep's ends: times, ρ and ρ̇ (the ρ̇ used inside the substep).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct RhoSpan {
-    pub t0: f64,
-    pub t1: f64,
-    pub rho0: Vector3<f64>,
-    pub rho1: Vector3<f64>,
-    pub rd0: Vector3<f64>,
-    pub rd1: Vector3<f64>,
+    pub(crate) t0: f64,
+    pub(crate) t1: f64,
+    pub(crate) rho0: Vector3<f64>,
+    pub(crate) rho1: Vector3<f64>,
+    pub(crate) rd0: Vector3<f64>,
+    pub(crate) rd1: Vector3<f64>,
 }
 
 impl RhoSpan {

@@ -10,6 +10,9 @@
 //! `|ω_q − w|/|w|` as read against each alternative reading; the one that fits names the
 //! option that fixes the file. Fixed size, no allocation.
 
+// The crate-internal helpers here serve the std front ends (pipeline, CSV reader).
+#![cfg_attr(not(feature = "std"), allow(dead_code))]
+
 use crate::attitude::Quaternion;
 use crate::fix::Fix;
 use crate::sample::Sample;
@@ -18,12 +21,12 @@ use nalgebra::Vector3;
 /// Steps needed before a verdict.
 pub const STEPS_NEEDED: usize = 64;
 /// Smallest gyro rate counted, rad/s (a step slower than this says little about frames).
-pub const MIN_RATE_RAD_S: f64 = 2e-3;
+pub(crate) const MIN_RATE_RAD_S: f64 = 2e-3;
 /// Smallest `|cos|` of the angle between the gyro's rate and the attitude's for a step to
 /// count in the gyro-unit check (a random direction passes with probability 5 %).
-pub const SCALE_MIN_COS: f64 = 0.9;
+pub(crate) const SCALE_MIN_COS: f64 = 0.9;
 /// A reading fits when its median relative mismatch is below this.
-pub const FIT: f64 = 0.25;
+pub(crate) const FIT: f64 = 0.25;
 
 /// Readings of the quaternion columns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,7 +67,7 @@ impl Reading {
 
     /// The fix, in words (no front end's option: [`Self::fixes`] carries it typed).
     #[must_use]
-    pub fn fix(&self) -> &'static str {
+    pub(crate) fn fix(&self) -> &'static str {
         match self {
             Reading::AsRead => "none needed",
             Reading::Conjugated => {
@@ -96,7 +99,7 @@ impl Reading {
 
     /// The settings that read the columns this way.
     #[must_use]
-    pub fn fixes(&self) -> &'static [Fix] {
+    pub(crate) fn fixes(&self) -> &'static [Fix] {
         match self {
             Reading::AsRead | Reading::GyroNegated => &[],
             Reading::GyroDegrees => &[Fix::GyroDegrees],
@@ -238,7 +241,7 @@ impl ConventionCheck {
 
     /// Whether both the frame check and the scale check have their steps.
     #[must_use]
-    pub fn decided(&self) -> bool {
+    pub(crate) fn decided(&self) -> bool {
         self.steps >= STEPS_NEEDED && self.scale_steps >= STEPS_NEEDED
             || self.unit_verdict().is_some()
     }
@@ -270,7 +273,7 @@ impl ConventionCheck {
 
     /// Steps gathered.
     #[must_use]
-    pub fn steps(&self) -> usize {
+    pub(crate) fn steps(&self) -> usize {
         self.steps.max(if self.unit_verdict().is_some() {
             self.scale_steps
         } else {

@@ -17,7 +17,7 @@
 //!
 //! Every error names the file, the line and the column. The reader refuses what is about
 //! the file: unparsable numbers, missing or duplicated columns, lines longer than
-//! [`MAX_LINE_BYTES`] (checked while reading, so a file without line breaks fails fast),
+//! `MAX_LINE_BYTES` (1 MiB) (checked while reading, so a file without line breaks fails fast),
 //! lines starting with `#` (there are no comment lines: every non-blank line is data). The
 //! values themselves go through the sample gate that Python's arrays and the C API also use
 //! ([`super::gate`], [`TelemetryError::Sample`]): NaN or infinite values, values outside the
@@ -30,10 +30,10 @@
 //! once ([`crate::estimator::rows`]).
 //!
 //! Messages are one line of bounded length: quoted file content is cut after
-//! [`crate::text::MAX_QUOTED_CHARS`] characters, numbers use [`crate::text::Num`].
+//! `MAX_QUOTED_CHARS` (80) characters, numbers use [`crate::text::Num`].
 //!
 //! ISO time stamps are converted to elapsed seconds across UTC leap seconds
-//! (`23:59:60`; [`super::time_stamp`]).
+//! (`23:59:60`), counting the leap seconds of the IERS table and any the file shows.
 //!
 //! Irregular sampling is accepted: the variational rows handle unequal steps. Consecutive quaternions of opposite
 //! sign (`q` and `−q` are the same attitude) are accepted and counted. Nothing is dropped:
@@ -57,7 +57,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// The longest line accepted, bytes (1 MiB).
-pub const MAX_LINE_BYTES: usize = 1 << 20;
+pub(crate) const MAX_LINE_BYTES: usize = 1 << 20;
 
 /// Column names. Defaults are those of the table in the module docs.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -164,7 +164,7 @@ pub enum TelemetryError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// A line is longer than [`MAX_LINE_BYTES`] (found before it is read whole).
+    /// A line is longer than `MAX_LINE_BYTES` (1 MiB) (found before it is read whole).
     #[error("{file}:{line}: line longer than {limit} bytes (no line break?)")]
     LineTooLong {
         /// File name.
@@ -409,7 +409,7 @@ impl<R: Read> TelemetryReader<R> {
 
     /// Bytes consumed so far (for progress reporting).
     #[must_use]
-    pub fn byte_position(&self) -> u64 {
+    pub(crate) fn byte_position(&self) -> u64 {
         self.reader.position().byte()
     }
 

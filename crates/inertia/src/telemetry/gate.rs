@@ -59,7 +59,7 @@ pub enum GyroUnit {
 impl GyroUnit {
     /// The factor that turns a stored rate into rad/s.
     #[must_use]
-    pub fn to_rad_s(self) -> f64 {
+    pub(crate) fn to_rad_s(self) -> f64 {
         match self {
             Self::RadPerS => 1.0,
             Self::DegPerS => core::f64::consts::PI / 180.0,
@@ -215,7 +215,7 @@ impl ReadStats {
     /// Count the step of `dt` s into the next sample, whose quaternion `q` follows `prev`
     /// (before that sample is counted in `rows`): the shortest and longest step, and a sign
     /// opposite to the previous quaternion's.
-    pub fn step(&mut self, dt: f64, prev: &Quaternion, q: &Quaternion) {
+    pub(crate) fn step(&mut self, dt: f64, prev: &Quaternion, q: &Quaternion) {
         self.min_step_s = if self.rows > 1 {
             self.min_step_s.min(dt)
         } else {
@@ -238,7 +238,7 @@ pub struct Order {
 
 impl Order {
     /// Whether a sample at `t_s`, with gyro rates or not, may follow the accepted ones.
-    pub fn check(&self, t_s: f64, has_gyro: bool) -> Result<(), SampleError> {
+    pub(crate) fn check(&self, t_s: f64, has_gyro: bool) -> Result<(), SampleError> {
         if let Some(g) = self.gyro {
             if g != has_gyro {
                 return Err(SampleError::GyroChanged {
@@ -255,14 +255,14 @@ impl Order {
     }
 
     /// Record an accepted sample.
-    pub fn accept(&mut self, t_s: f64, has_gyro: bool) {
+    pub(crate) fn accept(&mut self, t_s: f64, has_gyro: bool) {
         self.last_t_s = Some(t_s);
         self.gyro = Some(has_gyro);
     }
 
     /// The time of the last accepted sample, s.
     #[must_use]
-    pub fn last_t_s(&self) -> Option<f64> {
+    pub(crate) fn last_t_s(&self) -> Option<f64> {
         self.last_t_s
     }
 }
@@ -357,7 +357,7 @@ impl Gate {
     }
 
     /// Count a sample refused by its front end before the gate saw it (unparsable).
-    pub fn reject(&mut self) {
+    pub(crate) fn reject(&mut self) {
         self.stats.rejected += 1;
     }
 

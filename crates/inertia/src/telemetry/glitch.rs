@@ -6,26 +6,29 @@
 //! must match the gyro's average rate `w_k` over the same step to within the sensors'
 //! noise and an O(h²) remainder (as in [`super::convention`]). A step is a glitch when its
 //! mismatch `m = |ω_q − w|` is both far outside the recent steps' — `m² >`
-//! [`GLITCH_RATIO`]`² · E[m²]`, with `E[m²]` an exponential mean over the recent
-//! unflagged steps ([`MEMORY_STEPS`]) — and large in absolute terms,
-//! `m >` [`RELATIVE_FLOOR`]` · |w| +` [`ABSOLUTE_FLOOR_RAD_S`] (so that a gyro-propagated
+//! `GLITCH_RATIO² · E[m²]` (`GLITCH_RATIO` = 20), with `E[m²]` an exponential mean over the recent
+//! unflagged steps (`MEMORY_STEPS` = 100) — and large in absolute terms,
+//! `m > RELATIVE_FLOOR · |w| + ABSOLUTE_FLOOR_RAD_S` (0.1 and 1e-3 rad/s; so that a gyro-propagated
 //! attitude, whose mismatch is round-off, or the O(h²) remainder at 1 Hz never trip it).
 //! A 1° jump at 10 Hz is a 0.17 rad/s mismatch; a star tracker's 40″ roll noise about
 //! 3e-3 rad/s. Steps across a gap ([`crate::sample::is_gap`]) are not tested. Fixed size,
 //! no allocation.
 
+// The crate-internal helpers here serve the std front ends (pipeline, CSV reader).
+#![cfg_attr(not(feature = "std"), allow(dead_code))]
+
 use crate::sample::Sample;
 
 /// Mismatch, in RMS of the recent steps' mismatch, beyond which a step may be a glitch.
-pub const GLITCH_RATIO: f64 = 20.0;
+pub(crate) const GLITCH_RATIO: f64 = 20.0;
 /// Mismatch, as a fraction of the gyro rate, below which a step is never a glitch.
-pub const RELATIVE_FLOOR: f64 = 0.1;
+pub(crate) const RELATIVE_FLOOR: f64 = 0.1;
 /// Mismatch, rad/s, below which a step is never a glitch (with [`RELATIVE_FLOOR`]).
-pub const ABSOLUTE_FLOOR_RAD_S: f64 = 1e-3;
+pub(crate) const ABSOLUTE_FLOOR_RAD_S: f64 = 1e-3;
 /// Time constant of the recent steps' mean square mismatch, in steps.
-pub const MEMORY_STEPS: f64 = 100.0;
+pub(crate) const MEMORY_STEPS: f64 = 100.0;
 /// Steps before any verdict (the mean must have something to stand on).
-pub const WARM_UP_STEPS: usize = 20;
+pub(crate) const WARM_UP_STEPS: usize = 20;
 
 /// A step the test flags.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +72,7 @@ pub enum GlitchPolicy {
 }
 
 /// Glitches listed in full; beyond, only counted.
-pub const LISTED: usize = 16;
+pub(crate) const LISTED: usize = 16;
 
 /// The running test ([module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,7 +103,7 @@ impl Default for GlitchCheck {
 impl GlitchCheck {
     /// Test the step that ends at `s`; the glitch, when it is one (also counted and,
     /// among the first [`LISTED`], listed).
-    pub fn push(&mut self, s: &Sample) -> Option<Glitch> {
+    pub(crate) fn push(&mut self, s: &Sample) -> Option<Glitch> {
         let index = self.samples;
         self.samples += 1;
         let a = self.prev.replace(*s)?;
@@ -148,7 +151,7 @@ impl GlitchCheck {
     }
 
     /// The first [`LISTED`] steps flagged.
-    pub fn listed(&self) -> impl Iterator<Item = &Glitch> {
+    pub(crate) fn listed(&self) -> impl Iterator<Item = &Glitch> {
         self.listed.iter().flatten()
     }
 }

@@ -11,9 +11,9 @@ use std::io::{self, Read};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct LineTooLong {
     /// The 1-based physical line.
-    pub line: u64,
+    pub(crate) line: u64,
     /// The limit, bytes.
-    pub limit: usize,
+    pub(crate) limit: usize,
 }
 
 impl std::fmt::Display for LineTooLong {

@@ -13,4 +13,4 @@ mod line_cap;
 #[cfg(feature = "csv")]
 pub mod read_ahead;
 #[cfg(feature = "csv")]
-pub mod time_stamp;
+pub(crate) mod time_stamp;

@@ -2,7 +2,7 @@
 //!
 //! Parsing the CSV is about a tenth of the time of a long file's estimate; a
 //! [`ReadAhead`] moves it to a reader thread that fills batches of
-//! [`BATCH_SAMPLES`] samples into a bounded channel of [`BATCHES_AHEAD`] batches, so
+//! `BATCH_SAMPLES` (512) samples into a bounded channel of `BATCHES_AHEAD` (8) batches, so
 //! memory stays fixed whatever the file's length. It yields exactly what the
 //! [`TelemetryReader`] would, in order, each item with the line it came from; the reader
 //! stops at its first error, as the reader does. Dropping a `ReadAhead` early (an
@@ -16,10 +16,10 @@ use std::sync::mpsc::{sync_channel, Receiver};
 use std::thread::JoinHandle;
 
 /// Samples per batch handed from the reader thread to the estimator.
-pub const BATCH_SAMPLES: usize = 512;
+pub(crate) const BATCH_SAMPLES: usize = 512;
 
 /// Batches the reader thread may be ahead (bounded memory).
-pub const BATCHES_AHEAD: usize = 8;
+pub(crate) const BATCHES_AHEAD: usize = 8;
 
 /// One item of the reader, with the line it ended on and the bytes consumed by then.
 struct Item {

@@ -10,7 +10,7 @@
 
 /// Unix time of the end (the following midnight, UTC) of each leap second inserted
 /// since 1972, from the IERS table (27, the last at the end of 2016-12-31).
-pub const LEAP_SECOND_ENDS: [i64; 27] = [
+pub(crate) const LEAP_SECOND_ENDS: [i64; 27] = [
     78_796_800,
     94_694_400,
     126_230_400,
@@ -42,14 +42,14 @@ pub const LEAP_SECOND_ENDS: [i64; 27] = [
 
 /// Converts time stamps to seconds on a continuous scale, counting leap seconds.
 #[derive(Debug, Clone, Default)]
-pub struct Clock {
+pub(crate) struct Clock {
     /// Ends of leap seconds seen in the data and absent from the table.
     seen: Vec<i64>,
 }
 
 /// Why a time stamp was refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StampError {
+pub(crate) enum StampError {
     /// Not an ISO-8601 / RFC 3339 time stamp.
     Unparsable,
     /// Second 60 anywhere but at 23:59:60 UTC.
@@ -66,7 +66,7 @@ impl Clock {
 
     /// `(seconds, nanoseconds)` of a time stamp on the continuous scale (Unix time plus
     /// leap seconds so far); without an offset it is taken as UTC.
-    pub fn parse(&mut self, raw: &str) -> Result<(i64, i64), StampError> {
+    pub(crate) fn parse(&mut self, raw: &str) -> Result<(i64, i64), StampError> {
         let Some(i) = leap_second_field(raw) else {
             let (unix, nanos) = unix_time(raw).ok_or(StampError::Unparsable)?;
             return Ok((unix + self.leaps_before(unix), nanos));
