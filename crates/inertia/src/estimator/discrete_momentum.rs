@@ -25,6 +25,10 @@ use nalgebra::{Vector3, Vector6};
 /// disturbance torque ([`torque_tested`]).
 pub const TORQUE_CHI2: f64 = 16.27;
 
+/// A torque the χ² test keeps is still held at zero where holding it moves no element of
+/// the answer by more than this many of the answer's jackknife σ ([`torque_tested`]).
+pub const TORQUE_SHIFT_Z: f64 = 5.0;
+
 /// The outcome of the test for a constant disturbance torque at a solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -32,8 +36,16 @@ pub struct TorqueTest {
     /// `Δρ²/s²`: how much of the residual the torque unknowns explain, in noise
     /// variances (χ²₃ when there is no torque and the rows' errors are independent).
     pub chi2: f64,
-    /// Whether `τ_b` was held at zero (`chi2 ≤` [`TORQUE_CHI2`]).
+    /// Whether `τ_b` was held at zero (`chi2 ≤` [`TORQUE_CHI2`], or the answer's shift
+    /// within [`TORQUE_SHIFT_Z`] of its σ).
     pub held_at_zero: bool,
+    /// The largest shift of an element of the answer when the torque is held at zero,
+    /// in the answer's jackknife σ; `None` where the χ² test decided alone.
+    pub shift_z: Option<f64>,
+    /// That shift per element, `|ĵ − ĵ|τ_b=0|`, kg m², where the torque was held at zero
+    /// by it: the model uncertainty the held answer's σ carries.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub held_shift_kg_m2: Option<[f64; 6]>,
 }
 
 /// The reduced state to solve, and the torque test: `with` has the disturbance torque
@@ -47,15 +59,27 @@ pub struct TorqueTest {
 /// [`TORQUE_CHI2`] the data give no evidence of one and `τ_b` is held at zero: three
 /// unknowns fewer, measured in the README's matrix to lower the median error in 43 of
 /// 58 cells and raise it in 8, by at most 3 % (the paper's spin 3.0e-6 → 2.8e-6, four
-/// of the 1 Hz spins by 2–3×). Errors correlated along the chain (a propagated
-/// attitude's random walk) can make `s²` too small and the statistic too large, which
-/// errs toward keeping the torque. The σ stays that of the
-/// model with the torque where the jackknife's (which keeps `τ_b` in every delete-one
-/// problem) is the larger, as it mostly is.
+/// of the 1 Hz spins by 2–3×).
+///
+/// Errors correlated along the chain (a propagated attitude's random walk, a short
+/// record's vibration) make `s²` too small and the statistic too large, which errs
+/// toward keeping a torque that is not there, and three unknowns more cost a short record
+/// 5–10× its error. So where the χ² test keeps the torque and the answer has a jackknife
+/// σ (`sigma`, [`super::jackknife`]: correlated errors count there as they are), the
+/// torque is held at zero unless holding it moves some element of the answer by more than
+/// [`TORQUE_SHIFT_Z`] of that σ: the torque must matter to the answer, not only to the
+/// residuals. The held answer's σ then carries the move `|ĵ − ĵ|τ_b=0|`
+/// ([`TorqueTest::held_shift_kg_m2`]), the two models being ones the data do not tell
+/// apart. The move is taken with the prior knowledge of `constraints` stacked on, as the
+/// answer is. (Measuring the move against its own jackknife σ instead fails where the
+/// torque is real: the delete-one answers without it then scatter with the torque's
+/// effect on each group, and a 1e-5 N m torque on the slew was dropped at 1e-2 error.)
 #[must_use]
 pub fn torque_tested(
     with: RecursiveQr,
     without: Option<(RecursiveQr, f64)>,
+    sigma: Option<[f64; 6]>,
+    constraints: &Constraints,
 ) -> (RecursiveQr, Option<TorqueTest>) {
     let Some((without, growth)) = without else {
         return (with, None);
@@ -67,9 +91,42 @@ pub fn torque_tested(
     if !(s2.is_finite() && s2 > 0.0 && chi2.is_finite() && chi2 >= 0.0) {
         return (with, None);
     }
-    let held_at_zero = chi2 <= TORQUE_CHI2;
-    let test = TorqueTest { chi2, held_at_zero };
-    (if held_at_zero { without } else { with }, Some(test))
+    let mut test = TorqueTest {
+        chi2,
+        held_at_zero: chi2 <= TORQUE_CHI2,
+        shift_z: None,
+        held_shift_kg_m2: None,
+    };
+    if !test.held_at_zero {
+        if let Some((d, z)) = sigma.and_then(|sd| shift(&with, &without, &sd, constraints)) {
+            test.shift_z = Some(z);
+            if z <= TORQUE_SHIFT_Z {
+                test.held_at_zero = true;
+                test.held_shift_kg_m2 = Some(d.map(f64::abs));
+            }
+        }
+    }
+    (if test.held_at_zero { without } else { with }, Some(test))
+}
+
+/// The shift `d = ĵ − ĵ|τ_b=0` of the unconstrained answers, with prior knowledge, and
+/// its largest `|d_k|/σ_k` over the elements with `σ_k > 0`.
+fn shift(
+    with: &RecursiveQr,
+    without: &RecursiveQr,
+    sigma: &[f64; 6],
+    constraints: &Constraints,
+) -> Option<([f64; 6], f64)> {
+    let solve = |qr: &RecursiveQr| {
+        let a = super::prior::augment(qr, constraints).0;
+        crate::solver::unconstrained_minimiser(&a.r, &a.z)
+    };
+    let d = solve(with)? - solve(without)?;
+    let z = (0..6)
+        .filter(|&k| sigma[k] > 0.0)
+        .map(|k| d[k].abs() / sigma[k])
+        .fold(0.0, f64::max);
+    z.is_finite().then(|| (core::array::from_fn(|k| d[k]), z))
 }
 
 /// Settings of the discrete momentum estimator.
@@ -100,6 +157,9 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     /// The jackknife's chain groups; `None` with forgetting or after
     /// [`DiscreteMomentumEstimator::stop_jackknife`].
     groups: Option<ChainGroups>,
+    /// Whether the groups' σ joins the noise σ (else they serve the torque test only,
+    /// [`Self::jackknife_for_torque_only`]).
+    jackknife_in_sigma: bool,
     svd: SvdTracker,
     sv: Vector6<f64>,
     reduced: RecursiveQr,
@@ -139,6 +199,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
                 .memory_s
                 .is_none()
                 .then(ChainGroups::default),
+            jackknife_in_sigma: true,
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
             reduced: RecursiveQr::new(),
@@ -255,6 +316,18 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         self.groups = None;
     }
 
+    /// Keep the jackknife's groups for the torque test alone ([`torque_tested`]): the
+    /// noise σ is the least-squares one, as after [`Self::stop_jackknife`], which this is
+    /// where the torque is not tested. For a state whose σ comes from elsewhere (the
+    /// whole record as one chain, whose siblings' jackknife σ it takes).
+    pub fn jackknife_for_torque_only(&mut self) {
+        if self.settings.rows.torque_bias && self.settings.recursive.memory_s.is_none() {
+            self.jackknife_in_sigma = false;
+        } else {
+            self.stop_jackknife();
+        }
+    }
+
     /// Feed one sample. Returns an estimate when this sample completed a block and a solve
     /// was due.
     pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
@@ -274,7 +347,14 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let without = (self.settings.rows.torque_bias
             && self.settings.recursive.memory_s.is_none())
         .then(|| self.qr.shared().reduced_without_torque());
-        (self.reduced, self.torque_test) = torque_tested(with, without);
+        // The yardstick of the torque test's shift: the answer's jackknife σ (its groups
+        // keep the torque).
+        let yardstick = match (&without, self.groups.as_mut()) {
+            (Some(_), Some(g)) => g.sigma(&self.constraints),
+            _ => None,
+        };
+        (self.reduced, self.torque_test) =
+            torque_tested(with, without, yardstick, &self.constraints);
         let (solved, fit) = super::prior::augment(&self.reduced, &self.constraints);
         self.solved = solved;
         self.sv = self.svd.singular_values(&self.solved.r);
@@ -304,6 +384,9 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// ([`super::jackknife`]), kg m²; `None` with too few chains, with forgetting or
     /// after [`Self::stop_jackknife`].
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
+        if !self.jackknife_in_sigma {
+            return None;
+        }
         // Borrowed apart, not copied: the constraint set is large.
         let Self {
             groups,
@@ -314,13 +397,16 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
-    /// ([`super::jackknife`]), kg m².
+    /// ([`super::jackknife`]), and in quadrature with it the answer's shift where the
+    /// torque test held a torque at zero for moving the answer too little
+    /// ([`torque_tested`]), kg m².
     pub fn robust_noise_sigma(&mut self) -> Option<[f64; 6]> {
         let ls = self.noise_sigma()?;
-        Some(super::jackknife::robust_sigma(
-            &ls,
-            self.jackknife_sigma().as_ref(),
-        ))
+        let s = super::jackknife::robust_sigma(&ls, self.jackknife_sigma().as_ref());
+        Some(match self.torque_test.and_then(|t| t.held_shift_kg_m2) {
+            Some(d) => core::array::from_fn(|k| crate::math::sqrt(s[k] * s[k] + d[k] * d[k])),
+            None => s,
+        })
     }
 
     /// The reduced least-squares state in `j` at the last solve.

@@ -80,7 +80,12 @@ pub(super) fn run_batch(
             estimator: DISCRETE_MOMENTUM.name,
         });
     };
-    let (tested, torque_test) = torque_tested(batch.qr, batch.without_torque);
+    let (tested, torque_test) = torque_tested(
+        batch.qr,
+        batch.without_torque,
+        batch.jackknife_sigma_kg_m2,
+        &c.constraints,
+    );
     let mut run = BatchRun {
         samples,
         config: c,
@@ -153,7 +158,12 @@ impl BatchRun<'_> {
         );
         // As the recursive solve does: the torque held at zero where the data give no
         // evidence of one.
-        let (tested, _) = torque_tested(b.qr, b.without_torque);
+        let (tested, test) = torque_tested(
+            b.qr,
+            b.without_torque,
+            b.jackknife_sigma_kg_m2,
+            &c.constraints,
+        );
         let e = batch::solve_reduced(
             &tested,
             self.t_s,
@@ -180,6 +190,12 @@ impl BatchRun<'_> {
             noise_sigma(&solved, &svd.singular_values, &v_t.transpose())
                 .map(|ls| robust_sigma(&prior::zero_fixed(ls, &c.constraints), jackknife.as_ref()))
         });
+        // As the recursive estimator's: a torque held at zero for moving the answer too
+        // little leaves that move in σ.
+        let noise = match (noise, test.and_then(|t| t.held_shift_kg_m2)) {
+            (Some(s), Some(d)) => Some(core::array::from_fn(|k| s[k].hypot(d[k]))),
+            (s, _) => s,
+        };
         Ok((e, noise))
     }
 }

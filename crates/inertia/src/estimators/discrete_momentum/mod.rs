@@ -200,7 +200,7 @@ impl DiscreteMomentum {
         self.fits.reserve(rows.len());
         for (c, r) in self.candidates.iter_mut().zip(&rows) {
             if chained_siblings(r, rows.iter(), 0.0).next().is_some() {
-                c.stop_jackknife();
+                c.jackknife_for_torque_only();
             }
         }
         self.rows = rows;
