@@ -112,3 +112,102 @@ fn native_agrees_with_clarabel_with_equalities() {
     eprintln!("{n} problems with equalities: {compared} compared, worst objective {worst_obj:e}");
     assert!(compared > n / 2, "{compared}");
 }
+
+/// Issue 30, item 7: on the paper's slew with the paper's J (which breaks the triangle
+/// inequality by 4.9e-5 kg m², so that the physical set's `Σ ⪰ 0` face is active and
+/// barely pressed on: the constrained objective is ~1e-10 of `‖z‖²`), every estimator
+/// with a backend choice gives the same answers with either backend: the final J within
+/// 1e-7 (relative, Frobenius), the same status and reason at every estimate, the same
+/// constraint-conflict χ² (1e-4 relative) and the same row model. Before the fix Clarabel
+/// stopped at a point ~1e-5 inside the face (its gap tolerance is relative to the
+/// objective without the constant `‖z‖²`), 7e-7 to 2.6e-6 from the optimum.
+#[test]
+fn backends_agree_on_every_estimator_where_the_constraints_barely_press() {
+    use inertia::estimator::observability::Unobservable;
+    use inertia::estimator::Estimate;
+    use inertia::pipeline::registry::ESTIMATORS;
+    use inertia::pipeline::{Pipeline, PipelineSettings};
+    use inertia::sim::scenario::{Common, Scenario};
+
+    let out = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let run = |estimator: &str, solver: &str| {
+        let settings = PipelineSettings {
+            estimator: estimator.into(),
+            solver: solver.into(),
+            ..PipelineSettings::default()
+        };
+        let mut p = Pipeline::new(&settings).unwrap();
+        let mut history: Vec<Estimate> = Vec::new();
+        for s in &out.samples {
+            p.push_each(s, |e| history.push(*e)).unwrap();
+        }
+        (history, p.row_model())
+    };
+    let relative = |a: &inertia::tensor::InertiaVector, b: &inertia::tensor::InertiaVector| {
+        (a - b).norm() / a.norm()
+    };
+    let mut compared = 0;
+    for entry in ESTIMATORS.iter().filter(|e| e.capabilities.constraints) {
+        let name = entry.name;
+        let (native, rows_native) = run(name, "native");
+        let (clarabel, rows_clarabel) = run(name, "clarabel");
+        assert_eq!(native.len(), clarabel.len(), "{name}: estimates");
+        assert_eq!(rows_native, rows_clarabel, "{name}: row model");
+        let mut worst = (0.0f64, 0.0f64);
+        for (a, b) in native.iter().zip(&clarabel) {
+            assert_eq!(a.t_s, b.t_s, "{name}");
+            let (sa, sb) = (a.observability, b.observability);
+            assert_eq!(
+                sa.code(),
+                sb.code(),
+                "{name} at {} s: {sa:?} / {sb:?}",
+                a.t_s
+            );
+            assert_eq!(
+                sa.reason().map(|r| std::mem::discriminant(&r)),
+                sb.reason().map(|r| std::mem::discriminant(&r)),
+                "{name} at {} s: {sa:?} / {sb:?}",
+                a.t_s
+            );
+            if let (
+                Some(Unobservable::ConflictsWithConstraints { chi2: ca }),
+                Some(Unobservable::ConflictsWithConstraints { chi2: cb }),
+            ) = (sa.reason(), sb.reason())
+            {
+                assert!(
+                    (ca - cb).abs() <= 1e-4 * ca,
+                    "{name} at {} s: χ² {ca} / {cb}",
+                    a.t_s
+                );
+            }
+            assert_eq!(
+                a.solution.map(|s| s.status),
+                b.solution.map(|s| s.status),
+                "{name} at {} s",
+                a.t_s
+            );
+            if let (Some(ja), Some(jb)) = (a.j(), b.j()) {
+                let d = relative(&ja, &jb);
+                if d > worst.0 {
+                    worst = (d, a.t_s);
+                }
+            }
+        }
+        let (a, b) = (native.last().unwrap(), clarabel.last().unwrap());
+        let (ja, jb) = (a.j().unwrap(), b.j().unwrap());
+        let last = relative(&ja, &jb);
+        eprintln!(
+            "{name}: {} estimates, final J {last:.1e} apart ({:?}); the most, {:.1e}, at {} s",
+            native.len(),
+            a.solution.map(|s| s.status),
+            worst.0,
+            worst.1
+        );
+        assert!(
+            last <= 1e-7,
+            "{name}: final J {last:e} apart\nnative {ja:?}\nclarabel {jb:?}"
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 3, "the estimators with a backend choice");
+}
