@@ -11,6 +11,14 @@ pub(crate) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
+/// Sample standard deviation (the simulator's noise-statistics tests).
+#[cfg(feature = "sim")]
+pub(crate) fn sample_std(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
 /// Default momentum row settings with the given rotation source and longest chain.
 pub(crate) fn rows(
     rotation: crate::estimator::momentum_rows::RotationSource,

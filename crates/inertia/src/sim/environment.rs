@@ -169,7 +169,7 @@ pub struct Environment {
 impl Environment {
     /// Whether any torque acts.
     #[must_use]
-    pub fn is_active(&self) -> bool {
+    pub(crate) fn is_active(&self) -> bool {
         self.orbit.is_some()
             || self.constant_torque_nm != Vector3::zeros()
             || self.inertial_torque_nm != Vector3::zeros()

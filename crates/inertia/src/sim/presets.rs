@@ -324,3 +324,24 @@ impl Preset {
         self.scenario.simulate(&self.common)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The throw turns the lab effects on, and each can be switched off.
+    #[test]
+    fn throw_effects_are_on_and_can_be_switched_off() {
+        let r = Preset::throw().common.realism;
+        assert!(r.vibration.is_active() && r.wheels.is_active() && r.environment.is_active());
+        let all = [
+            LabEffect::Vibration,
+            LabEffect::SpeedTelemetry,
+            LabEffect::InertialTorque,
+            LabEffect::Drag,
+        ];
+        let bare = Preset::throw_without(&all).common.realism;
+        assert!(!bare.vibration.is_active());
+        assert!(!bare.wheels.is_active() && !bare.environment.is_active());
+    }
+}

@@ -8,7 +8,7 @@
 //! the same noisy increments, `q̃_{k+1} = q̃_k (q_k† q_{k+1}) exp(n_k)`, i.e. an ideal
 //! (coning-compensated) strapdown integration whose only error is the gyro noise.
 //!
-//! [`super::gyro::Gyro`] draws that noise from stream 1 and adds bias and bias
+//! The gyro of [`super::gyro`] draws that noise from stream 1 and adds bias and bias
 //! instability when they are set.
 
 use rand_distr::Normal;

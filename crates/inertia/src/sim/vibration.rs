@@ -44,7 +44,7 @@ impl Default for RotorVibration {
 impl RotorVibration {
     /// Whether the gyro vibrates.
     #[must_use]
-    pub fn is_active(&self) -> bool {
+    pub(crate) fn is_active(&self) -> bool {
         self.amplitude_rad_s != Vector3::zeros()
     }
 

@@ -78,7 +78,7 @@ impl WheelTelemetry {
 
     /// Whether the telemetered ρ differs from the true node value in any way.
     #[must_use]
-    pub fn is_active(&self) -> bool {
+    pub(crate) fn is_active(&self) -> bool {
         *self != Self::default()
     }
 

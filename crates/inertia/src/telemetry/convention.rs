@@ -5,8 +5,9 @@
 //! O(h²)), which must match the gyro's average rate `w_k` over the same step. Read with the
 //! wrong convention, it does not: a conjugated quaternion (JPL / inertial → body) gives
 //! `ω_q ≈ −C ω` in the wrong frame; scalar-first columns read as scalar-last scramble the
-//! components. [`ConventionCheck`] gathers steps in which the body turns clearly faster than
-//! the gyro noise, and [`ConventionCheck::verdict`] compares the median relative mismatch
+//! components. The check (`ConventionCheck`, run by the pipeline's `AttitudeChecks`)
+//! gathers steps in which the body turns clearly faster than the gyro noise, and its
+//! [`Verdict`] compares the median relative mismatch
 //! `|ω_q − w|/|w|` as read against each alternative reading; the one that fits names the
 //! option that fixes the file. Fixed size, no allocation.
 
@@ -160,7 +161,7 @@ pub enum Verdict {
 
 /// Mismatches of the steps gathered so far, per reading.
 #[derive(Debug, Clone)]
-pub struct ConventionCheck {
+pub(crate) struct ConventionCheck {
     prev: Option<Sample>,
     mismatch: [[f64; STEPS_NEEDED]; 7],
     steps: usize,
@@ -183,7 +184,7 @@ impl Default for ConventionCheck {
 
 impl ConventionCheck {
     /// Feed the next sample (no effect once decided, or without gyro rates).
-    pub fn push(&mut self, s: &Sample) {
+    pub(crate) fn push(&mut self, s: &Sample) {
         if self.decided() {
             return;
         }
@@ -224,7 +225,7 @@ impl ConventionCheck {
     /// direction). The last condition keeps out steps whose attitude turns by its noise
     /// alone (a star tracker's 40″ at 10 Hz is ~3e-3 rad/s), whose `ω_q` points anywhere
     /// and whose ratio is noise: once their median fell within 10 % of π/180 on honest
-    /// rad/s data, and they hid a real deg/s (tests/integration/gyro_unit.rs).
+    /// rad/s data, and they hid a real deg/s (the unit tests in telemetry/convention/tests.rs).
     fn push_scale(&mut self, a: &Sample, b: &Sample, w: &Vector3<f64>, h: f64) {
         let wn = w.norm();
         if self.scale_steps >= STEPS_NEEDED || !(h > 0.0 && h.is_finite() && wn.is_finite()) {
@@ -283,7 +284,7 @@ impl ConventionCheck {
 
     /// The verdict on the steps so far.
     #[must_use]
-    pub fn verdict(&self) -> Verdict {
+    pub(crate) fn verdict(&self) -> Verdict {
         if let Some(v) = self.unit_verdict() {
             return v;
         }
@@ -319,3 +320,6 @@ impl ConventionCheck {
         }
     }
 }
+
+#[cfg(all(test, feature = "sim"))]
+mod tests;

@@ -15,7 +15,6 @@ mod discrete_convergence;
 mod discrete_momentum;
 mod dynamics;
 mod estimators;
-mod gyro_unit;
 mod inertial_torque;
 mod lab_realism;
 mod numeric_range;

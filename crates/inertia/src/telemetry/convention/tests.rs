@@ -1,4 +1,4 @@
-//! The gyro-unit check (`telemetry::convention`: rates in deg/s read as rad/s, or the
+//! The gyro-unit check (rates in deg/s read as rad/s, or the
 //! reverse, named as such) on honest data whose attitude is noisy: a star tracker
 //! (5″/5″/40″, 10 Hz) with a FOG gyro on the paper's slew, the Monte Carlo matrix's
 //! `slew | star tracker + FOG | 10 Hz` cell. There the differenced attitude of a step at
@@ -8,12 +8,13 @@
 //! truth is the paper's J, one seed of 20 too); and the same steps hid real deg/s rates
 //! (seed 1: not named). Now the same data in deg/s are named on every seed.
 
-use inertia::pipeline::{Pipeline, PipelineError, PipelineSettings};
-use inertia::sample::Sample;
-use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
-use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{AttitudeSource, CommandHold, StarTracker};
-use inertia::telemetry::convention::{ConventionCheck, Reading, Verdict};
+use super::{ConventionCheck, Reading, Verdict};
+use crate::pipeline::{Pipeline, PipelineError, PipelineSettings};
+use crate::sample::Sample;
+use crate::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
+use crate::sim::scenario::{Common, Scenario};
+use crate::sim::{AttitudeSource, CommandHold, StarTracker};
+use std::vec::Vec;
 
 /// The matrix's FOG, deg/√h.
 const FOG_ARW: f64 = 0.02;
