@@ -34,8 +34,10 @@ crates/inertia-py/tests/test_readme.py (.ci/python), not here.
 Links: every relative link and image target in the checked files must exist (anchors
 are not checked), and so must every mdBook {{#include FILE}}.
 
-Usage: python3 scripts/check_book.py [--inertia PATH] [FILE.md ...]
-Exit 0 when everything agrees; 1 otherwise, after listing every difference.
+Usage: python3 scripts/check_book.py [--inertia PATH] [--bless] [FILE.md ...]
+Exit 0 when everything agrees; 1 otherwise, after listing every difference. With
+--bless, an "output" block whose commands print something else is rewritten with what
+they print (review the diff: a changed number is a changed result, to be explained).
 """
 
 import argparse
@@ -90,8 +92,9 @@ def blocks(path):
     return out
 
 
-def console_steps(text):
-    """[(command, [expected lines])] of a console block."""
+def console_steps(text, raw=False):
+    """[(command, [expected lines])] of a console block (with `raw`, each step's command
+    lines as written, continuations included, as a third element)."""
     steps, lines = [], text.split("\n")
     k = 0
     while k < len(lines):
@@ -100,16 +103,17 @@ def console_steps(text):
                 raise ValueError(f"output before the first `$ ` command: {lines[k]!r}")
             k += 1
             continue
-        cmd = lines[k][2:]
+        cmd, first = lines[k][2:], k
         while cmd.endswith("\\") and k + 1 < len(lines):
             k += 1
             cmd = cmd[:-1] + lines[k]
         k += 1
+        written = lines[first:k]
         expected = []
         while k < len(lines) and not lines[k].startswith("$ "):
             expected.append(lines[k])
             k += 1
-        steps.append((cmd, expected))
+        steps.append((cmd, expected, written) if raw else (cmd, expected))
     return steps
 
 
@@ -155,9 +159,28 @@ def check_links(path, problems):
             problems.append(f"{path.relative_to(ROOT)}: {{{{#include {target}}}}} does not exist")
 
 
+def bless(path, rewrites):
+    """Replace the bodies of the blocks of `path` in `rewrites` (block, new body lines),
+    keeping each block's indentation."""
+    if not rewrites:
+        return
+    lines = path.read_text(encoding="utf-8").split("\n")
+    for b, body in sorted(rewrites, key=lambda r: -r[0].line):
+        start = b.line  # the fence is line b.line (1-based): the body starts after it
+        indent = FENCE.match(lines[start - 1]).group(1)
+        end = start
+        while not lines[end].strip().startswith(FENCE.match(lines[start - 1]).group(2)):
+            end += 1
+        lines[start:end] = [indent + l if l else l for l in body]
+    path.write_text("\n".join(lines), encoding="utf-8")
+    print(f"blessed {len(rewrites)} block(s) of {path.relative_to(ROOT)}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--inertia", default=str(ROOT / "target" / "release" / "inertia"))
+    ap.add_argument("--bless", action="store_true",
+                    help="rewrite the output blocks that disagree with what the tool prints")
     ap.add_argument("files", nargs="*")
     args = ap.parse_args()
     files = [Path(f).resolve() for f in args.files] or (
@@ -172,6 +195,7 @@ def main():
                LC_ALL="C.UTF-8", NO_COLOR="1")
 
     problems, counts = [], {"output": 0, "commands": 0, "run": 0, "repo": 0, "skip": 0}
+    rewrites = []
     passed = failed = 0
     for path in files:
         check_links(path, problems)
@@ -213,17 +237,25 @@ def main():
                     failed += 1
                     continue
                 counts["output"] += 1
-                for cmd, expected in steps:
+                blessed, changed = [], False
+                for cmd, expected, written in console_steps(b.text, raw=True):
                     counts["commands"] += 1
                     code, out = run(cmd, work, env)
                     expected, actual = normalise(expected), normalise(out.split("\n"))
+                    agree = outputs_agree(expected, actual)
+                    blessed += written + (expected if agree else actual)
                     if code != want_exit:
                         problems.append(f"{b.where()}: `$ {cmd}` exited with {code}, not {want_exit}:\n{out}")
                         ok = False
-                    elif not outputs_agree(expected, actual):
+                    elif not agree:
                         diff = "\n".join(difflib.unified_diff(expected, actual, "the book", "the tool", lineterm=""))
-                        problems.append(f"{b.where()}: `$ {cmd}` printed something else:\n{diff}")
-                        ok = False
+                        if args.bless:
+                            changed = True
+                        else:
+                            problems.append(f"{b.where()}: `$ {cmd}` printed something else:\n{diff}")
+                            ok = False
+                if changed:
+                    rewrites.append((b, blessed))
             else:
                 counts[b.mode] += 1
                 script = "set -euo pipefail\n" + b.text
@@ -236,6 +268,7 @@ def main():
             failed += not ok
         if work is not None:
             shutil.rmtree(work, ignore_errors=True)
+        bless(path, [r for r in rewrites if r[0].path == path])
     shutil.rmtree(bindir, ignore_errors=True)
 
     for p in problems:

@@ -83,6 +83,7 @@ pub type FixNames = fn(Fix) -> Option<&'static str>;
 
 /// The library's names ([`Fix::setting`]).
 #[must_use]
+#[cfg_attr(not(feature = "serde"), allow(dead_code))] // used by the report
 pub(crate) fn library_names(fix: Fix) -> Option<&'static str> {
     Some(fix.setting())
 }

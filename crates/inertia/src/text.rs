@@ -81,6 +81,7 @@ impl fmt::Display for Num {
 
 /// A count and a noun, plural unless the count is 1: `1 gap`, `0 gaps`, `2 sign flips`.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(feature = "serde"), allow(dead_code))] // used by the report
 pub(crate) struct Counted<'a>(pub usize, pub &'a str);
 
 impl fmt::Display for Counted<'_> {

@@ -22,7 +22,7 @@ use super::settings::PipelineConfig;
 use super::status::{PhysicalMargin, PHYSICAL_Z};
 use crate::constraints::ActiveBound;
 use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO, SHIFT_Z};
-use crate::estimator::discrete_momentum::TORQUE_CHI2;
+use crate::estimator::discrete_momentum::{TORQUE_CHI2, TORQUE_SHIFT_Z};
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::observability::Observability;

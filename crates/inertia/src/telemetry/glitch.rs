@@ -151,6 +151,7 @@ impl GlitchCheck {
     }
 
     /// The first [`LISTED`] steps flagged.
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))] // used by the report
     pub(crate) fn listed(&self) -> impl Iterator<Item = &Glitch> {
         self.listed.iter().flatten()
     }

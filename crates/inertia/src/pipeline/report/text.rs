@@ -176,7 +176,13 @@ impl fmt::Display for ReportText<'_> {
         if let Some(t) = r.torque_bias_nm {
             let test = r
                 .torque_test
-                .map(|t| format!(" (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2})", t.chi2))
+                .map(|t| match t.shift_z {
+                    Some(z) => format!(
+                        " (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2}, and it moves the answer by {z:.3e} σ > {TORQUE_SHIFT_Z})",
+                        t.chi2
+                    ),
+                    None => format!(" (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2})", t.chi2),
+                })
                 .unwrap_or_default();
             writeln!(
                 s,
@@ -184,12 +190,20 @@ impl fmt::Display for ReportText<'_> {
                 t[0], t[1], t[2]
             )?;
         } else if let Some(t) = r.torque_test.filter(|t| t.held_at_zero) {
-            writeln!(
-                s,
-                "unknown constant torque: held at zero, the data give no evidence of one \
-                 (χ²₃ = {:.2} ≤ {TORQUE_CHI2})",
-                t.chi2
-            )?;
+            match t.shift_z {
+                Some(z) if t.chi2 > TORQUE_CHI2 => writeln!(
+                    s,
+                    "unknown constant torque: held at zero, it would move the answer by at most \
+                     {z:.2} σ (≤ {TORQUE_SHIFT_Z}; χ²₃ = {:.2} > {TORQUE_CHI2}); the move is in σ",
+                    t.chi2
+                )?,
+                _ => writeln!(
+                    s,
+                    "unknown constant torque: held at zero, the data give no evidence of one \
+                     (χ²₃ = {:.2} ≤ {TORQUE_CHI2})",
+                    t.chi2
+                )?,
+            }
         }
         match r.drift_weighted {
             Some(true) => writeln!(
