@@ -160,6 +160,8 @@ pub struct Report {
     #[serde(skip)]
     wheel_delay_error: Option<crate::estimator::wheel_delay::DelayError>,
     #[serde(skip)]
+    held_speeds: Option<(usize, f64)>,
+    #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
     physical: Option<PhysicalMargin>,
@@ -184,6 +186,9 @@ pub enum Warning {
     /// The wheel-speed time tag was to be estimated and could not be: the speeds were
     /// read as time-tagged.
     WheelDelayNotEstimated(crate::estimator::wheel_delay::DelayError),
+    /// The wheel speeds change only every this many samples (held between updates of this
+    /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]).
+    HeldWheelSpeeds(usize, f64),
 }
 
 /// The wheel-speed time tag as the report carries it.
@@ -218,6 +223,7 @@ impl Warning {
             Warning::AttitudeGyroDisagree(_) => "attitude_gyro_disagree",
             Warning::Excitation(_) => "excitation",
             Warning::WheelDelayNotEstimated(_) => "wheel_delay_not_estimated",
+            Warning::HeldWheelSpeeds(..) => "held_wheel_speeds",
         }
     }
 }
@@ -264,6 +270,14 @@ impl fmt::Display for Warning {
             Warning::WheelDelayNotEstimated(e) => {
                 write!(f, "{e}; the wheel speeds are read as time-tagged")
             }
+            Warning::HeldWheelSpeeds(every, period_s) => write!(
+                f,
+                "the wheel speeds change only every {every} samples (held for {} s between \
+                 updates): read at their time stamps they lag by about {} s on average, which \
+                 biases J; the wheel-speed time tag (wheel_delay: estimate) corrects it",
+                Num(*period_s),
+                Num(0.5 * period_s * (*every as f64 - 1.0) / *every as f64)
+            ),
         }
     }
 }
@@ -338,6 +352,7 @@ impl Report {
             warnings: std::vec::Vec::new(),
             wheel_delay: None,
             wheel_delay_error: None,
+            held_speeds: None,
             observability: estimate.observability,
             physical: super::status::physical_margin(estimate),
             attitude: None,
@@ -371,7 +386,18 @@ impl Report {
         if let Some(e) = self.wheel_delay_error {
             w.push(Warning::WheelDelayNotEstimated(e));
         }
+        if let Some((every, period_s)) = self.held_speeds {
+            w.push(Warning::HeldWheelSpeeds(every, period_s));
+        }
         w
+    }
+
+    /// With the wheel speeds' update period (samples, s) where they look held and no time
+    /// tag was asked for ([`crate::telemetry::held_speeds`]).
+    #[must_use]
+    pub fn with_held_speeds(mut self, held: Option<(usize, f64)>) -> Self {
+        self.held_speeds = held;
+        self.refreshed()
     }
 
     /// With the wheel-speed time tag the run applied, or why it could not be estimated.

@@ -25,6 +25,7 @@ use crate::estimator::Estimate;
 use crate::fix::Fix;
 use crate::sample::Sample;
 use crate::telemetry::gate::{Order, SampleError};
+use crate::telemetry::held_speeds::HeldSpeeds;
 use crate::text::Num;
 use std::collections::VecDeque;
 use std::vec::Vec;
@@ -232,6 +233,8 @@ pub struct Run {
     held: Option<Vec<Sample>>,
     /// The time tag applied at [`Self::finish`], or why it could not be estimated.
     delay: Option<Result<DelayFit, DelayError>>,
+    /// Whether the wheel speeds look held between updates ([`HeldSpeeds`]).
+    speeds: HeldSpeeds,
 }
 
 impl core::fmt::Debug for Run {
@@ -267,6 +270,7 @@ impl Run {
             stopped: None,
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
             delay: None,
+            speeds: HeldSpeeds::default(),
         })
     }
 
@@ -340,6 +344,7 @@ impl Run {
         }
         self.recent.push_back((s.t_s, index));
         self.input += 1;
+        self.speeds.push(&s.rho_nms);
         if let Some(held) = &mut self.held {
             held.push(*s);
             return Ok(());
@@ -465,6 +470,15 @@ impl Run {
         self.delay.as_ref()
     }
 
+    /// The update period of the wheel speeds, in samples, where they look held between
+    /// updates and no time tag was asked for ([`HeldSpeeds`]); else `None`.
+    #[must_use]
+    pub fn held_speeds_period_samples(&self) -> Option<usize> {
+        (self.config.wheel_delay == WheelDelay::Off)
+            .then(|| self.speeds.period_samples())
+            .flatten()
+    }
+
     /// Input samples accepted.
     #[must_use]
     pub fn input_samples(&self) -> usize {
@@ -521,6 +535,10 @@ impl Run {
         Some(
             report
                 .with_wheel_delay(self.delay.as_ref())
+                .with_held_speeds(
+                    self.held_speeds_period_samples()
+                        .map(|p| (p, p as f64 * self.sample_period_s())),
+                )
                 .with_input(super::report::InputSummary {
                     file: file.into(),
                     sample_period_s: self.sample_period_s(),

@@ -8,6 +8,7 @@ pub mod convention;
 pub mod csv;
 pub mod gate;
 pub mod glitch;
+pub mod held_speeds;
 #[cfg(feature = "csv")]
 mod line_cap;
 #[cfg(feature = "csv")]

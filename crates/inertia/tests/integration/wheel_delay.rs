@@ -148,3 +148,40 @@ fn refuses_a_wild_time_tag_and_reports_one_it_cannot_estimate() {
     let (_, r) = run(&s, WheelDelay::Estimate, false);
     assert!(r.wheel_delay().expect("asked").is_err());
 }
+
+/// Problem: speeds held at 100 Hz on the 4 kHz throw, and the 10 Hz slew's speeds as
+/// telemetered at every sample. Reference: the simulator's update period (40 samples).
+/// A run without a time tag names the held speeds' period (the report's
+/// `held_wheel_speeds` warning), not the slew's; a run given a time tag says nothing.
+#[test]
+fn held_speeds_are_named_where_no_time_tag_is_given() {
+    let mut p = Preset::throw_without(&[
+        LabEffect::Vibration,
+        LabEffect::InertialTorque,
+        LabEffect::Drag,
+    ]);
+    p.common.seed = 1;
+    let throw = p.simulate().expect("sim").samples;
+    let slew = Scenario::slew()
+        .simulate(&Common::physical())
+        .expect("sim")
+        .samples;
+    assert_eq!(
+        run(&throw, WheelDelay::Off, false)
+            .1
+            .held_speeds_period_samples(),
+        Some(40)
+    );
+    assert_eq!(
+        run(&throw, WheelDelay::Estimate, false)
+            .1
+            .held_speeds_period_samples(),
+        None
+    );
+    assert_eq!(
+        run(&slew, WheelDelay::Off, false)
+            .1
+            .held_speeds_period_samples(),
+        None
+    );
+}
