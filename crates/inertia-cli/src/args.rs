@@ -476,8 +476,9 @@ pub struct EstimateArgs {
     /// The wheel-speed telemetry's time tag: the speeds are read δ later than their time
     /// stamps. `off` (default), the delay in seconds (e.g. `0.05`; negative: early), or
     /// `estimate` (the residuals' minimum over ±min(0.25 s, a tenth of the record), with
-    /// σ; its σ widens each element's). Any estimator; the run then estimates once, at
-    /// the end of the input. Speeds held between updates lag by half the update period.
+    /// σ; its σ widens each element's). Any estimator; the run then keeps every sample
+    /// and gives its estimates (and the history) at the end of the input. Speeds held
+    /// between updates lag by about half the update period.
     #[arg(
         long,
         value_name = "S|estimate",

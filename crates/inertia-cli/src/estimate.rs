@@ -99,10 +99,15 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         );
         p
     });
-    // The lines of the samples a run's error may name: every one in batch mode (the
-    // batch names any sample), the last `RECENT` streaming.
+    // The lines of the samples a run's error may name: every one in batch mode or where
+    // the run keeps the samples for the wheel speeds' time tag (the estimate at the end
+    // names any sample), the last `RECENT` streaming.
     let mut lines = VecDeque::new();
-    let keep = if a.batch { usize::MAX } else { RECENT };
+    let keep = if a.batch || run.holds_samples() {
+        usize::MAX
+    } else {
+        RECENT
+    };
     let line_of = |lines: &VecDeque<u64>, n: usize, e: &RunError| -> Option<u64> {
         let first = n - lines.len();
         e.sample

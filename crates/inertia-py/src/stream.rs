@@ -57,6 +57,11 @@ impl Stream {
         let conv = settings::convention(&kw)?;
         let pipeline_settings = settings::pipeline(&kw)?;
         kw.finish()?;
+        if pipeline_settings.wheel_delay != Default::default() {
+            return Err(crate::errors::value_error(
+                "wheel_delay: the wheel speeds' time tag needs the whole record; give it to estimate()",
+            ));
+        }
         let config = pipeline_settings
             .validate()
             .map_err(settings::settings_error)?;

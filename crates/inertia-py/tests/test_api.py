@@ -331,3 +331,5 @@ def test_wheel_delay_shifts_the_speeds_and_is_reported(slew):
         inertia.estimate(tel, wheel_delay="late")
     with pytest.raises(TypeError, match="wheel_delay"):
         inertia.Estimator(wheel_delay=0.01)
+    with pytest.raises(ValueError, match="whole record"):
+        inertia._inertia.Stream(kwargs={"wheel_delay": 0.01})

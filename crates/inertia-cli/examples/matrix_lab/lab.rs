@@ -75,12 +75,11 @@ pub fn cells() -> Vec<LabCell> {
 }
 
 /// The wheel speeds' time tag from `WHEEL_DELAY` (`off`, seconds or `estimate`; every
-/// estimator), off when unset.
+/// estimator), off when unset; a value it cannot read stops the matrix.
 fn wheel_delay_from_env() -> WheelDelay {
-    std::env::var("WHEEL_DELAY")
-        .ok()
-        .and_then(|v| inertia::pipeline::parse_wheel_delay(&v).ok())
-        .unwrap_or_default()
+    std::env::var("WHEEL_DELAY").map_or(WheelDelay::Off, |v| {
+        inertia::pipeline::parse_wheel_delay(&v).unwrap_or_else(|e| panic!("WHEEL_DELAY: {e}"))
+    })
 }
 
 fn estimate(samples: &[Sample], name: &str) -> Option<Estimate> {

@@ -122,10 +122,17 @@ fn shift(
         crate::solver::unconstrained_minimiser(&a.r, &a.z)
     };
     let d = solve(with)? - solve(without)?;
+    // NaN is kept (no test then), and without an element with σ > 0 there is none.
     let z = (0..6)
         .filter(|&k| sigma[k] > 0.0)
         .map(|k| d[k].abs() / sigma[k])
-        .fold(0.0, f64::max);
+        .reduce(|a, b| {
+            if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        })?;
     z.is_finite().then(|| (core::array::from_fn(|k| d[k]), z))
 }
 
@@ -397,16 +404,22 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
-    /// ([`super::jackknife`]), and in quadrature with it the answer's shift where the
-    /// torque test held a torque at zero for moving the answer too little
-    /// ([`torque_tested`]), kg m².
+    /// ([`super::jackknife`]), kg m² (the held torque's move is added by the caller,
+    /// [`Self::held_torque_shift`]).
     pub fn robust_noise_sigma(&mut self) -> Option<[f64; 6]> {
         let ls = self.noise_sigma()?;
-        let s = super::jackknife::robust_sigma(&ls, self.jackknife_sigma().as_ref());
-        Some(match self.torque_test.and_then(|t| t.held_shift_kg_m2) {
-            Some(d) => core::array::from_fn(|k| crate::math::sqrt(s[k] * s[k] + d[k] * d[k])),
-            None => s,
-        })
+        Some(super::jackknife::robust_sigma(
+            &ls,
+            self.jackknife_sigma().as_ref(),
+        ))
+    }
+
+    /// The move of the answer, kg m² per element, where the last solve's torque test held
+    /// the torque at zero for moving the answer too little ([`torque_tested`]): a model
+    /// uncertainty the answer's σ carries in quadrature, after every noise σ.
+    #[must_use]
+    pub fn held_torque_shift(&self) -> Option<[f64; 6]> {
+        self.torque_test.and_then(|t| t.held_shift_kg_m2)
     }
 
     /// The reduced least-squares state in `j` at the last solve.

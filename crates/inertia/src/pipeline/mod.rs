@@ -326,6 +326,7 @@ impl Pipeline {
 
     /// Build from an already validated configuration.
     pub fn from_config(config: PipelineConfig) -> Result<Self, PipelineError> {
+        config.check_no_wheel_delay()?;
         let resampler = config
             .resample_s
             .map(Resampler::new)
@@ -531,6 +532,7 @@ impl Pipeline {
 /// Estimate from all samples at once (eq. 57) with the configured estimator, which must
 /// have a batch form. Memory and resampling do not apply.
 pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    config.check_no_wheel_delay()?;
     let run = batch_applies(config)?;
     let mut check = ConventionCheck::default();
     let mut glitches = GlitchCheck::default();

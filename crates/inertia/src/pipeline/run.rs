@@ -208,6 +208,18 @@ pub fn check_first_step(
     Ok(())
 }
 
+/// The input sample a pipeline error belongs to: for a step too large for the rows, the
+/// sample among `(time, index)` that ends the step; else `index`, the sample pushed.
+fn locate(
+    e: &PipelineError,
+    index: usize,
+    mut samples: impl Iterator<Item = (f64, usize)>,
+) -> usize {
+    e.step_end_s()
+        .and_then(|end| samples.find(|(t, _)| PipelineError::ends_step(*t, end)))
+        .map_or(index, |(_, i)| i)
+}
+
 enum Mode {
     Streaming(std::boxed::Box<Pipeline>),
     Batch {
@@ -258,7 +270,9 @@ impl Run {
                 out: None,
             }
         } else {
-            Mode::Streaming(std::boxed::Box::new(Pipeline::from_config(config)?))
+            Mode::Streaming(std::boxed::Box::new(Pipeline::from_config(
+                config.with_delay_applied(),
+            )?))
         };
         Ok(Self {
             config,
@@ -290,7 +304,8 @@ impl Run {
     }
 
     /// Feed input sample [`Self::input_samples`]; `on_estimate` receives every estimate it
-    /// produced, in time order (none in batch mode before [`Self::finish`]).
+    /// produced, in time order (none in batch mode, nor while the run holds the samples
+    /// for a wheel-speed time tag, before [`Self::finish`], which then gives them all).
     pub fn push(&mut self, s: &Sample, on_estimate: impl FnMut(&Estimate)) -> Result<(), RunError> {
         let index = self.input;
         if let Some(m) = &self.stopped {
@@ -355,14 +370,7 @@ impl Run {
                 Ok(())
             }
             Mode::Streaming(p) => p.push_each(s, on_estimate).map_err(|e| {
-                let at = e
-                    .step_end_s()
-                    .and_then(|end| {
-                        self.recent
-                            .iter()
-                            .find(|(t, _)| PipelineError::ends_step(*t, end))
-                    })
-                    .map_or(index, |&(_, i)| i);
+                let at = locate(&e, index, self.recent.iter().copied());
                 RunError::at(at, RunErrorKind::Pipeline(e))
             }),
         }
@@ -392,13 +400,16 @@ impl Run {
             let Mode::Streaming(p) = &mut self.mode else {
                 unreachable!("only a streaming run holds its samples")
             };
-            **p = Pipeline::from_config(self.config).map_err(|e| RunError {
-                sample: None,
-                kind: RunErrorKind::Pipeline(e),
-            })?;
+            **p =
+                Pipeline::from_config(self.config.with_delay_applied()).map_err(|e| RunError {
+                    sample: None,
+                    kind: RunErrorKind::Pipeline(e),
+                })?;
             for (index, s) in held.iter().enumerate() {
                 if let Err(e) = p.push_each(s, &mut on_estimate) {
-                    let e = RunError::at(index, RunErrorKind::Pipeline(e));
+                    let times = held[..=index].iter().map(|s| s.t_s).zip(0..);
+                    let at = locate(&e, index, times);
+                    let e = RunError::at(at, RunErrorKind::Pipeline(e));
                     self.stopped = Some(std::string::ToString::to_string(&e));
                     return Err(e);
                 }
@@ -425,7 +436,7 @@ impl Run {
                 if samples.len() < entry.capabilities.min_samples() {
                     return Err(too_few(samples.len(), samples.len()));
                 }
-                let o = batch(samples, &self.config).map_err(|e| {
+                let o = batch(samples, &self.config.with_delay_applied()).map_err(|e| {
                     let sample = match &e {
                         PipelineError::Estimator {
                             source: crate::estimator::EstimatorError::Row { sample, .. },
@@ -477,6 +488,13 @@ impl Run {
         (self.config.wheel_delay == WheelDelay::Off)
             .then(|| self.speeds.period_samples())
             .flatten()
+    }
+
+    /// Whether the run keeps every sample until [`Self::finish`] (batch, or a wheel-speed
+    /// time tag to apply), so that an error there may name any sample.
+    #[must_use]
+    pub fn holds_samples(&self) -> bool {
+        self.held.is_some() || matches!(self.mode, Mode::Batch { .. })
     }
 
     /// Input samples accepted.

@@ -86,8 +86,10 @@ pub struct PipelineSettings {
     pub glitches: GlitchPolicy,
     /// The wheel-speed telemetry's time tag ([`crate::estimator::wheel_delay`]): the
     /// speeds are read `δ` later than their time stamps, `δ` given or estimated, and its
-    /// σ widens the answer's (a consider term). Any estimator. The run then keeps every
-    /// sample and estimates at the end of the input. Default [`WheelDelay::Off`].
+    /// σ widens the answer's (a consider term). Any estimator, through a
+    /// [`super::Run`] only (a [`super::Pipeline`] or a batch call refuses it). The run
+    /// then keeps every sample and gives its estimates at the end of the input. Default
+    /// [`WheelDelay::Off`].
     pub wheel_delay: WheelDelay,
 }
 
@@ -284,7 +286,7 @@ impl PipelineSettings {
                 return Err(PipelineError::InvalidSetting {
                     field: "wheel_delay",
                     value: d,
-                    expected: "a finite time tag of at most 0.25 s either way",
+                    expected: "a finite time tag within the search's ±MAX_HALF_RANGE_S (0.25 s)",
                 });
             }
         }
@@ -331,6 +333,28 @@ impl PipelineSettings {
 }
 
 impl PipelineConfig {
+    /// A wheel-speed time tag is applied by a [`super::Run`] alone, which holds the record
+    /// ([`crate::estimator::wheel_delay`]); a [`super::Pipeline`] or a batch call given
+    /// one refuses it rather than ignore it.
+    pub(crate) fn check_no_wheel_delay(&self) -> Result<(), PipelineError> {
+        if self.wheel_delay == WheelDelay::Off {
+            return Ok(());
+        }
+        Err(PipelineError::NeedsSetting {
+            setting: "wheel_delay",
+            needs: "Run",
+            requirement: "to apply it",
+            why: "the speeds are read later over the whole record, which only a run holds",
+        })
+    }
+
+    /// This configuration with its wheel-speed time tag applied by the run: the time tag
+    /// off for the pipeline or batch call, its consider term kept.
+    pub(crate) fn with_delay_applied(mut self) -> Self {
+        self.wheel_delay = WheelDelay::Off;
+        self
+    }
+
     /// The estimator's registry entry.
     #[must_use]
     pub fn estimator(&self) -> &'static EstimatorEntry {

@@ -35,8 +35,9 @@
 use super::PipelineConfig;
 use crate::constraints::Consistency;
 use crate::estimator::observability::{Observability, Unobservable};
+use crate::estimator::uncertainty::Uncertainty;
 use crate::estimator::Estimate;
-use crate::tensor::matrix_from_j;
+use crate::tensor::{matrix_from_j, InertiaVector};
 
 /// How many σ of `J1 + J2 − J3` (or of `J1`) an answer may lie beyond the physical set
 /// and still be determined.
@@ -108,13 +109,12 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 /// ([`crate::estimator::wheel_delay`]), the rotor scale's where one is given
 /// ([`widen_for_rotor_scale`]), then [`settle`].
 pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
+    let threshold = config.observability.max_relative_sigma;
     if let Some(c) = config.wheel_delay_consider {
-        if let (Some(u), Some(j)) = (e.uncertainty, e.j()) {
-            e.uncertainty = Some(u.with_time_tag(&j, &c));
-        }
+        widen(e, threshold, |u, j| u.with_time_tag(j, &c));
     }
     if let Some(r) = config.rotor_scale_sigma {
-        widen_for_rotor_scale(e, r, config.observability.max_relative_sigma);
+        widen_for_rotor_scale(e, r, threshold);
     }
     settle(e, config.constraints().set().consistency);
 }
@@ -123,10 +123,20 @@ pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
 /// "determined" back where the widened relative σ `σ_F/‖Ĵ‖_F` exceeds `threshold`
 /// (module docs, "What the user said"); the answer is kept.
 pub fn widen_for_rotor_scale(e: &mut Estimate, r: f64, threshold: f64) {
+    widen(e, threshold, |u, j| u.with_rotor_scale(j, r));
+}
+
+/// Widen `e`'s σ by a consider term (`widened`) and take "determined" back where the
+/// widened relative σ `σ_F/‖Ĵ‖_F` exceeds `threshold`; the answer is kept.
+fn widen(
+    e: &mut Estimate,
+    threshold: f64,
+    widened: impl Fn(&Uncertainty, &InertiaVector) -> Uncertainty,
+) {
     let (Some(u), Some(j)) = (e.uncertainty, e.j()) else {
         return;
     };
-    let u = u.with_rotor_scale(&j, r);
+    let u = widened(&u, &j);
     e.uncertainty = Some(u);
     let relative_sigma = u.frobenius_sigma_kg_m2() / matrix_from_j(&j).norm();
     if matches!(e.observability, Observability::Determined { .. }) && !(relative_sigma <= threshold)

@@ -86,7 +86,9 @@ fn time_blocks_give_short_records_a_sigma_that_covers() {
             let j = e.last().and_then(|x| x.j()).expect("answer");
             let truth = j_from_matrix(&run.inertia_kg_m2);
             let sigma_ls = e.noise_sigma().expect("σ");
-            let sigma = e.robust_noise_sigma().expect("σ");
+            let noise = e.robust_noise_sigma().expect("σ");
+            let shift = e.held_torque_shift().unwrap_or([0.0; 6]);
+            let sigma: [f64; 6] = core::array::from_fn(|k| noise[k].hypot(shift[k]));
             for k in 0..6 {
                 let err = (j[k] - truth[k]).abs();
                 robust[k] += usize::from(err <= 3.0 * sigma[k]);

@@ -6,7 +6,9 @@ use super::candidates::{candidates, chained_siblings};
 use super::cross_check::COMPARABLE_FIT;
 use super::finish::{finish, Evidence, Finished};
 use super::select::{alternatives_from_s, in_running, pick, test_inertial_torque};
-use super::sigma::{discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife};
+use super::sigma::{
+    discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife, with_held_shift,
+};
 use super::standing::RULE_OUT_AFTER;
 use super::twins;
 use super::DISCRETE_MOMENTUM;
@@ -192,10 +194,7 @@ impl BatchRun<'_> {
         });
         // As the recursive estimator's: a torque held at zero for moving the answer too
         // little leaves that move in σ.
-        let noise = match (noise, test.and_then(|t| t.held_shift_kg_m2)) {
-            (Some(s), Some(d)) => Some(core::array::from_fn(|k| s[k].hypot(d[k]))),
-            (s, _) => s,
-        };
+        let noise = noise.map(|s| with_held_shift(s, test.and_then(|t| t.held_shift_kg_m2)));
         Ok((e, noise))
     }
 }

@@ -200,5 +200,16 @@ pub(super) fn candidate_noise_sigma(
             jackknife = sibling_jackknife([jackknife, c.jackknife_sigma()].into_iter());
         }
     }
-    Some(robust_sigma(&own, jackknife.as_ref()))
+    let noise = robust_sigma(&own, jackknife.as_ref());
+    Some(with_held_shift(noise, candidates[i].held_torque_shift()))
+}
+
+/// `noise` with the move of a torque held at zero for moving the answer too little
+/// ([`crate::estimator::discrete_momentum::torque_tested`]) in quadrature: the last step
+/// of the noise σ, recursive and batch alike.
+pub(super) fn with_held_shift(noise: [f64; 6], shift: Option<[f64; 6]>) -> [f64; 6] {
+    match shift {
+        Some(d) => quadrature(&noise, &d),
+        None => noise,
+    }
 }
