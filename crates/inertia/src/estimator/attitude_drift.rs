@@ -70,7 +70,7 @@ impl AttitudeDrift {
     /// a block of coefficient `noise_s`. `Π` comes from the means, not from the block
     /// being whitened, so that the weights do not depend on that block's noise.
     #[must_use]
-    pub fn process<const N: usize>(
+    pub(crate) fn process<const N: usize>(
         &self,
         a: &[SVector<f64, N>; 3],
         b: &[f64; 3],
@@ -102,7 +102,7 @@ impl AttitudeDrift {
 /// innovations, or `None` where `P + Q + I` is not positive definite (non-finite input),
 /// in which case nothing moves.
 #[must_use]
-pub fn local_level_step<const N: usize>(
+pub(crate) fn local_level_step<const N: usize>(
     a: &[SVector<f64, N>; 3],
     b: &[f64; 3],
     mean_a: &mut [SVector<f64, N>; 3],

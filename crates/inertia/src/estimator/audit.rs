@@ -16,17 +16,25 @@
 //!   [`CONFLICT_CHI2`] → [`Unobservable::ConflictsWithConstraints`], reported as an answer
 //!   that leans on the constraint set ([`Observability::FromPrior`]), not on the data.
 
+// The crate-internal helpers here serve the std front ends (pipeline, estimators).
+#![cfg_attr(not(feature = "std"), allow(dead_code))]
+
 use super::observability::{Observability, Unobservable};
 use super::qr::RecursiveQr;
 use super::Estimate;
 use crate::tensor::matrix_from_j;
 
 /// χ² threshold of the constraint-conflict test: the 1 − 10⁻⁴ quantile of χ²₆.
-pub const CONFLICT_CHI2: f64 = 27.86;
+pub(crate) const CONFLICT_CHI2: f64 = 27.86;
 
 /// Withdraw or qualify the status of `e` (solved from `qr` under a `J ⪰ εI` floor of
 /// `epsilon_kg_m2`) where its own data contradict it.
-pub fn audit(e: &mut Estimate, qr: &RecursiveQr, epsilon_kg_m2: f64, max_relative_sigma: f64) {
+pub(crate) fn audit(
+    e: &mut Estimate,
+    qr: &RecursiveQr,
+    epsilon_kg_m2: f64,
+    max_relative_sigma: f64,
+) {
     let moments = e
         .j()
         .map(|j| crate::eigen3::symmetric_eigen3(&matrix_from_j(&j)).0);
@@ -35,7 +43,7 @@ pub fn audit(e: &mut Estimate, qr: &RecursiveQr, epsilon_kg_m2: f64, max_relativ
 
 /// [`audit`] given the principal moments of `e`'s `J` (any order), for a caller that has
 /// them already.
-pub fn audit_at(
+pub(crate) fn audit_at(
     e: &mut Estimate,
     qr: &RecursiveQr,
     epsilon_kg_m2: f64,
@@ -108,7 +116,7 @@ fn least_squares_frobenius_sigma(qr: &RecursiveQr) -> Option<f64> {
 /// the stated one, else the least-squares one — within `max_relative_sigma · ‖J_ls‖`).
 /// `None` off the floor.
 #[must_use]
-pub fn at_floor(
+pub(crate) fn at_floor(
     e: &Estimate,
     qr: &RecursiveQr,
     epsilon_kg_m2: f64,
@@ -145,7 +153,7 @@ pub fn at_floor(
 /// sign of ρ gives. Checked before a cross-check that would withdraw the answer for
 /// another reason.
 #[must_use]
-pub fn reversed_at_floor(
+pub(crate) fn reversed_at_floor(
     e: &Estimate,
     qr: &RecursiveQr,
     epsilon_kg_m2: f64,

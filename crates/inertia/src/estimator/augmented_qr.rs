@@ -91,7 +91,7 @@ impl AugmentedQr {
 
     /// The state with an inertial torque per slot ([`super::trend_slot`]) or without.
     #[must_use]
-    pub fn with_inertial_torque(self, on: bool) -> Self {
+    pub(crate) fn with_inertial_torque(self, on: bool) -> Self {
         Self {
             inertial_torque: on,
             ..self
@@ -101,12 +101,12 @@ impl AugmentedQr {
     /// Weigh the blocks folded from now on for an attitude that drifts
     /// ([`super::attitude_drift`]; `None`: centred as without drift, the default). The
     /// pipeline passes its latest estimate of `J` here after each answer.
-    pub fn set_drift(&mut self, drift: Option<AttitudeDrift>) {
+    pub(crate) fn set_drift(&mut self, drift: Option<AttitudeDrift>) {
         self.drift = drift;
     }
 
     /// The time of the next block, s (for the drift between a slot's blocks).
-    pub fn advance_to(&mut self, t_s: f64) {
+    pub(crate) fn advance_to(&mut self, t_s: f64) {
         self.now_s = t_s;
     }
 
@@ -124,7 +124,7 @@ impl AugmentedQr {
 
     /// [`Self::add`] of the same block to two states (two candidates sharing their rows,
     /// [`super::discrete_momentum::DiscreteMomentumEstimator::fold_shared_pair`]), their
-    /// reflections interleaved ([`SharedQr::add_pair`]): the same states as two
+    /// reflections interleaved (`SharedQr::add_pair`): the same states as two
     /// [`Self::add`], bit for bit.
     pub fn add_pair(
         (a, chain_a): (&mut Self, Option<&mut NormalEquations>),
@@ -246,7 +246,7 @@ impl AugmentedQr {
     }
 
     /// Count `n` more nuisance unknowns (a new chain's initial momenta).
-    pub fn add_nuisance(&mut self, n: usize) {
+    pub(crate) fn add_nuisance(&mut self, n: usize) {
         self.shared.add_nuisance(n);
     }
 
@@ -258,7 +258,7 @@ impl AugmentedQr {
 
     /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`): the means are
     /// those of the weighted rows still.
-    pub fn scale(&mut self, lambda: f64) {
+    pub(crate) fn scale(&mut self, lambda: f64) {
         self.shared.scale(lambda);
         for s in &mut self.slots {
             s.weight *= lambda;
@@ -273,13 +273,13 @@ impl AugmentedQr {
 
     /// The state in the shared unknowns.
     #[must_use]
-    pub fn shared(&self) -> &SharedQr {
+    pub(crate) fn shared(&self) -> &SharedQr {
         &self.shared
     }
 
     /// Scalar rows folded in.
     #[must_use]
-    pub fn rows(&self) -> usize {
+    pub(crate) fn rows(&self) -> usize {
         self.shared.rows()
     }
 
@@ -291,7 +291,8 @@ impl AugmentedQr {
 
     /// Residual sum of squares `ρ²` (weighted).
     #[must_use]
-    pub fn rss(&self) -> f64 {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn rss(&self) -> f64 {
         self.shared.rss()
     }
 
@@ -303,7 +304,8 @@ impl AugmentedQr {
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
-    pub fn residual_variance(&self) -> f64 {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn residual_variance(&self) -> f64 {
         self.shared.residual_variance()
     }
 
@@ -317,7 +319,7 @@ impl AugmentedQr {
     /// back-substitution, the current chain's initial momenta from the means; zero for
     /// unknowns the rows never involved.
     #[must_use]
-    pub fn nuisance_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J> {
+    pub(crate) fn nuisance_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J> {
         let lead = self.shared.leading_at(j);
         let y = SVector::<f64, SHARED>::from_fn(|i, _| {
             if i < J_SHARED {

@@ -88,7 +88,7 @@ pub fn estimate<S: RowSource>(
 }
 
 /// The estimate (stamped `t_s`) from a reduced least-squares state.
-pub fn solve_reduced(
+pub(crate) fn solve_reduced(
     qr: &RecursiveQr,
     t_s: f64,
     constraints: &Constraints,

@@ -22,11 +22,11 @@ use super::qr::RecursiveQr;
 use nalgebra::{Matrix6, Vector6};
 
 /// `D` of the module docs.
-pub const NOISE_GRAM_DIAGONAL: [f64; 6] = [1.0, 1.0, 1.0, 2.0, 2.0, 2.0];
+pub(crate) const NOISE_GRAM_DIAGONAL: [f64; 6] = [1.0, 1.0, 1.0, 2.0, 2.0, 2.0];
 
 /// The compensated `(R', z')`, or `None` when the noise dominates.
 #[must_use]
-pub fn compensate(
+pub(crate) fn compensate(
     qr: &RecursiveQr,
     gyro_noise_rad_s_rthz: f64,
 ) -> Option<(Matrix6<f64>, Vector6<f64>)> {

@@ -16,10 +16,10 @@
 //! momentum's random walk correlates a chain), so the thresholds below are empirical.
 //!
 //! **Spans.** The record is cut into consecutive segments of at least
-//! [`FIRST_SEGMENT_DOF`] residual degrees of freedom; when [`MAX_SEGMENTS`] are complete,
+//! `FIRST_SEGMENT_DOF` (60) residual degrees of freedom; when `MAX_SEGMENTS` (32) are complete,
 //! neighbours are merged pairwise and the segment length doubles, so that memory is fixed
 //! and a long record has between `MAX_SEGMENTS/2` and `MAX_SEGMENTS` complete segments
-//! (the test starts at [`MIN_SEGMENTS`]; the open segment, the newest data, is not
+//! (the test starts at `MIN_SEGMENTS` (8); the open segment, the newest data, is not
 //! tested until it completes). A span is
 //! one segment (against all the others: a glitch), or the record after a segment
 //! boundary (against the record before it: a change that persists), or before it
@@ -33,13 +33,16 @@
 //! allows: ratios up to 92 in the Monte Carlo matrix (README), 970 on a noise-free spin.
 //! Such a span is harmless when the answer does not depend on it. So a span is
 //! inconsistent when its ratio exceeds [`INCONSISTENT_RATIO`] *and* the answer moved, with
-//! or without it, beyond [`SHIFT_Z`] of its own stated σ: the estimate now is compared
+//! or without it, beyond `SHIFT_Z` (20) of its own stated σ: the estimate now is compared
 //! with the last answer before the span (its σ), or, for a span at the start of the
 //! record, with the first one after it. A change of J moves the answer by many σ,
 //! a glitch that the rows feel does too; a noisier stretch of honest data does not.
 //! Without a stated σ (an estimator with no uncertainty model, such as the
 //! finite-difference baseline) no span is inconsistent: the worst one is still reported.
 //! Under exponential forgetting the increments are reweighted and the test is not made.
+
+// The crate-internal helpers here serve the std front ends (pipeline, estimators).
+#![cfg_attr(not(feature = "std"), allow(dead_code))]
 
 use super::compensation::NOISE_GRAM_DIAGONAL;
 use super::observability::{Observability, Unobservable};
@@ -48,13 +51,13 @@ use super::Estimate;
 use crate::tensor::InertiaVector;
 
 /// Largest number of complete segments kept.
-pub const MAX_SEGMENTS: usize = 32;
+pub(crate) const MAX_SEGMENTS: usize = 32;
 
 /// Fewest complete segments for the test.
-pub const MIN_SEGMENTS: usize = 8;
+pub(crate) const MIN_SEGMENTS: usize = 8;
 
 /// Residual degrees of freedom of a segment before the first merge.
-pub const FIRST_SEGMENT_DOF: f64 = 60.0;
+pub(crate) const FIRST_SEGMENT_DOF: f64 = 60.0;
 
 /// Ratio of a span's residual variance to the rest's beyond which it may be inconsistent
 /// with one model and noise level.
@@ -65,7 +68,7 @@ pub const INCONSISTENT_RATIO: f64 = 300.0;
 /// reach ratios of 970 from the discretisation remainder alone, the answers moved by up
 /// to 10.1 of their early σ (which, without noise, is too small); in the broken runs of
 /// `tests/integration/consistency.rs`, by at least 52.
-pub const SHIFT_Z: f64 = 20.0;
+pub(crate) const SHIFT_Z: f64 = 20.0;
 
 /// An answer and its stated σ per element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -124,7 +127,7 @@ struct Span {
 
 /// The residual record of one least-squares state, in segments ([module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ResidualSegments {
+pub(crate) struct ResidualSegments {
     done: [Segment; MAX_SEGMENTS],
     len: usize,
     target_dof: f64,
@@ -146,7 +149,7 @@ impl Default for ResidualSegments {
 impl ResidualSegments {
     /// No residuals yet.
     #[must_use]
-    pub fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self {
             done: [Segment::default(); MAX_SEGMENTS],
             len: 0,
@@ -162,7 +165,7 @@ impl ResidualSegments {
     /// Record the state after the rows of the sample at `t_s`: its cumulative residual
     /// sum of squares and residual degrees of freedom. Increments before the state has
     /// any residual degree of freedom (the rows that fix the unknowns) are not counted.
-    pub fn record(&mut self, rss: f64, dof: f64, t_s: f64) {
+    pub(crate) fn record(&mut self, rss: f64, dof: f64, t_s: f64) {
         if !rss.is_finite() || !dof.is_finite() {
             return;
         }
@@ -199,7 +202,7 @@ impl ResidualSegments {
 
     /// Note an answer (determined, or leaning on the prior) and its stated σ per element
     /// (kg m²), for the spans that start after it.
-    pub fn note(&mut self, j: &InertiaVector, sigma_kg_m2: &[f64; 6]) {
+    pub(crate) fn note(&mut self, j: &InertiaVector, sigma_kg_m2: &[f64; 6]) {
         if j.iter().chain(sigma_kg_m2).all(|v| v.is_finite()) {
             self.latest = Some(Snapshot {
                 j: *j,
@@ -209,8 +212,9 @@ impl ResidualSegments {
     }
 
     /// Complete segments so far.
+    #[cfg(test)]
     #[must_use]
-    pub fn segments(&self) -> usize {
+    pub(crate) fn segments(&self) -> usize {
         self.len
     }
 
@@ -263,7 +267,7 @@ impl ResidualSegments {
 
     /// The span that stands out most, with at least [`MIN_SEGMENTS`] complete segments.
     #[must_use]
-    pub fn worst(&self) -> Option<Worst> {
+    pub(crate) fn worst(&self) -> Option<Worst> {
         self.worst
     }
 
@@ -272,7 +276,7 @@ impl ResidualSegments {
     /// after it is never inconsistent: the ratio alone does not tell a failed model from
     /// honest residuals of unequal size (module docs).
     #[must_use]
-    pub fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
+    pub(crate) fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
         // No span beyond the ratio: nothing to compare (the common case, without a pass
         // over the spans at every solve).
         if !self.worst.is_some_and(|w| w.ratio > INCONSISTENT_RATIO) {
@@ -311,7 +315,11 @@ pub const DENSITY_OVERSTATED_RATIO: f64 = 0.5;
 /// implies ([`DENSITY_OVERSTATED_RATIO`], [`Unobservable::DensityOverstated`]). A model
 /// that failed for part of the record leaves an answer that is no mixture's truth, and an
 /// overstated density an over-compensated one; σ knows neither.
-pub fn check(e: &mut Estimate, segments: Option<&ResidualSegments>, density_ratio: Option<f64>) {
+pub(crate) fn check(
+    e: &mut Estimate,
+    segments: Option<&ResidualSegments>,
+    density_ratio: Option<f64>,
+) {
     if !matches!(
         e.observability,
         Observability::Determined { .. } | Observability::FromPrior(_)

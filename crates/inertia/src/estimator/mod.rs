@@ -12,7 +12,7 @@
 //! Every estimate says whether the data determine J ([`observability`]).
 
 pub mod attitude_drift;
-pub mod audit;
+pub(crate) mod audit;
 pub mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
@@ -33,7 +33,7 @@ pub mod resample;
 pub mod rows;
 pub mod shared_qr;
 pub mod svd_tracker;
-pub mod trend_slot;
+pub(crate) mod trend_slot;
 pub mod uncertainty;
 #[cfg(feature = "std")]
 pub mod wheel_delay;

@@ -30,7 +30,7 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// Relative tolerance of the triangle test of [`not_physical`]: `Σ`'s smallest eigenvalue
 /// may be down to `−1e-3 · tr(J)`.
-pub const NOT_PHYSICAL_TOLERANCE: f64 = 1e-3;
+pub(crate) const NOT_PHYSICAL_TOLERANCE: f64 = 1e-3;
 
 /// Why a finite `j` is not a physical inertia, if it is not: a principal moment ≤ 0, or
 /// `Σ = ½ tr(J) I − J` below `−NOT_PHYSICAL_TOLERANCE · tr(J)` (a triangle inequality of
@@ -196,7 +196,7 @@ impl MomentumRls {
 
     /// Current `j`.
     #[must_use]
-    pub fn j(&self) -> InertiaVector {
+    pub(crate) fn j(&self) -> InertiaVector {
         InertiaVector::from_fn(|i, _| self.x[i])
     }
 

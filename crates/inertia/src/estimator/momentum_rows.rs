@@ -46,7 +46,7 @@
 //! A gap ([`crate::sample::is_gap`]) or a step that rotates too far restarts the chain:
 //! the sums restart and the initial momenta become new unknowns; [`MomentumRows::epoch`]
 //! counts the restarts so the estimator can eliminate the old ones. A chain that only
-//! grows too long ([`MomentumRowSettings::max_chain_s`]) is split by a [`ChainClock`]
+//! grows too long ([`MomentumRowSettings::max_chain_s`]) is split by a `ChainClock`
 //! instead: its rows go on (no interval lost, the sums running), only the initial
 //! momenta are new unknowns from the split on. The sums' values at the split are then a
 //! constant offset of every later row of the chain (`S τ_b`, `T`), which the new initial
@@ -65,7 +65,7 @@
 //! block carries its `s` ([`AugmentedRow::trend_s`]) and the torque is one more unknown of
 //! the block's initial-momentum slot: minimised out with it per chain (and per parity,
 //! so the Richardson rows' two slots each have their own), as a linear trend of the
-//! inertial momentum ([`super::trend_slot`]). A split chain's torque before and after the
+//! inertial momentum (`estimator/trend_slot.rs`). A split chain's torque before and after the
 //! split are then two unknowns, like its initial momenta.
 
 use crate::attitude::Quaternion;
@@ -81,9 +81,9 @@ pub const ANCHOR0: usize = 0;
 /// Column of the second initial-momentum unknown (Richardson rows, odd centres).
 pub const ANCHOR1: usize = 3;
 /// Column of the disturbance torque `τ_b`.
-pub const TORQUE: usize = 6;
+pub(crate) const TORQUE: usize = 6;
 /// Column of the wheel-momentum curvature coefficient `κ` ([`Stencil::Adaptive`]).
-pub const KAPPA: usize = 9;
+pub(crate) const KAPPA: usize = 9;
 /// Column of `j`.
 pub const J: usize = 10;
 
@@ -203,7 +203,7 @@ pub struct MomentumRowSettings {
     /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
     /// random walk) rotates the momentum by at most the drift within one chain. `None`:
     /// chains end only at gaps. The rows themselves do not depend on it: the split is
-    /// [`ChainClock`]'s, downstream of [`MomentumRows`].
+    /// the estimator's `ChainClock`'s, downstream of [`MomentumRows`].
     pub max_chain_s: Option<f64>,
 }
 
@@ -255,7 +255,7 @@ impl MomentumRowSettings {
     /// The model but for the chain length, which only [`ChainClock`] uses: candidates
     /// equal in it fit the same model in different chains.
     #[must_use]
-    pub fn rows_only(&self) -> Self {
+    pub(crate) fn rows_only(&self) -> Self {
         Self {
             max_chain_s: None,
             ..*self
@@ -266,7 +266,7 @@ impl MomentumRowSettings {
     /// inertial torque, which only the state uses. Candidates equal in it can share one
     /// row source.
     #[must_use]
-    pub fn source_key(&self) -> Self {
+    pub(crate) fn source_key(&self) -> Self {
         Self {
             inertial_torque: false,
             ..self.rows_only()
@@ -275,7 +275,7 @@ impl MomentumRowSettings {
 
     /// Initial-momentum unknowns of one chain: `X₀`, and `X₁` for Richardson rows.
     #[must_use]
-    pub fn anchors_per_chain(&self) -> usize {
+    pub(crate) fn anchors_per_chain(&self) -> usize {
         if self.stencil.richardson() {
             6
         } else {
@@ -286,7 +286,7 @@ impl MomentumRowSettings {
     /// Unknowns besides `j` the rows involve in one chain: the initial momenta and, with
     /// [`Self::inertial_torque`], a torque for each.
     #[must_use]
-    pub fn nuisance_per_chain(&self) -> usize {
+    pub(crate) fn nuisance_per_chain(&self) -> usize {
         self.anchors_per_chain() * (1 + usize::from(self.inertial_torque))
     }
 
@@ -346,7 +346,7 @@ struct Node {
 /// Splits a row source's chains into chains no longer than
 /// [`MomentumRowSettings::max_chain_s`] (module docs, "Chains").
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChainClock {
+pub(crate) struct ChainClock {
     max_chain_s: Option<f64>,
     /// The source's epoch the current chain belongs to (`None` before the first row).
     source_epoch: Option<u64>,
@@ -359,7 +359,7 @@ pub struct ChainClock {
 impl ChainClock {
     /// A clock for chains of at most `max_chain_s` (`None`: the source's chains whole).
     #[must_use]
-    pub fn new(max_chain_s: Option<f64>) -> Self {
+    pub(crate) fn new(max_chain_s: Option<f64>) -> Self {
         Self {
             max_chain_s,
             source_epoch: None,
@@ -373,7 +373,7 @@ impl ChainClock {
     /// spans [`MomentumRowSettings::max_chain_s`] there (the first
     /// [`super::jackknife::MIN_GROUPS`] chains a quarter of it, so that the jackknife over
     /// chains has its groups early).
-    pub fn epoch(&mut self, source: &MomentumRows) -> u64 {
+    pub(crate) fn epoch(&mut self, source: &MomentumRows) -> u64 {
         if self.source_epoch != Some(source.epoch()) {
             self.source_epoch = Some(source.epoch());
             self.start_s = source.chain_start_s();
@@ -453,7 +453,7 @@ impl MomentumRows {
 
     /// The settings.
     #[must_use]
-    pub fn settings(&self) -> &MomentumRowSettings {
+    pub(crate) fn settings(&self) -> &MomentumRowSettings {
         &self.settings
     }
 
@@ -472,14 +472,14 @@ impl MomentumRows {
 
     /// Time of the chain's first node, s.
     #[must_use]
-    pub fn chain_start_s(&self) -> f64 {
+    pub(crate) fn chain_start_s(&self) -> f64 {
         self.chain_start_s
     }
 
     /// Start time of the newest interval, s (after a push that gave a row: the interval
     /// the row ends with).
     #[must_use]
-    pub fn interval_start_s(&self) -> Option<f64> {
+    pub(crate) fn interval_start_s(&self) -> Option<f64> {
         self.nodes[1].map(|n| n.t_s)
     }
 

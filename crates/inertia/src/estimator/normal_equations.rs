@@ -10,9 +10,9 @@
 //! between them; a Householder fold waits at each of its 10 pivots for a `√` and
 //! divisions. On the 1M-sample run the chain folds were 13 % of the time (7.8–8.0 s
 //! instead of 8.8–9.0 s with normal equations, the candidates' own folds interleaved in
-//! pairs, [`super::shared_qr::SharedQr::add_pair`]).
+//! pairs, `SharedQr::add_pair`).
 //!
-//! [`NormalEquations::factor`] is the Cholesky factor `RᵀR = AᵀA`, `Rᵀz = Aᵀβ`,
+//! `NormalEquations::factor` is the Cholesky factor `RᵀR = AᵀA`, `Rᵀz = Aᵀβ`,
 //! `ρ² = βᵀβ − ‖z‖²`: the QR factor of the same rows up to rounding (tested), the
 //! diagonal non-negative as [`SharedQr`] keeps it. Its rounding error grows as the
 //! square of the rows' condition number, scaled column by column (Cholesky is
@@ -20,7 +20,7 @@
 //! it does not matter here: on the 1M-sample run every jackknife σ agrees with the QR
 //! chain states' to 2e-9 relative and every `Ĵ` and status is the same, and the Monte
 //! Carlo matrix (58 cells × 50 seeds) is unchanged to its four digits. A pivot that has
-//! lost all but [`PIVOT_DIGITS`] of its digits is taken as a direction the chain does not
+//! lost all but `PIVOT_DIGITS` (12) of its digits is taken as a direction the chain does not
 //! determine, as an exactly dependent column leaves its row of `R` zero in the QR. `ρ²`
 //! from the difference can lose the digits `βᵀβ` has over it; it enters the
 //! delete-one problems only through the weight of a prior ([`super::prior::augment`]).
@@ -32,7 +32,7 @@ use nalgebra::{SMatrix, SVector};
 /// A pivot of the Cholesky factor at or below `10^−PIVOT_DIGITS` of its diagonal entry of
 /// `AᵀA` is a direction the rows do not determine (its row of `R` is left zero): a
 /// condition number of the scaled rows beyond 10⁶.
-pub const PIVOT_DIGITS: i32 = 12;
+pub(crate) const PIVOT_DIGITS: i32 = 12;
 
 /// `AᵀA`, `Aᵀβ`, `βᵀβ` of a chain's centred rows in the shared unknowns, and the same
 /// counters as [`SharedQr`].
@@ -60,7 +60,7 @@ impl NormalEquations {
     /// Add a block of rows `a` with right-hand sides `beta` (as folded into the
     /// estimator's [`SharedQr::add`]); `y` are the rows' right-hand sides as measured and
     /// `noise_s` their errors-in-variables coefficient.
-    pub fn add(&mut self, block: &SharedBlock, y: &[f64; 3], noise_s: f64) {
+    pub(crate) fn add(&mut self, block: &SharedBlock, y: &[f64; 3], noise_s: f64) {
         let (a, beta) = block;
         for k in 0..SHARED {
             let col = &mut self.ata.as_mut_slice()[k * SHARED..k * SHARED + k + 1];
@@ -75,19 +75,19 @@ impl NormalEquations {
     }
 
     /// Count a block of rows that needed no fold ([`SharedQr::count_absorbed`]).
-    pub fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
+    pub(crate) fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
         self.counts.count(y, noise_s);
     }
 
     /// The rows' counters.
     #[must_use]
-    pub fn counts(&self) -> &RowCounts {
+    pub(crate) fn counts(&self) -> &RowCounts {
         &self.counts
     }
 
     /// The factor of these rows (module docs), with no nuisance unknowns counted.
     #[must_use]
-    pub fn factor(&self) -> SharedQr {
+    pub(crate) fn factor(&self) -> SharedQr {
         let floor = libm::pow(10.0, -f64::from(PIVOT_DIGITS));
         // Rᵀ stored: column i of `rt` is row i of R.
         let mut rt = SMatrix::<f64, SHARED, SHARED>::zeros();

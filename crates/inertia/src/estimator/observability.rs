@@ -34,7 +34,7 @@ pub const DEFAULT_MAX_RELATIVE_SIGMA: f64 = 0.1;
 
 /// Residual degrees of freedom needed before a variance estimate is trusted: with fewer,
 /// `s²` (and so every σ) is itself too uncertain to gate on.
-pub const MIN_RESIDUAL_DOF: usize = 6;
+pub(crate) const MIN_RESIDUAL_DOF: usize = 6;
 
 /// Thresholds of the observability test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -403,7 +403,7 @@ impl core::fmt::Display for Observability {
 /// formed (fewer than [`MIN_RESIDUAL_DOF`] residual degrees of freedom or a singular `R`).
 /// `sv` are the singular values of `R`: `tr((RᵀR)⁻¹) = Σ σ_k⁻²`.
 #[must_use]
-pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
+pub(crate) fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
     if qr.residual_dof() < MIN_RESIDUAL_DOF as f64 || sv.min() <= 0.0 {
         return f64::INFINITY;
     }
@@ -424,7 +424,7 @@ pub fn relative_sigma(qr: &RecursiveQr, sv: &nalgebra::Vector6<f64>) -> f64 {
 /// of `R`. Its relative standard deviation is `s √(Σ_{i≤5} σ_i⁻²)` with the per-row
 /// misfit `s² = σ_6²/(rows − 5)`.
 #[must_use]
-pub fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: f64) -> f64 {
+pub(crate) fn direction_relative_sigma(sv: &nalgebra::Vector6<f64>, rows: f64) -> f64 {
     if rows < (5 + MIN_RESIDUAL_DOF) as f64 {
         return f64::INFINITY;
     }
@@ -452,7 +452,7 @@ pub fn assess(
 /// Assess `qr` given the singular values `sv` of `R` (any order), e.g. from a
 /// [`super::svd_tracker::SvdTracker`].
 #[must_use]
-pub fn assess_with(
+pub(crate) fn assess_with(
     qr: &RecursiveQr,
     sv: &nalgebra::Vector6<f64>,
     has_bounds: bool,

@@ -21,7 +21,7 @@
 //! * the prior-data disagreement `χ² = Δρ²/s²`, `Δρ²` the misfit the prior rows add: for
 //!   a prior that is right within its σ, a χ² with as many degrees of freedom as the data
 //!   determine (at most `p`, the prior's rows), were the rows' errors independent. Above
-//!   [`RESIDUAL_VARIANCE_ALLOWANCE`] times the 99.9 % point of `χ²_p` the answer is
+//!   `RESIDUAL_VARIANCE_ALLOWANCE` (4) times the 99.9 % point of `χ²_p` the answer is
 //!   withdrawn as [`super::observability::Unobservable::PriorConflict`].
 //!
 //! Without excitation (`y ≡ 0`) the data fix only the direction of `j`: `s² = σ_6²
@@ -29,8 +29,8 @@
 //! is the prior's alone (the data's information along it is removed).
 //!
 //! With noise-free data (`ρ² = 0`), or data that leave a direction open (`σ_6(R)` below
-//! [`SCALE_FLOOR`]` · c`), `s` is floored at [`SCALE_FLOOR`]` · c · min σ_k` (`c` the
-//! root-mean-square column norm of `R`), so that the prior still fixes the directions the
+//! `SCALE_FLOOR · c`), `s` is floored at `SCALE_FLOOR · c · min σ_k` (`SCALE_FLOOR` =
+//! 1e-4, `c` the root-mean-square column norm of `R`), so that the prior still fixes the directions the
 //! data leave open, with its own σ there, in a problem the solvers resolve. Data that
 //! determine every direction keep their own `s`: a prior never makes σ larger than the
 //! data's alone.
@@ -41,12 +41,12 @@ use crate::solver::eliminate_fixed;
 use nalgebra::Vector6;
 
 /// 99.9 % points of `χ²_k`, `k = 1 … 6`.
-pub const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
+pub(crate) const CHI2_999: [f64; 6] = [10.828, 13.816, 16.266, 18.467, 20.515, 22.458];
 
 /// Floor of the residual scale `s`, relative to `c · min σ_k` (`c` the root-mean-square
 /// column norm of `R`): data that fit (nearly) exactly still leave the prior a weight
 /// within `10⁻⁸` of theirs in the normal equations, which the solvers resolve.
-pub const SCALE_FLOOR: f64 = 1e-4;
+pub(crate) const SCALE_FLOOR: f64 = 1e-4;
 
 /// How much the residual scale `s` may understate the noise of `ĵ`: the conflict test
 /// flags `χ² > RESIDUAL_VARIANCE_ALLOWANCE · χ²_{p, 0.999}`. The rows' errors are
@@ -54,7 +54,7 @@ pub const SCALE_FLOOR: f64 = 1e-4;
 /// residuals understate the variance of `ĵ`: on the under-excited test data
 /// (`tests/integration/prior.rs`) the median χ² of a right prior is 9.5 against χ²₃'s 2.4, a factor
 /// of 4.
-pub const RESIDUAL_VARIANCE_ALLOWANCE: f64 = 4.0;
+pub(crate) const RESIDUAL_VARIANCE_ALLOWANCE: f64 = 4.0;
 
 /// How the prior sits with the data at one solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -89,7 +89,7 @@ impl PriorFit {
 /// Above [`super::audit::CONFLICT_CHI2`] the data contradict the equalities, as they
 /// contradicted an active bound before equalities were eliminated.
 #[must_use]
-pub fn equality_chi2(qr: &RecursiveQr, constraints: &Constraints) -> Option<f64> {
+pub(crate) fn equality_chi2(qr: &RecursiveQr, constraints: &Constraints) -> Option<f64> {
     let fixed = constraints.fixed();
     if fixed.iter().all(Option::is_none) || !(qr.residual_dof() > 0.0 && qr.rss > 0.0) {
         return None;
@@ -101,7 +101,7 @@ pub fn equality_chi2(qr: &RecursiveQr, constraints: &Constraints) -> Option<f64>
 /// `sigma` with 0 for the elements fixed by equalities (their pinning rows give them a
 /// least-squares σ that stands for nothing).
 #[must_use]
-pub fn zero_fixed(mut sigma: [f64; 6], constraints: &Constraints) -> [f64; 6] {
+pub(crate) fn zero_fixed(mut sigma: [f64; 6], constraints: &Constraints) -> [f64; 6] {
     for (s, v) in sigma.iter_mut().zip(constraints.fixed()) {
         if v.is_some() {
             *s = 0.0;
@@ -113,15 +113,8 @@ pub fn zero_fixed(mut sigma: [f64; 6], constraints: &Constraints) -> [f64; 6] {
 /// `true` when `constraints` carry an equality or a prior (else [`augment`] is the
 /// identity).
 #[must_use]
-pub fn applies(constraints: &Constraints) -> bool {
+pub(crate) fn applies(constraints: &Constraints) -> bool {
     constraints.set().prior.is_some() || constraints.fixed().iter().any(Option::is_some)
-}
-
-/// The data's state with the fixed elements eliminated: the reduced problem, embedded
-/// in six unknowns (each fixed element pinned by one exact row).
-#[must_use]
-pub fn eliminate(qr: &RecursiveQr, constraints: &Constraints) -> RecursiveQr {
-    reduce(qr, constraints.fixed()).0
 }
 
 fn reduce(qr: &RecursiveQr, fixed: &[Option<f64>; 6]) -> (RecursiveQr, f64) {
@@ -146,7 +139,8 @@ fn reduce(qr: &RecursiveQr, fixed: &[Option<f64>; 6]) -> (RecursiveQr, f64) {
 }
 
 /// The data's state with the prior knowledge of `constraints` stacked on: the fixed
-/// elements eliminated ([`eliminate`]), then the prior rows. Returns the state unchanged
+/// elements eliminated (the reduced problem embedded in six unknowns, each fixed element
+/// pinned by one exact row), then the prior rows. Returns the state unchanged
 /// (and no fit) when there is no equality and no prior. The state's `rss` and `weight`
 /// stay the data's, so its residual variance is `s²`.
 #[must_use]

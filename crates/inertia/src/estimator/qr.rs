@@ -73,7 +73,7 @@ impl RecursiveQr {
     }
 
     /// Fold a row block, including its errors-in-variables coefficient.
-    pub fn add(&mut self, row: &crate::discrete::Row) {
+    pub(crate) fn add(&mut self, row: &crate::discrete::Row) {
         self.add_block(&row.h, &row.y);
         self.noise_s += row.noise_s;
     }
@@ -87,12 +87,12 @@ impl RecursiveQr {
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
-    pub fn residual_variance(&self) -> f64 {
+    pub(crate) fn residual_variance(&self) -> f64 {
         residual_variance(self.rss, self.residual_dof())
     }
 
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
-    pub fn scale(&mut self, lambda: f64) {
+    pub(crate) fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);
         self.r *= s;
         self.z *= s;

@@ -47,7 +47,7 @@ impl Default for RecursiveSettings {
 
 impl RecursiveSettings {
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), EstimatorError> {
+    pub(crate) fn validate(&self) -> Result<(), EstimatorError> {
         if self.solve_every == 0 {
             return Err(EstimatorError::InvalidSetting {
                 field: "solve_every",
@@ -178,7 +178,8 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// Least-squares standard deviation per element at the last solve (from the tracked
     /// SVD; see [`super::uncertainty`]).
     #[must_use]
-    pub fn noise_sigma(&self) -> Option<[f64; 6]> {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn noise_sigma(&self) -> Option<[f64; 6]> {
         super::uncertainty::noise_sigma(&self.solved, &self.sv, self.svd.v())
             .map(|s| super::prior::zero_fixed(s, &self.constraints))
     }
@@ -186,7 +187,8 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     /// The least-squares state with the prior knowledge stacked on, at the last solve
     /// ([`super::prior::augment`]).
     #[must_use]
-    pub fn solved(&self) -> &RecursiveQr {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn solved(&self) -> &RecursiveQr {
         &self.solved
     }
 

@@ -24,9 +24,9 @@ pub trait RowSource {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Stencil {
     /// Nodes k, k+1, k+2.
-    pub nodes: [Sample; 3],
+    pub(crate) nodes: [Sample; 3],
     /// `φ_k`, `φ_{k+1}`.
-    pub phi: [Vector3<f64>; 2],
+    pub(crate) phi: [Vector3<f64>; 2],
 }
 
 /// The last two samples and the φ of the interval between them. A step longer than
@@ -42,7 +42,7 @@ pub(crate) struct Window {
 
 impl Window {
     /// Forget the buffered samples, keep the gap count.
-    pub fn reset(&mut self) {
+    pub(crate) fn reset(&mut self) {
         *self = Window {
             gaps: self.gaps,
             ..Window::default()
@@ -50,12 +50,12 @@ impl Window {
     }
 
     /// Gaps seen so far.
-    pub fn gaps(&self) -> usize {
+    pub(crate) fn gaps(&self) -> usize {
         self.gaps
     }
 
     /// Feed a sample; the stencil it completes, if any.
-    pub fn push(&mut self, s: &Sample) -> Option<Result<Stencil, RowError>> {
+    pub(crate) fn push(&mut self, s: &Sample) -> Option<Result<Stencil, RowError>> {
         // Each sample's attitude is checked once, as it arrives (node 2 of its first row).
         if let Err(e) = check_unit(&s.q, 2) {
             return Some(Err(e));

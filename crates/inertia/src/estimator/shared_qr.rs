@@ -1,5 +1,5 @@
 //! The least-squares state in the unknowns every chain of discrete momentum rows shares,
-//! `y = [τ_b; κ; j]` ([`SHARED`] = 10, [`super::momentum_rows`]), the chains' initial
+//! `y = [τ_b; κ; j]` (`SHARED` = 10, [`super::momentum_rows`]), the chains' initial
 //! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
 //! folded by Householder reflections, one per pivot for each 3-row block
 //! (the crate's `householder` module; the factor of paper eqs. 60–61 up to rounding).
@@ -19,18 +19,18 @@ use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
 /// Number of shared unknowns: `[τ_b (3); κ (1); j (6)]`, the columns
 /// [`TORQUE`]`..`[`UNKNOWNS`] of a row.
-pub const SHARED: usize = UNKNOWNS - TORQUE;
+pub(crate) const SHARED: usize = UNKNOWNS - TORQUE;
 /// Position of `j` among the shared unknowns.
-pub const J_SHARED: usize = J - TORQUE;
+pub(crate) const J_SHARED: usize = J - TORQUE;
 
 /// A 3-row block in the shared unknowns with its right-hand sides.
-pub type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
+pub(crate) type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
 
 /// The counters every state of rows keeps beside its factor: the energy of the
 /// right-hand sides as measured, the rows and their weight, and the sum of their
 /// errors-in-variables coefficients ([`super::momentum_rows::AugmentedRow::noise_s`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RowCounts {
+pub(crate) struct RowCounts {
     pub(super) y_energy: f64,
     pub(super) rows: usize,
     pub(super) weight: f64,
@@ -66,13 +66,13 @@ impl RowCounts {
 
     /// Scalar rows counted.
     #[must_use]
-    pub fn rows(&self) -> usize {
+    pub(crate) fn rows(&self) -> usize {
         self.rows
     }
 
     /// Row weight counted (rows, discounted by forgetting).
     #[must_use]
-    pub fn weight(&self) -> f64 {
+    pub(crate) fn weight(&self) -> f64 {
         self.weight
     }
 }
@@ -94,7 +94,7 @@ impl SharedQr {
     /// The empty state; `nuisance` unknowns (the disturbance torque) are counted from the
     /// start.
     #[must_use]
-    pub fn new(nuisance: usize) -> Self {
+    pub(crate) fn new(nuisance: usize) -> Self {
         Self {
             rt: SMatrix::zeros(),
             z: SVector::zeros(),
@@ -107,7 +107,7 @@ impl SharedQr {
     /// Fold a block of `M` rows (consumed: zero afterwards, its right-hand sides the
     /// leftover) into this state, one reflection per pivot. `y` are the rows' right-hand sides as measured (for the energy
     /// counter) and `noise_s` their errors-in-variables coefficient.
-    pub fn add<const M: usize>(
+    pub(crate) fn add<const M: usize>(
         &mut self,
         block: ([SVector<f64, SHARED>; M], [f64; M]),
         y: &[f64; M],
@@ -130,7 +130,7 @@ impl SharedQr {
     /// pivot by pivot so that the processor overlaps their `√` and divisions, on which
     /// each pivot waits: the same states as two [`Self::add`], bit for bit. The blocks'
     /// rows share `y` and `noise_s` (one row block, centred for each state).
-    pub fn add_pair(
+    pub(crate) fn add_pair(
         (s, (mut a, mut beta)): (&mut Self, SharedBlock),
         (o, (mut a2, mut beta2)): (&mut Self, SharedBlock),
         y: &[f64; 3],
@@ -150,7 +150,7 @@ impl SharedQr {
 
     /// Count a block of rows that needed no fold (its leftover is zero: the rows fix
     /// unknowns of their own, such as a chain's first block its initial momenta).
-    pub fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
+    pub(crate) fn count_absorbed(&mut self, y: &[f64; 3], noise_s: f64) {
         self.count(y, &[0.0; 3], noise_s);
     }
 
@@ -163,7 +163,7 @@ impl SharedQr {
 
     /// Fold another state's rows into this one: afterwards this is the state of both sets
     /// of rows (their unknowns identified column by column).
-    pub fn merge(&mut self, other: &SharedQr) {
+    pub(crate) fn merge(&mut self, other: &SharedQr) {
         // Its non-zero rows, folded in a wavefront ([`wavefront`]).
         let mut a = [SVector::<f64, SHARED>::zeros(); SHARED];
         let mut beta = [0.0; SHARED];
@@ -206,12 +206,12 @@ impl SharedQr {
     }
 
     /// Count `n` more nuisance unknowns (a new chain's initial momenta).
-    pub fn add_nuisance(&mut self, n: usize) {
+    pub(crate) fn add_nuisance(&mut self, n: usize) {
         self.nuisance += n as f64;
     }
 
     /// Weigh the whole state by `λ` (exponential forgetting, `0 < λ ≤ 1`).
-    pub fn scale(&mut self, lambda: f64) {
+    pub(crate) fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);
         self.rt *= s;
         self.z *= s;
@@ -220,39 +220,35 @@ impl SharedQr {
         self.nuisance *= lambda;
     }
 
-    /// The rows' counters.
-    #[must_use]
-    pub fn counts(&self) -> &RowCounts {
-        &self.counts
-    }
-
     /// Scalar rows folded in.
     #[must_use]
-    pub fn rows(&self) -> usize {
+    pub(crate) fn rows(&self) -> usize {
         self.counts.rows
     }
 
     /// Row weight folded in (rows, discounted by forgetting).
     #[must_use]
-    pub fn weight(&self) -> f64 {
+    pub(crate) fn weight(&self) -> f64 {
         self.counts.weight
     }
 
     /// Residual sum of squares `ρ²` (weighted).
     #[must_use]
-    pub fn rss(&self) -> f64 {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn rss(&self) -> f64 {
         self.rss
     }
 
     /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
     #[must_use]
-    pub fn residual_dof(&self) -> f64 {
+    pub(crate) fn residual_dof(&self) -> f64 {
         super::qr::residual_dof(self.counts.weight, self.nuisance)
     }
 
     /// Residual sum of squares per residual degree of freedom, `∞` without any.
     #[must_use]
-    pub fn residual_variance(&self) -> f64 {
+    #[cfg_attr(not(feature = "std"), allow(dead_code))]
+    pub(crate) fn residual_variance(&self) -> f64 {
         super::qr::residual_variance(self.rss, self.residual_dof())
     }
 
@@ -310,7 +306,7 @@ impl SharedQr {
     /// `[τ_b; κ]` at a given `j`: back-substitution through the leading rows; zero for
     /// unknowns the rows never involved.
     #[must_use]
-    pub fn leading_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J_SHARED> {
+    pub(crate) fn leading_at(&self, j: &crate::tensor::InertiaVector) -> SVector<f64, J_SHARED> {
         let mut x = SVector::<f64, J_SHARED>::zeros();
         for i in (0..J_SHARED).rev() {
             let d = self.rt[(i, i)];

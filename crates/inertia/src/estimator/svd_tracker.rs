@@ -69,7 +69,7 @@ impl SvdTracker {
     /// The tracked right singular vectors (columns, in the order of the last
     /// [`Self::singular_values`]).
     #[must_use]
-    pub fn v(&self) -> &Matrix6<f64> {
+    pub(crate) fn v(&self) -> &Matrix6<f64> {
         &self.v
     }
 

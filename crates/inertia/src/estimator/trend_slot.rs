@@ -17,7 +17,7 @@
 use nalgebra::{Matrix3, Matrix6, SMatrix, SVector};
 
 /// A block's rows in the shared unknowns and their right-hand sides.
-pub type Block<const N: usize> = ([SVector<f64, N>; 3], [f64; 3]);
+pub(crate) type Block<const N: usize> = ([SVector<f64, N>; 3], [f64; 3]);
 
 /// The covariance of the error of `[X̂; τ̂]` in the rows' white variances.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,7 +51,7 @@ impl Covariance {
 
 /// The torque part of a slot's state (its level `X̂` is the slot's means).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Trend<const N: usize> {
+pub(crate) struct Trend<const N: usize> {
     /// `τ̂_m = tau_a[m]·y − tau_b[m]`, N m.
     tau_a: [SVector<f64, N>; 3],
     tau_b: [f64; 3],
@@ -67,7 +67,7 @@ pub struct Trend<const N: usize> {
 
 /// What a block did to the slot.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TrendStep<const N: usize> {
+pub(crate) enum TrendStep<const N: usize> {
     /// The block fixed an unknown of the slot: no row.
     Absorbed,
     /// The block's whitened innovation.
@@ -77,7 +77,7 @@ pub enum TrendStep<const N: usize> {
 impl<const N: usize> Trend<N> {
     /// The trend of a slot whose first block, at `s`, set its level means.
     #[must_use]
-    pub fn start(s: f64) -> Self {
+    pub(crate) fn start(s: f64) -> Self {
         Self {
             tau_a: [SVector::zeros(); 3],
             tau_b: [0.0; 3],
@@ -88,7 +88,7 @@ impl<const N: usize> Trend<N> {
     }
 
     /// Weigh the state by `λ` (forgetting): the covariance grows by `1/λ`.
-    pub fn scale(&mut self, lambda: f64) {
+    pub(crate) fn scale(&mut self, lambda: f64) {
         if self.p.is_none() {
             self.first_var /= lambda;
         }
@@ -106,7 +106,7 @@ impl<const N: usize> Trend<N> {
     /// `level_b`, with the drift's covariance `q` since the slot's last block. `None` when
     /// the state cannot go on (a step `s` that does not increase, or a covariance that is
     /// no longer positive definite); the caller then restarts the slot at the block.
-    pub fn step(
+    pub(crate) fn step(
         &mut self,
         (a_new, b_new): (&[SVector<f64, N>; 3], &[f64; 3]),
         s: f64,

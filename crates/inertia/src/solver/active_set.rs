@@ -27,15 +27,15 @@ const MAX_ITERATIONS: u32 = 40;
 
 /// The relaxed optimum and its multipliers.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ActiveSetSolution {
+pub(crate) struct ActiveSetSolution {
     /// Optimal `j` of the relaxation.
-    pub j: Vector6<f64>,
+    pub(crate) j: Vector6<f64>,
     /// Working-set changes made.
-    pub iterations: u32,
+    pub(crate) iterations: u32,
     /// Stationarity residual `‖2Rᵀ(Rj − z) − Σ λ_l a_l‖∞`, relative to `max(1, ‖2Rᵀ(Rj − z)‖∞)`.
-    pub dual_residual: f64,
+    pub(crate) dual_residual: f64,
     /// Complementarity `Σ λ_l (a_lᵀ j − b_l)` over the working set (≈ 0).
-    pub gap: f64,
+    pub(crate) gap: f64,
 }
 
 /// Solve `Rᵀ w = a` (forward substitution).
@@ -104,7 +104,7 @@ fn equality_qp(
 
 /// The relaxed problem's optimum, or `None` (see the module docs).
 #[must_use]
-pub fn solve_linear(
+pub(crate) fn solve_linear(
     r: &Matrix6<f64>,
     z: &Vector6<f64>,
     constraints: &Constraints,

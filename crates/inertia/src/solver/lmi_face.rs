@@ -34,21 +34,21 @@ const MAX_STEPS: u32 = 12;
 
 /// An exact answer on one LMI face.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FaceSolution {
+pub(crate) struct FaceSolution {
     /// The optimum.
-    pub j: Vector6<f64>,
+    pub(crate) j: Vector6<f64>,
     /// Multiplier of the active eigenvalue constraint (≥ 0).
-    pub mu: f64,
+    pub(crate) mu: f64,
     /// Newton steps.
-    pub steps: u32,
+    pub(crate) steps: u32,
     /// `‖∇f − μ∇g‖∞ / max(1, ‖∇f‖∞)`.
-    pub dual_residual: f64,
+    pub(crate) dual_residual: f64,
     /// The active eigenvalue `λ_min(F(j))` (≈ 0; negative values are the violation).
-    pub eigenvalue: f64,
+    pub(crate) eigenvalue: f64,
     /// `μ ‖∇g‖∞ / max(1, ‖∇f‖∞)`: how clearly the objective presses on the face, in the
     /// units of the dual tolerance (`1e-12`, on `dual_residual`). Near the tolerance the
     /// face cannot be told from the interior ([`crate::solver::Backend::solve_on_last_face`]).
-    pub multiplier_margin: f64,
+    pub(crate) multiplier_margin: f64,
 }
 
 /// Sorted eigenpairs of a symmetric 3×3 matrix, ascending.
@@ -60,7 +60,7 @@ type Eigen = (Vector3<f64>, [Vector3<f64>; 3]);
 /// recomputed (one of the two eigendecompositions of a typical solve). Only a matrix
 /// equal bit for bit hits (`+0` and `−0` differ), so the answer is the same bit for bit.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct EigenMemo(Option<(Matrix3<f64>, Eigen)>);
+pub(crate) struct EigenMemo(Option<(Matrix3<f64>, Eigen)>);
 
 impl EigenMemo {
     fn eigen(&mut self, f: &Matrix3<f64>) -> Eigen {
@@ -82,7 +82,7 @@ fn bilinear(lmi: &Lmi<6>, a: &Vector3<f64>, b: &Vector3<f64>) -> Vector6<f64> {
 
 /// Solve on the face of LMI `index`, starting from `start`.
 #[must_use]
-pub fn solve(
+pub(crate) fn solve(
     r: &Matrix6<f64>,
     z: &Vector6<f64>,
     constraints: &Constraints,

@@ -164,18 +164,18 @@ pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<Ine
 
 /// A least-squares pair with the fixed elements eliminated ([`eliminate_fixed`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Eliminated {
+pub(crate) struct Eliminated {
     /// Upper-triangular factor of the reduced problem (with the rows `c x_k = c v_k`).
-    pub r: Matrix6<f64>,
+    pub(crate) r: Matrix6<f64>,
     /// Its right-hand side.
-    pub z: Vector6<f64>,
+    pub(crate) z: Vector6<f64>,
     /// Residual sum of squares the fixed values add (the data's least-squares `j` need
     /// not have those values).
-    pub extra_rss: f64,
+    pub(crate) extra_rss: f64,
     /// Number of fixed elements.
-    pub fixed: usize,
+    pub(crate) fixed: usize,
     /// `c`, the scale of the fixed elements' rows.
-    pub scale: f64,
+    pub(crate) scale: f64,
 }
 
 /// Eliminate the elements fixed by equalities from `‖R j − z‖²`: with `j = j_f + P x`
@@ -186,7 +186,11 @@ pub struct Eliminated {
 /// problem's singular values besides `c`, and the fixed values as its exact minimiser in
 /// those coordinates.
 #[must_use]
-pub fn eliminate_fixed(r: &Matrix6<f64>, z: &Vector6<f64>, fixed: &[Option<f64>; 6]) -> Eliminated {
+pub(crate) fn eliminate_fixed(
+    r: &Matrix6<f64>,
+    z: &Vector6<f64>,
+    fixed: &[Option<f64>; 6],
+) -> Eliminated {
     let mut out = Eliminated {
         r: *r,
         z: *z,
@@ -230,7 +234,7 @@ pub fn eliminate_fixed(r: &Matrix6<f64>, z: &Vector6<f64>, fixed: &[Option<f64>;
 }
 
 /// Solve `minimise ‖R j − z‖², j ∈ C` with `backend` (see the module docs). Elements
-/// fixed by an equality are eliminated ([`eliminate_fixed`]) and returned exactly.
+/// fixed by an equality are eliminated (`eliminate_fixed`) and returned exactly.
 pub fn solve(
     backend: &mut dyn Backend,
     r: &Matrix6<f64>,

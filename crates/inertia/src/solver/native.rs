@@ -48,7 +48,7 @@ pub struct SettingsError {
 
 impl NativeSettings {
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), SettingsError> {
+    pub(crate) fn validate(&self) -> Result<(), SettingsError> {
         let b = &self.barrier;
         let positive = |field, value: f64| {
             if value.is_finite() && value > 0.0 {
