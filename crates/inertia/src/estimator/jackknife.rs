@@ -191,13 +191,16 @@ impl ChainGroups {
     /// Each delete-one-group problem carries the prior knowledge of `constraints`
     /// ([`super::prior::augment`]), as the estimate does.
     pub fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
+        // The chains' groups change only when a chain ends; the time blocks, when a block
+        // closes.
+        let key = (self.chains, if self.by_chain() { 0 } else { self.blocks_ever });
         if let Some((chains, blocks, sigma)) = self.cached {
-            if chains == self.chains && blocks == self.blocks_ever {
+            if (chains, blocks) == key {
                 return sigma.map(|s| self.scaled(s));
             }
         }
         let sigma = self.compute(constraints);
-        self.cached = Some((self.chains, self.blocks_ever, sigma));
+        self.cached = Some((key.0, key.1, sigma));
         sigma.map(|s| self.scaled(s))
     }
 
