@@ -193,7 +193,10 @@ impl ChainGroups {
     pub fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
         // The chains' groups change only when a chain ends; the time blocks, when a block
         // closes.
-        let key = (self.chains, if self.by_chain() { 0 } else { self.blocks_ever });
+        let key = (
+            self.chains,
+            if self.by_chain() { 0 } else { self.blocks_ever },
+        );
         if let Some((chains, blocks, sigma)) = self.cached {
             if (chains, blocks) == key {
                 return sigma.map(|s| self.scaled(s));

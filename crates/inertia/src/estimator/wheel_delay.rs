@@ -44,9 +44,8 @@
 //! The samples' times must increase strictly (the run's sample gate checks that). Cost:
 //! about 90 fits of the record's rows, and some 0.3 KB per sample while it runs.
 
-use crate::attitude::incremental_rotation;
-use crate::discrete_momentum::IntervalMomentum;
-use crate::sample::{is_gap, Sample};
+use super::momentum_rows::{MomentumRowSettings, MomentumRows, Stencil, J, TORQUE};
+use crate::sample::Sample;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use std::vec::Vec;
 
@@ -193,7 +192,8 @@ const W: usize = X + 3;
 type Moments = [SMatrix<f64, W, W>; 3];
 
 /// One interval's rows: the chain it belongs to, `−S_k` (the body torque's columns),
-/// `A_k` (j's), the inertial torque's coefficient `s_k`, the right-hand side.
+/// `A_k` (j's), the inertial torque's coefficient `s_k`, the right-hand side (the plain
+/// rows of [`super::momentum_rows`]).
 type Block = (usize, Matrix3<f64>, SMatrix<f64, 3, 6>, f64, Vector3<f64>);
 
 /// The rows of the window at one trial `δ`, one 3-row block per interval.
@@ -208,50 +208,41 @@ fn rows(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Rows {
     let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
     // The shifted times increase with k: the search for each starts where the last ended.
     let mut cursor = lo;
-    let mut rho_at = |k: usize| {
-        let x = t[k] + delay_s;
-        let (v, i) = interpolate_from(&t, &rho, cursor, x);
-        cursor = i;
-        v
-    };
-    let mut next: Option<(usize, Vector3<f64>)> = None;
     let mut out = Rows {
         blocks: Vec::with_capacity(hi - lo),
         chains: 0,
     };
-    let (mut s, mut tsum, mut si) = (Matrix3::zeros(), Vector3::zeros(), 0.0);
-    let mut chain_start = true;
-    let mut prev_h: Option<f64> = None;
-    for k in lo..hi {
-        let (b, e) = (&samples[k], &samples[k + 1]);
-        let h = e.t_s - b.t_s;
-        let phi = incremental_rotation(&b.q, &e.q);
-        let restart = prev_h.is_some_and(|p| is_gap(p, h)) || !(phi.norm() < 0.5);
-        if restart {
-            chain_start = true;
-            prev_h = None;
-            continue;
-        }
-        let c = b.q.to_matrix();
-        if chain_start {
-            out.chains += 1;
-            (s, tsum, si) = (Matrix3::zeros(), Vector3::zeros(), 0.0);
-            chain_start = false;
-        } else if let Some(p) = prev_h {
-            let hbar = 0.5 * (p + h);
-            s += c * hbar;
-            tsum += c * b.tau_nm * hbar;
-            si += hbar;
-        }
-        prev_h = Some(h);
-        let rho_b = match next {
-            Some((i, v)) if i == k => v,
-            _ => rho_at(k),
+    // The estimator's own plain rows ([`super::momentum_rows`]), each block's inertial
+    // torque coefficient with it; a chain is an epoch of theirs that gave rows.
+    let mut source = MomentumRows::new(MomentumRowSettings {
+        stencil: Stencil::Plain,
+        torque_bias: true,
+        inertial_torque: true,
+        ..MomentumRowSettings::default()
+    });
+    let mut epoch = None;
+    for (k, s) in samples.iter().enumerate().take(hi + 1).skip(lo) {
+        let (rho_k, i) = interpolate_from(&t, &rho, cursor, t[k] + delay_s);
+        cursor = i;
+        let shifted = Sample {
+            rho_nms: rho_k,
+            ..*s
         };
-        let rho_e = rho_at(k + 1);
-        next = Some((k + 1, rho_e));
-        let m = IntervalMomentum::new(&c, &phi, &(0.5 * (rho_b + rho_e)), h);
-        out.blocks.push((out.chains - 1, -s, m.a, si, m.b + tsum));
+        // A step the rows cannot use restarts the chain, as in the estimator.
+        let Ok(Some(row)) = source.push(&shifted) else {
+            continue;
+        };
+        if epoch != Some(source.epoch()) {
+            epoch = Some(source.epoch());
+            out.chains += 1;
+        }
+        out.blocks.push((
+            out.chains - 1,
+            row.a.fixed_view::<3, 3>(0, TORQUE).into_owned(),
+            row.a.fixed_view::<3, 6>(0, J).into_owned(),
+            row.trend_s,
+            row.b,
+        ));
     }
     out
 }
