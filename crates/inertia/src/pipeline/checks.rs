@@ -55,13 +55,13 @@ impl AttitudeChecks {
 
     /// The glitch check.
     #[must_use]
-    pub fn glitches(&self) -> &GlitchCheck {
+    pub(crate) fn glitches(&self) -> &GlitchCheck {
         &self.glitch
     }
 
     /// The convention check's verdict so far.
     #[must_use]
-    pub fn verdict(&self) -> Verdict {
+    pub(crate) fn verdict(&self) -> Verdict {
         self.convention.verdict()
     }
 }
@@ -110,9 +110,9 @@ pub(crate) fn reversed_momentum(
 
 /// The message of [`PipelineError::ReversedMomentum`].
 pub(crate) struct ReversedMessage<'a> {
-    pub sample: &'a Option<usize>,
-    pub tau_given: &'a bool,
-    pub quaternions: &'a Verdict,
+    pub(crate) sample: &'a Option<usize>,
+    pub(crate) tau_given: &'a bool,
+    pub(crate) quaternions: &'a Verdict,
 }
 
 impl core::fmt::Display for ReversedMessage<'_> {

@@ -49,7 +49,7 @@ const CHUNK: usize = 1 << 16;
 /// them (only `reason` can need quoting: a field holding `,`, `"`, `\r` or `\n` is
 /// quoted, with `"` doubled), into a buffer handed to `out` in pieces of about 64 KiB:
 /// no allocation per row or field, and no per-field quoting scan of the numbers.
-pub struct HistoryWriter<W: Write> {
+pub(crate) struct HistoryWriter<W: Write> {
     /// `None` only once [`Self::finish`] has taken it.
     out: Option<W>,
     pending: std::vec::Vec<u8>,
@@ -59,7 +59,7 @@ pub struct HistoryWriter<W: Write> {
 
 impl<W: Write> HistoryWriter<W> {
     /// Write the header to `out`.
-    pub fn new(out: W) -> Result<Self, csv::Error> {
+    pub(crate) fn new(out: W) -> Result<Self, csv::Error> {
         let mut pending = std::vec::Vec::with_capacity(CHUNK + 1024);
         pending.extend_from_slice(HEADER.join(",").as_bytes());
         pending.push(b'\n');
@@ -72,7 +72,7 @@ impl<W: Write> HistoryWriter<W> {
     }
 
     /// Append one estimate (no allocation).
-    pub fn write(&mut self, e: &Estimate) -> Result<(), csv::Error> {
+    pub(crate) fn write(&mut self, e: &Estimate) -> Result<(), csv::Error> {
         use core::fmt::Write as _;
         let Self {
             out,
@@ -115,7 +115,7 @@ impl<W: Write> HistoryWriter<W> {
     }
 
     /// Flush and return the writer.
-    pub fn finish(mut self) -> Result<W, csv::Error> {
+    pub(crate) fn finish(mut self) -> Result<W, csv::Error> {
         let mut out = self.out.take().ok_or_else(|| {
             csv::Error::from(std::io::Error::other("history writer already finished"))
         })?;
@@ -138,18 +138,18 @@ impl<W: Write> Drop for HistoryWriter<W> {
 }
 
 /// Estimates handed to the writer thread at a time.
-pub const BEHIND_BATCH: usize = 256;
+pub(crate) const BEHIND_BATCH: usize = 256;
 
 /// Batches the writer thread may have waiting (8,192 estimates, 3.5 MB): room for the
 /// writer to stall while its output is synced to disk (the CLI syncs every 32 MiB, about
 /// 80,000 rows, which took 13–17 ms, or 3,000–4,000 samples of the estimator, in the
 /// 1,000,000-sample run) without stopping the estimator. With 8 batches the estimator
 /// waited at each sync: that run took 0.1–0.2 s longer.
-pub const BEHIND_BATCHES: usize = 32;
+pub(crate) const BEHIND_BATCHES: usize = 32;
 
-/// A [`HistoryWriter`] on its own thread: formatting the numbers (about a tenth of a
+/// A `HistoryWriter` on its own thread: formatting the numbers (about a tenth of a
 /// long run) overlaps the estimator. Estimates are handed over in batches of
-/// [`BEHIND_BATCH`] through a channel bounded at [`BEHIND_BATCHES`], so memory stays
+/// `BEHIND_BATCH` through a channel bounded at `BEHIND_BATCHES`, so memory stays
 /// fixed. The output is the same byte for byte; a write error stops the thread and is
 /// returned by the next [`Self::write`] or by [`Self::finish`].
 pub struct WriteBehind<W: Write + Send + 'static> {
@@ -224,7 +224,7 @@ impl<W: Write + Send + 'static> WriteBehind<W> {
 
 impl<W: Write + Send + 'static> Drop for WriteBehind<W> {
     /// Hand what is pending to the writer and wait for it (errors are lost: call
-    /// [`Self::finish`] to see them), as [`HistoryWriter`] does when dropped.
+    /// [`Self::finish`] to see them), as `HistoryWriter` does when dropped.
     fn drop(&mut self) {
         if self.thread.is_some() {
             if let Some(tx) = &self.to_writer {

@@ -58,7 +58,8 @@ pub mod history;
 pub mod report;
 
 pub use checks::AttitudeChecks;
-pub use registry::{BatchOutput, Capabilities, Estimator};
+pub(crate) use registry::Estimator;
+pub use registry::{BatchOutput, Capabilities};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
 pub use sdp::Constrained;
 pub use settings::{
@@ -269,7 +270,7 @@ impl PipelineError {
     /// name ([`Self::ends_step`]); the estimator may be behind the reader (resampling
     /// reads ahead, the half-rate shadow's step ends at a later sample).
     #[must_use]
-    pub fn step_end_s(&self) -> Option<f64> {
+    pub(crate) fn step_end_s(&self) -> Option<f64> {
         match self {
             PipelineError::Estimator {
                 source:
@@ -286,7 +287,7 @@ impl PipelineError {
     /// Whether a sample at `t_s` is at or after the step end `step_end_s` (to 1e-9 of its
     /// size): the first such sample ends the step.
     #[must_use]
-    pub fn ends_step(t_s: f64, step_end_s: f64) -> bool {
+    pub(crate) fn ends_step(t_s: f64, step_end_s: f64) -> bool {
         t_s >= step_end_s - 1e-9 * (1.0 + step_end_s.abs())
     }
 }
@@ -483,7 +484,7 @@ impl Pipeline {
     }
 
     /// With an attitude drift stated: whether the last answer came from the rows weighted
-    /// for it ([`registry::Estimator::drift_weighted`]).
+    /// for it (`registry::Estimator::drift_weighted`).
     #[must_use]
     pub fn drift_weighted(&self) -> Option<bool> {
         self.estimator.drift_weighted()
@@ -492,7 +493,7 @@ impl Pipeline {
     /// With both rotation sources in play (gyro rates in the telemetry, no
     /// `rotation_source` set): whether the attitude was found to be the gyro's own
     /// integral, whose rows are then not folded twice
-    /// ([`registry::Estimator::attitude_is_gyro_integral`]); `None` until decided.
+    /// (`registry::Estimator::attitude_is_gyro_integral`); `None` until decided.
     #[must_use]
     pub fn attitude_is_gyro_integral(&self) -> Option<bool> {
         self.estimator.attitude_is_gyro_integral()
@@ -518,7 +519,7 @@ impl Pipeline {
 
     /// Samples the estimator saw (after resampling).
     #[must_use]
-    pub fn estimator_samples(&self) -> usize {
+    pub(crate) fn estimator_samples(&self) -> usize {
         self.estimator_samples
     }
 

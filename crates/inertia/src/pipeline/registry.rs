@@ -14,7 +14,7 @@ use crate::solver::Backend;
 use std::boxed::Box;
 
 /// A streaming estimator as the pipeline drives it.
-pub trait Estimator: Send {
+pub(crate) trait Estimator: Send {
     /// Feed one sample; an estimate when one is due.
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError>;
     /// Gaps in the time stamps seen so far (no row spans a gap).
@@ -77,13 +77,13 @@ pub struct BatchOutput {
     /// The row model used, for estimators that choose one.
     pub row_model: Option<MomentumRowSettings>,
     /// The residual variance over the part the stated gyro density alone implies, where
-    /// the estimator makes that test ([`Estimator::gyro_density_ratio`]).
+    /// the estimator makes that test (`Estimator::gyro_density_ratio`).
     pub gyro_density_ratio: Option<f64>,
     /// The test for a constant disturbance torque, for estimators that make it
     /// ([`crate::estimator::discrete_momentum::torque_tested`]).
     pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
     /// Whether the attitude was found to be the gyro's own integral, for estimators that
-    /// make that test ([`Estimator::attitude_is_gyro_integral`]).
+    /// make that test (`Estimator::attitude_is_gyro_integral`).
     pub attitude_is_gyro_integral: Option<bool>,
 }
 
@@ -119,9 +119,9 @@ impl Capabilities {
 }
 
 /// Build a streaming estimator from a validated configuration.
-pub type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
+pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
 /// Estimate from all samples at once.
-pub type BatchFn = fn(&[Sample], &PipelineConfig) -> Result<BatchOutput, PipelineError>;
+pub(crate) type BatchFn = fn(&[Sample], &PipelineConfig) -> Result<BatchOutput, PipelineError>;
 
 /// A registered estimator.
 #[derive(Debug)]
@@ -205,18 +205,18 @@ fn names<T>(entries: &[T], name: impl Fn(&T) -> &'static str) -> std::string::St
 
 /// Names of the registered estimators, comma-separated.
 #[must_use]
-pub fn estimator_names() -> std::string::String {
+pub(crate) fn estimator_names() -> std::string::String {
     names(ESTIMATORS, |e| e.name)
 }
 
 /// Names of the registered backends, comma-separated.
 #[must_use]
-pub fn backend_names() -> std::string::String {
+pub(crate) fn backend_names() -> std::string::String {
     names(BACKENDS, |e| e.name)
 }
 
 /// The estimator called `name`.
-pub fn estimator(name: &str) -> Result<&'static EstimatorEntry, PipelineError> {
+pub(crate) fn estimator(name: &str) -> Result<&'static EstimatorEntry, PipelineError> {
     ESTIMATORS
         .iter()
         .find(|e| e.name == name)
@@ -224,7 +224,7 @@ pub fn estimator(name: &str) -> Result<&'static EstimatorEntry, PipelineError> {
 }
 
 /// The backend called `name`, if this build can run it.
-pub fn backend(name: &str) -> Result<&'static BackendEntry, PipelineError> {
+pub(crate) fn backend(name: &str) -> Result<&'static BackendEntry, PipelineError> {
     let entry = BACKENDS
         .iter()
         .find(|e| e.name == name)

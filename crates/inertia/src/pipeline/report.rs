@@ -290,7 +290,7 @@ impl Report {
     /// The report of `estimate`, produced by a pipeline with `config` from `samples`
     /// samples with `gaps` gaps.
     #[must_use]
-    pub fn new(
+    pub(crate) fn new(
         estimate: &Estimate,
         config: &PipelineConfig,
         batch: bool,
@@ -395,14 +395,16 @@ impl Report {
     /// With the wheel speeds' update period (samples, s) where they look held and no time
     /// tag was asked for ([`crate::telemetry::held_speeds`]).
     #[must_use]
-    pub fn with_held_speeds(mut self, held: Option<(usize, f64)>) -> Self {
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_held_speeds(mut self, held: Option<(usize, f64)>) -> Self {
         self.held_speeds = held;
         self.refreshed()
     }
 
     /// With the wheel-speed time tag the run applied, or why it could not be estimated.
     #[must_use]
-    pub fn with_wheel_delay(
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_wheel_delay(
         mut self,
         delay: Option<
             &Result<
@@ -447,7 +449,7 @@ impl Report {
 
     /// With the verdict of the attitude-against-gyro convention check.
     #[must_use]
-    pub fn with_attitude_check(mut self, verdict: Verdict) -> Self {
+    pub(crate) fn with_attitude_check(mut self, verdict: Verdict) -> Self {
         self.attitude = Some(verdict);
         self.refreshed()
     }
@@ -484,14 +486,15 @@ impl Report {
 
     /// With the input summary.
     #[must_use]
-    pub fn with_input(mut self, input: InputSummary) -> Self {
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_input(mut self, input: InputSummary) -> Self {
         self.input = Some(input);
         self
     }
 
     /// With the excitation report.
     #[must_use]
-    pub fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
+    pub(crate) fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
         self.excitation = excitation;
         self.refreshed()
     }
@@ -499,7 +502,7 @@ impl Report {
     /// With the row model and the estimated disturbance torque (N m), where the estimator
     /// has them.
     #[must_use]
-    pub fn with_row_model(
+    pub(crate) fn with_row_model(
         mut self,
         row_model: Option<MomentumRowSettings>,
         torque_bias_nm: Option<nalgebra::Vector3<f64>>,
@@ -511,7 +514,7 @@ impl Report {
 
     /// With the test for a constant disturbance torque, where the estimator makes it.
     #[must_use]
-    pub fn with_torque_test(
+    pub(crate) fn with_torque_test(
         mut self,
         test: Option<crate::estimator::discrete_momentum::TorqueTest>,
     ) -> Self {
@@ -521,14 +524,14 @@ impl Report {
 
     /// With whether the attitude was found to be the gyro's own integral.
     #[must_use]
-    pub fn with_attitude_is_gyro_integral(mut self, same: Option<bool>) -> Self {
+    pub(crate) fn with_attitude_is_gyro_integral(mut self, same: Option<bool>) -> Self {
         self.attitude_is_gyro_integral = same;
         self
     }
 
     /// With whether the answer came from the rows weighted for a stated attitude drift.
     #[must_use]
-    pub fn with_drift_weighted(mut self, weighted: Option<bool>) -> Self {
+    pub(crate) fn with_drift_weighted(mut self, weighted: Option<bool>) -> Self {
         self.drift_weighted = weighted;
         self
     }
@@ -536,7 +539,11 @@ impl Report {
     /// With the residual tests' findings, where the estimator makes them: the worst span
     /// and the ratio to the stated gyro density.
     #[must_use]
-    pub fn with_residual_tests(mut self, worst: Option<Worst>, density_ratio: Option<f64>) -> Self {
+    pub(crate) fn with_residual_tests(
+        mut self,
+        worst: Option<Worst>,
+        density_ratio: Option<f64>,
+    ) -> Self {
         self.residual_consistency = worst;
         self.gyro_density_ratio = density_ratio;
         self.refreshed()
@@ -544,7 +551,7 @@ impl Report {
 
     /// With the glitches kept, if any.
     #[must_use]
-    pub fn with_glitches(mut self, check: Option<&GlitchCheck>) -> Self {
+    pub(crate) fn with_glitches(mut self, check: Option<&GlitchCheck>) -> Self {
         self.glitches = check.filter(|c| c.count() > 0).map(|c| Glitches {
             count: c.count(),
             listed: c.listed().copied().collect(),

@@ -179,7 +179,7 @@ impl RunError {
 
     /// The pipeline's error, where the pipeline or the estimator stopped.
     #[must_use]
-    pub fn pipeline(&self) -> Option<&PipelineError> {
+    pub(crate) fn pipeline(&self) -> Option<&PipelineError> {
         match &self.kind {
             RunErrorKind::Pipeline(e) => Some(e),
             _ => None,
@@ -511,7 +511,8 @@ impl Run {
 
     /// The sample period, s: the resampling period where resampling, else the first step.
     #[must_use]
-    pub fn sample_period_s(&self) -> f64 {
+    #[cfg_attr(not(all(feature = "serde", feature = "csv")), allow(dead_code))] // used by the report
+    pub(crate) fn sample_period_s(&self) -> f64 {
         self.config
             .resample_s()
             .unwrap_or(self.first_t_s[1] - self.first_t_s[0])

@@ -150,7 +150,7 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
 
     /// The span whose residuals stand out most.
     #[must_use]
-    pub fn residual_consistency(&self) -> Option<Worst> {
+    pub(crate) fn residual_consistency(&self) -> Option<Worst> {
         self.residuals.as_ref()?.worst()
     }
 }

@@ -484,7 +484,7 @@ impl InertialTorque {
 
     /// The name for reports and options.
     #[must_use]
-    pub fn name(&self) -> &'static str {
+    pub(crate) fn name(&self) -> &'static str {
         match self {
             InertialTorque::Off => "off",
             InertialTorque::On => "on",

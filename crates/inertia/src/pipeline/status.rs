@@ -22,7 +22,7 @@
 //!   (the paper's own J breaks `J1 + J2 ≥ J3` by 4.9e-5 kg m², so an estimator that is
 //!   right to its σ can be here when its σ is smaller than that). Within [`PHYSICAL_Z`] σ
 //!   the answer is consistent with a physical inertia at its accuracy and stays
-//!   determined (the report says so, [`physical_margin`]).
+//!   determined (the report says so, [`PhysicalMargin`]).
 //! * **What the user said.** A relative uncertainty of the rotor momentum's scale
 //!   ([`super::PipelineSettings::rotor_scale_sigma`], the wheels' spin inertia known to
 //!   ±r) is a consider parameter: σ is widened by `r |ĵ|` per element
@@ -44,7 +44,7 @@ use crate::tensor::{matrix_from_j, InertiaVector};
 pub const PHYSICAL_Z: f64 = 3.0;
 
 /// A violation smaller than this fraction of `J3` is round-off, not a violation.
-pub const PHYSICAL_ROUND_OFF: f64 = 1e-6;
+pub(crate) const PHYSICAL_ROUND_OFF: f64 = 1e-6;
 
 /// How far an answer lies outside the physical set.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,7 +64,7 @@ pub struct PhysicalMargin {
 impl PhysicalMargin {
     /// Whether the violation exceeds [`PHYSICAL_Z`] σ (or there is no σ to judge it).
     #[must_use]
-    pub fn significant(&self) -> bool {
+    pub(crate) fn significant(&self) -> bool {
         self.z.is_none_or(|z| z > PHYSICAL_Z)
     }
 }
@@ -72,7 +72,7 @@ impl PhysicalMargin {
 /// The physical margin of `e`'s answer when it breaks `J1 > 0` or `J1 + J2 ≥ J3` by more
 /// than round-off; `None` for a physical answer or none.
 #[must_use]
-pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
+pub(crate) fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
     let j = e.j()?;
     let (mut m, _) = crate::eigen3::symmetric_eigen3(&matrix_from_j(&j));
     m.as_mut_slice().sort_unstable_by(f64::total_cmp);
@@ -108,7 +108,7 @@ pub fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 /// wheel-speed time tag's consider term where one was applied
 /// ([`crate::estimator::wheel_delay`]), the rotor scale's where one is given
 /// ([`widen_for_rotor_scale`]), then [`settle`].
-pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
+pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     let threshold = config.observability.max_relative_sigma;
     if let Some(c) = config.wheel_delay_consider {
         widen(e, threshold, |u, j| u.with_time_tag(j, &c));
@@ -122,7 +122,7 @@ pub fn apply(e: &mut Estimate, config: &PipelineConfig) {
 /// Widen `e`'s σ by the rotor momentum's scale uncertainty `r` (relative) and take
 /// "determined" back where the widened relative σ `σ_F/‖Ĵ‖_F` exceeds `threshold`
 /// (module docs, "What the user said"); the answer is kept.
-pub fn widen_for_rotor_scale(e: &mut Estimate, r: f64, threshold: f64) {
+pub(crate) fn widen_for_rotor_scale(e: &mut Estimate, r: f64, threshold: f64) {
     widen(e, threshold, |u, j| u.with_rotor_scale(j, r));
 }
 

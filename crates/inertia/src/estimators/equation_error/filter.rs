@@ -18,27 +18,27 @@ use nalgebra::{SMatrix, SVector};
 use std::vec::Vec;
 
 /// The polynomial order.
-pub const ORDER: usize = 4;
+pub(crate) const ORDER: usize = 4;
 /// The smallest half-width m (a window of 7 samples for 5 coefficients).
-pub const MIN_HALF_WIDTH: usize = 3;
+pub(crate) const MIN_HALF_WIDTH: usize = 3;
 
 /// Weights of one window.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SavitzkyGolay {
+pub(crate) struct SavitzkyGolay {
     /// Half-width m: the window is `2m + 1` samples.
-    pub half_width: usize,
+    pub(crate) half_width: usize,
     /// Weights of the smoothed value at the centre.
-    pub smooth: Vec<f64>,
+    pub(crate) smooth: Vec<f64>,
     /// Weights of the first derivative at the centre, per unit step (divide by h).
-    pub d1: Vec<f64>,
+    pub(crate) d1: Vec<f64>,
     /// Weights of the second derivative at the centre, per unit step² (divide by h²).
-    pub d2: Vec<f64>,
+    pub(crate) d2: Vec<f64>,
 }
 
 impl SavitzkyGolay {
     /// The weights for half-width `m` (at least [`MIN_HALF_WIDTH`]).
     #[must_use]
-    pub fn new(half_width: usize) -> Self {
+    pub(crate) fn new(half_width: usize) -> Self {
         let m = half_width.max(MIN_HALF_WIDTH);
         let n = 2 * m + 1;
         let scale = m as f64;
@@ -72,7 +72,7 @@ impl SavitzkyGolay {
     /// The window whose −3 dB cutoff is nearest `cutoff_hz` at the sample rate
     /// `rate_hz` (module docs), at least [`MIN_HALF_WIDTH`].
     #[must_use]
-    pub fn for_cutoff(cutoff_hz: f64, rate_hz: f64) -> Self {
+    pub(crate) fn for_cutoff(cutoff_hz: f64, rate_hz: f64) -> Self {
         let n = ((ORDER + 1) as f64 * rate_hz / cutoff_hz + 4.6) / 3.2;
         let m = ((n - 1.0) / 2.0).round();
         Self::new(if m.is_finite() && m > 0.0 {
@@ -84,14 +84,14 @@ impl SavitzkyGolay {
 
     /// The window length, samples.
     #[must_use]
-    pub fn window_len(&self) -> usize {
+    pub(crate) fn window_len(&self) -> usize {
         2 * self.half_width + 1
     }
 }
 
 /// `Σ_i w_i y_i` over a window of vectors.
 #[must_use]
-pub fn apply<'a>(
+pub(crate) fn apply<'a>(
     weights: &[f64],
     window: impl Iterator<Item = &'a nalgebra::Vector3<f64>>,
 ) -> nalgebra::Vector3<f64> {

@@ -69,21 +69,21 @@ pub(crate) const EQUATION_ERROR: EstimatorEntry = EstimatorEntry {
 
 /// The default cutoff as a fraction of the sample rate: 200 Hz at 4 kHz, 0.5 Hz at 10 Hz
 /// (a window of 33 samples; 63 samples leave a 4e-4 filter bias on the paper's slew).
-pub const DEFAULT_CUTOFF_FRACTION: f64 = 1.0 / 20.0;
+pub(crate) const DEFAULT_CUTOFF_FRACTION: f64 = 1.0 / 20.0;
 
 /// Relative tolerance on the time step.
 const STEP_TOLERANCE: f64 = 1e-3;
 
 /// Settings of the baseline.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct EquationErrorSettings {
+pub(crate) struct EquationErrorSettings {
     /// The filter's −3 dB cutoff, Hz (`None`: [`DEFAULT_CUTOFF_FRACTION`] of the sample
     /// rate).
-    pub cutoff_hz: Option<f64>,
+    pub(crate) cutoff_hz: Option<f64>,
     /// Estimate a constant body-frame torque beside j.
-    pub body_torque: bool,
+    pub(crate) body_torque: bool,
     /// Estimate every this many samples.
-    pub solve_every: usize,
+    pub(crate) solve_every: usize,
 }
 
 impl Default for EquationErrorSettings {
@@ -108,7 +108,7 @@ struct Node {
 
 /// The estimator's state.
 #[derive(Debug, Clone)]
-pub struct EquationError {
+pub(crate) struct EquationError {
     settings: EquationErrorSettings,
     filter: Option<SavitzkyGolay>,
     step_s: Option<f64>,
@@ -125,7 +125,7 @@ pub struct EquationError {
 impl EquationError {
     /// A new estimator.
     #[must_use]
-    pub fn new(settings: EquationErrorSettings) -> Self {
+    pub(crate) fn new(settings: EquationErrorSettings) -> Self {
         let p = Self::unknowns(settings.body_torque);
         Self {
             settings,
@@ -151,7 +151,7 @@ impl EquationError {
 
     /// Feed a sample; an estimate when one is due (every
     /// [`EquationErrorSettings::solve_every`] samples once there are rows).
-    pub fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
+    pub(crate) fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         let index = self.samples;
         self.samples += 1;
         let rate = gyro_sample(s, index)?;
@@ -243,7 +243,7 @@ impl EquationError {
 
     /// The least-squares answer of the rows so far.
     #[must_use]
-    pub fn estimate(&self, t_s: f64) -> Estimate {
+    pub(crate) fn estimate(&self, t_s: f64) -> Estimate {
         let p = self.ata.nrows();
         let rows = 3 * self.blocks;
         let not = |reason| Estimate {
@@ -307,7 +307,7 @@ impl EquationError {
 
     /// The estimated constant body-frame torque, N m, when estimated and solvable.
     #[must_use]
-    pub fn body_torque_nm(&self) -> Option<Vector3<f64>> {
+    pub(crate) fn body_torque_nm(&self) -> Option<Vector3<f64>> {
         if self.ata.nrows() != 9 {
             return None;
         }
