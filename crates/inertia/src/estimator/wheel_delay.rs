@@ -17,17 +17,18 @@
 //! # The profile
 //!
 //! For each trial `δ` the record's `ρ` is read at `t + δ` (the cubic through the four
-//! nearest samples, held at the record's ends) and the plain discrete momentum rows are fitted by
-//! least squares in `[τ_b; j]`, with each chain's initial momentum `L̄₀` and a torque
-//! fixed in the inertial frame `τ_I` minimised out per chain
-//! ([`crate::estimator::momentum_rows`], "Inertial torque"): a disturbance of either kind
-//! must not pass for a time tag. `δ̂` minimises the residual sum of squares `RSS(δ)`: on
-//! a grid of [`GRID`] steps each side over `±H`, `H = min(`[`MAX_HALF_RANGE_S`]`, T/10)`
-//! for a record of `T` s, then on a fine grid over two steps each side of the best node,
+//! nearest samples, held at the ends of each stretch between gaps, [`shift_rho`]) and the
+//! estimator's plain discrete momentum rows are fitted by least squares in `[τ_b; j]`,
+//! with each chain's initial momentum `L̄₀` and a torque fixed in the inertial frame `τ_I`
+//! minimised out per chain ([`crate::estimator::momentum_rows`], "Inertial torque"): a
+//! disturbance of either kind must not pass for a time tag. `δ̂` minimises the residual
+//! sum of squares `RSS(δ)`: on a grid of [`GRID`] steps each side over `±H`,
+//! `H = min(`[`MAX_HALF_RANGE_S`]`, T/10)` with `T` the shortest stretch between gaps (of
+//! at least 16 samples), then on a fine grid over two steps each side of the best node,
 //! whose least-squares parabola's vertex is `δ̂` (the profile wiggles at the sample
-//! period where the speeds are held; the parabola smooths that). Only rows whose samples
-//! keep every trial's `t + δ` inside the record are fitted, so every trial fits the same
-//! rows.
+//! period where the speeds are held; the parabola smooths that). Only the rows of each
+//! stretch whose samples keep every trial's `t + δ` inside it are fitted, so every trial
+//! fits the same rows.
 //!
 //! # σ
 //!
@@ -142,9 +143,29 @@ pub fn shift_rho(samples: &mut [Sample], delay_s: f64) {
     }
     let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
     let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
-    for (k, s) in samples.iter_mut().enumerate() {
-        s.rho_nms = interpolate(&t, &rho, k, t[k] + delay_s);
+    for (a, b) in segments(&t) {
+        for k in a..=b {
+            samples[k].rho_nms = interpolate(&t[a..=b], &rho[a..=b], k - a, t[k] + delay_s);
+        }
     }
+}
+
+/// The stretches of samples between gaps ([`crate::sample::is_gap`]), first and last
+/// index of each: a time tag reads the speeds within a stretch, never across a gap (as
+/// between the records of a run).
+fn segments(t: &[f64]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for k in 2..t.len() {
+        if crate::sample::is_gap(t[k - 1] - t[k - 2], t[k] - t[k - 1]) {
+            out.push((start, k - 1));
+            start = k;
+        }
+    }
+    if !t.is_empty() {
+        out.push((start, t.len() - 1));
+    }
+    out
 }
 
 /// `ρ` at time `x`, interpolated, starting the search at sample `k`.
@@ -196,20 +217,21 @@ type Moments = [SMatrix<f64, W, W>; 3];
 /// rows of [`super::momentum_rows`]).
 type Block = (usize, Matrix3<f64>, SMatrix<f64, 3, 6>, f64, Vector3<f64>);
 
-/// The rows of the window at one trial `δ`, one 3-row block per interval.
+/// A stretch of rows to fit: its first and last sample, and the first and last sample of
+/// the stretch between gaps that holds it ([`segments`]).
+type Window = (usize, usize, usize, usize);
+
+/// The rows of the windows at one trial `δ`, one 3-row block per interval.
 struct Rows {
     blocks: Vec<Block>,
     chains: usize,
 }
 
-fn rows(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Rows {
-    let (lo, hi) = window;
+fn rows(samples: &[Sample], windows: &[Window], delay_s: f64) -> Rows {
     let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
     let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
-    // The shifted times increase with k: the search for each starts where the last ended.
-    let mut cursor = lo;
     let mut out = Rows {
-        blocks: Vec::with_capacity(hi - lo),
+        blocks: Vec::with_capacity(windows.iter().map(|w| w.1 + 1 - w.0).sum()),
         chains: 0,
     };
     // The estimator's own plain rows ([`super::momentum_rows`]), each block's inertial
@@ -221,8 +243,20 @@ fn rows(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Rows {
         ..MomentumRowSettings::default()
     });
     let mut epoch = None;
-    for (k, s) in samples.iter().enumerate().take(hi + 1).skip(lo) {
-        let (rho_k, i) = interpolate_from(&t, &rho, cursor, t[k] + delay_s);
+    // Between windows the samples jump a gap: the rows restart their chain there.
+    let samples_in = windows
+        .iter()
+        .flat_map(|&(lo, hi, a, b)| (lo..=hi).map(move |k| (k, a, b)));
+    // The shifted times increase with k: the search for each starts where the last ended.
+    let mut cursor = 0;
+    let mut segment_start = usize::MAX;
+    for (k, a, b) in samples_in {
+        let s = &samples[k];
+        if a != segment_start {
+            segment_start = a;
+            cursor = 0;
+        }
+        let (rho_k, i) = interpolate_from(&t[a..=b], &rho[a..=b], cursor, t[k] + delay_s);
         cursor = i;
         let shifted = Sample {
             rho_nms: rho_k,
@@ -346,8 +380,8 @@ fn rhs(r: &Rows) -> Vec<Vector3<f64>> {
 }
 
 /// `RSS(δ)` and `ĵ(δ)`, or `None` where the fit is singular.
-fn profile(samples: &[Sample], window: (usize, usize), delay_s: f64) -> Option<(f64, Fit)> {
-    let r = rows(samples, window, delay_s);
+fn profile(samples: &[Sample], windows: &[Window], delay_s: f64) -> Option<(f64, Fit)> {
+    let r = rows(samples, windows, delay_s);
     let f = fit(&r, &rhs(&r))?;
     Some((f.rss, f))
 }
@@ -400,29 +434,46 @@ pub fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
     if n < 8 {
         return Err(DelayError::NotEstimable("too few samples"));
     }
-    let (t0, t1) = (samples[0].t_s, samples[n - 1].t_s);
-    let half = MAX_HALF_RANGE_S.min((t1 - t0) / 10.0);
+    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    // The stretches between gaps (records), and the shortest of them that matter.
+    let stretches: Vec<(usize, usize)> = segments(&t)
+        .into_iter()
+        .filter(|&(a, b)| b >= a + 16)
+        .collect();
+    let shortest = stretches
+        .iter()
+        .map(|&(a, b)| t[b] - t[a])
+        .fold(f64::INFINITY, f64::min);
+    let half = MAX_HALF_RANGE_S.min(shortest / 10.0);
     let step = half / GRID as f64;
     // The trials reach ±(H + 2 steps): the fine grid about a node at most H − 1 step
-    // out, and the derivative a step beyond; one step more of margin.
+    // out, and the derivative a step beyond; one step more of margin, within each
+    // stretch, so that no trial reads a speed across a gap or beyond the record.
     let margin = half + 3.0 * step;
-    let lo = samples.partition_point(|s| s.t_s < t0 + margin);
-    let hi = samples
-        .partition_point(|s| s.t_s <= t1 - margin)
-        .saturating_sub(1);
-    if hi < lo + 8 {
+    let windows: Vec<Window> = stretches
+        .iter()
+        .filter_map(|&(a, b)| {
+            let lo = a + t[a..=b].partition_point(|&x| x < t[a] + margin);
+            let hi = (a + t[a..=b].partition_point(|&x| x <= t[b] - margin)).checked_sub(1)?;
+            (hi >= lo + 8).then_some((lo, hi, a, b))
+        })
+        .collect();
+    if windows.is_empty() || !(half > 0.0) {
         return Err(DelayError::NotEstimable(
             "too few samples inside the search window",
         ));
     }
-    let window = (lo, hi);
-    let rho0 = samples[lo].rho_nms;
-    if samples[lo..=hi].iter().all(|s| s.rho_nms == rho0) {
+    let windows = &windows[..];
+    let rho0 = samples[windows[0].0].rho_nms;
+    if windows
+        .iter()
+        .all(|&(lo, hi, ..)| samples[lo..=hi].iter().all(|s| s.rho_nms == rho0))
+    {
         return Err(DelayError::NotEstimable(
             "the rotor momentum does not change",
         ));
     }
-    let eval = |d: f64| profile(samples, window, d).map_or(f64::INFINITY, |p| p.0);
+    let eval = |d: f64| profile(samples, windows, d).map_or(f64::INFINITY, |p| p.0);
     let grid: Vec<(f64, f64)> = (0..=2 * GRID)
         .map(|i| {
             let d = -half + step * i as f64;
@@ -455,14 +506,14 @@ pub fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
         .filter(|p| p.1.is_finite())
         .collect();
     let delay = d_best + step * parabola_vertex(&fine).unwrap_or(0.0);
-    let r = rows(samples, window, delay);
+    let r = rows(samples, windows, delay);
     let y = rhs(&r);
     let f = fit(&r, &y).ok_or(DelayError::NotEstimable("singular fit"))?;
     // ∂r/∂δ at fixed unknowns, then residualised on the regressors (the same fit).
     let eps = step;
     // The rows a step either side, one at a time: their right-hand sides and answers.
     let side = |d: f64| {
-        let r = rows(samples, window, d);
+        let r = rows(samples, windows, d);
         let y = rhs(&r);
         let j = fit(&r, &y).map(|f| f.theta);
         (y, j)

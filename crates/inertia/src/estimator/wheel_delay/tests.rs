@@ -122,3 +122,34 @@ fn parses_the_settings_names() {
     assert!("nan".parse::<WheelDelay>().is_err());
     assert!("late".parse::<WheelDelay>().is_err());
 }
+
+/// A time tag reads the speeds within a stretch between gaps, never across one: the
+/// samples before a gap hold the last speed before it, those after it start from the
+/// first after it.
+#[test]
+fn the_shift_does_not_read_across_a_gap() {
+    let t = [0.0, 0.1, 0.2, 0.3, 0.4, 5.0, 5.1, 5.2, 5.3, 5.4];
+    let mut s: Vec<Sample> = t
+        .iter()
+        .map(|&t| Sample {
+            t_s: t,
+            q: Quaternion::from_xyzw([0.0, 0.0, 0.0, 1.0]),
+            rho_nms: Vector3::new(if t < 1.0 { 10.0 * t } else { -3.0 }, 0.0, 0.0),
+            tau_nm: Vector3::zeros(),
+            omega_rad_s: None,
+        })
+        .collect();
+    shift_rho(&mut s, 0.15);
+    assert!((s[2].rho_nms.x - 3.5).abs() < 1e-12, "{}", s[2].rho_nms.x);
+    assert_eq!(
+        s[4].rho_nms.x, 4.0,
+        "held at the stretch's end, not read after the gap"
+    );
+    assert!((s[5].rho_nms.x + 3.0).abs() < 1e-12);
+    shift_rho(&mut s, -0.3);
+    let x = s[5].rho_nms.x;
+    assert!(
+        (x + 3.0).abs() < 1e-12,
+        "held at the stretch's start, not read before it: {x}"
+    );
+}
