@@ -15,14 +15,19 @@ use inertia::tensor::relative_frobenius_error;
 use nalgebra::Matrix3;
 
 /// The final estimate of a run of the default estimator with `delay`, streaming or batch.
-fn run(samples: &[Sample], delay: WheelDelay, batch: bool) -> (Estimate, Run) {
+/// A run of the default estimator with `delay`, streaming or batch.
+fn new_run(delay: WheelDelay, batch: bool) -> Run {
     let config = PipelineSettings {
         wheel_delay: delay,
         ..PipelineSettings::default()
     }
     .validate()
     .expect("settings");
-    let mut r = Run::new(config, batch).expect("run");
+    Run::new(config, batch).expect("run")
+}
+
+fn run(samples: &[Sample], delay: WheelDelay, batch: bool) -> (Estimate, Run) {
+    let mut r = new_run(delay, batch);
     let mut last = None;
     for s in samples {
         r.push(s, |e| last = Some(*e)).expect("push");
@@ -206,13 +211,7 @@ fn a_given_time_tag_is_the_shift_and_errors_name_the_same_sample() {
     let (a, b) = (given.j().expect("J"), reference.j().expect("J"));
     assert!((a - b).norm() <= 1e-12 * b.norm(), "{a} vs {b}");
     let count = |delay| {
-        let config = PipelineSettings {
-            wheel_delay: delay,
-            ..PipelineSettings::default()
-        }
-        .validate()
-        .expect("settings");
-        let mut r = Run::new(config, false).expect("run");
+        let mut r = new_run(delay, false);
         let mut n = 0;
         for s in &shifted {
             r.push(s, |_| n += 1).expect("push");
@@ -235,13 +234,7 @@ fn a_given_time_tag_is_the_shift_and_errors_name_the_same_sample() {
         s.q = inertia::attitude::Quaternion::from_wxyz([r.w, r.i, r.j, r.k]);
     }
     let error_at = |delay| {
-        let config = PipelineSettings {
-            wheel_delay: delay,
-            ..PipelineSettings::default()
-        }
-        .validate()
-        .expect("settings");
-        let mut r = Run::new(config, false).expect("run");
+        let mut r = new_run(delay, false);
         for s in &samples {
             if let Err(e) = r.push(s, |_| {}) {
                 return e.sample;
