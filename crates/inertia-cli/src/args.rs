@@ -246,6 +246,11 @@ pub struct SimulateArgs {
     /// telemetry rate) [default: every sample, or the preset's].
     #[arg(long, value_name = "HZ")]
     pub wheel_hold_hz: Option<f64>,
+    /// A spacecraft file (TOML) whose rotors carry the simulated rotor momentum: the CSV
+    /// holds their speed columns instead of rho_*, split among them as a pseudo-inverse
+    /// allocator does, with the file's spin inertias as the truth.
+    #[arg(long, value_name = "FILE.toml")]
+    pub spacecraft: Option<PathBuf>,
     /// Output CSV file (the truth goes to the same name with `.truth.json`).
     #[arg(short = 'o', long, value_name = "FILE.csv")]
     pub output: PathBuf,
@@ -349,6 +354,11 @@ pub struct InputArgs {
     /// reaction on the body): negate them as they are read.
     #[arg(long)]
     pub negate_rho: bool,
+    /// A spacecraft file (TOML): the rotors' axes, spin inertias ± σ and speed columns.
+    /// The rotor momentum is computed from the wheel speeds (the file then has no rho_*
+    /// columns), and the spin inertias' σ widen the answer's σ.
+    #[arg(long, value_name = "FILE.toml")]
+    pub spacecraft: Option<std::path::PathBuf>,
     /// Rename a column, e.g. `--column t=time --column rho_x=h_wheel_x`.
     #[arg(long = "column", value_name = "DEFAULT=NAME")]
     pub columns: Vec<String>,

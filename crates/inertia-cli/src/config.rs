@@ -367,8 +367,20 @@ pub fn settings_error(e: PipelineError) -> CliError {
     }
 }
 
-/// CSV options from the input arguments.
-pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
+/// The spacecraft file of the input arguments, if any.
+pub fn spacecraft(a: &InputArgs) -> Result<Option<inertia::spacecraft::Spacecraft>, CliError> {
+    a.spacecraft
+        .as_deref()
+        .map(|p| inertia::spacecraft::Spacecraft::load(p).map_err(|e| input(e.to_string())))
+        .transpose()
+}
+
+/// CSV options from the input arguments (and the speed columns of their spacecraft
+/// file).
+pub fn csv_options(
+    a: &InputArgs,
+    spacecraft: Option<&inertia::spacecraft::Spacecraft>,
+) -> Result<CsvOptions, CliError> {
     let mut columns = ColumnNames::default();
     for c in &a.columns {
         let (k, v) = c.split_once('=').ok_or_else(|| {
@@ -412,5 +424,6 @@ pub fn csv_options(a: &InputArgs) -> Result<CsvOptions, CliError> {
         } else {
             inertia::telemetry::csv::GyroUnit::RadPerS
         },
+        speed_columns: spacecraft.map_or_else(Vec::new, |s| s.speed_columns()),
     })
 }

@@ -72,7 +72,8 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             "-o -: the report goes to standard output; give the history a file name (e.g. -o history.csv)",
         ));
     }
-    let options = config::csv_options(&a.input)?;
+    let spacecraft = config::spacecraft(&a.input)?;
+    let options = config::csv_options(&a.input, spacecraft.as_ref())?;
     let settings = config::pipeline_settings(a)?;
     let config = settings.validate().map_err(settings_error)?;
     let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
@@ -82,6 +83,9 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let file = reader.file().to_string();
     let q_columns = reader.quaternion_columns();
     let mut run = Run::new(config, a.batch).map_err(settings_error)?;
+    if let Some(s) = spacecraft {
+        run = run.with_spacecraft(s);
+    }
     run.check_columns(reader.has_gyro())
         .map_err(|e| run_error(&e, &file, Some(1), &q_columns))?;
     // Parsing overlaps the estimator.
@@ -121,7 +125,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         }
         lines.push_back(reader.last_line());
         let n = run.input_samples();
-        run.push(&s, |e| {
+        run.push_with_speeds(&s, reader.last_speeds(), |e| {
             if let (Some(h), None) = (history.as_mut(), &write_error) {
                 write_error = h.write(e).err();
             }

@@ -3,7 +3,9 @@
 //! The paper's scenarios or a spacecraft preset, with the library's realism settings
 //! (`inertia::sim::Realism`) from the command line. With gravity gradient on, the CSV
 //! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
-//! at each sample (ignored by `estimate`, which reads columns by name).
+//! at each sample (ignored by `estimate`, which reads columns by name). With a spacecraft
+//! file (`--spacecraft`), the rotors' speed columns replace `rho_*`
+//! (`inertia::sim::rotors`).
 //!
 //! A run is held in memory (at most [`MAX_SAMPLES`] samples, about 0.25 kB each; at most
 //! [`MAX_INTEGRATION_STEPS`] integrator steps) and the
@@ -18,7 +20,7 @@ use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::sim::{AttitudeSource, CommandHold, Orbit, SimConfig, SimOutput, MAX_SAMPLES};
-use inertia::telemetry::csv::{write_samples, write_samples_with};
+use inertia::telemetry::csv::{write_samples, write_samples_with, write_samples_with_speeds};
 use inertia::text::Num;
 use nalgebra::Vector3;
 use std::io::Write;
@@ -257,11 +259,28 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
     Ok((sc, common))
 }
 
-/// Write the telemetry CSV, with the orbit position columns when there is an orbit.
-fn write_csv(w: &mut dyn Write, out: &SimOutput) -> std::io::Result<()> {
-    match out.orbit {
-        None => write_samples(w, &out.samples),
-        Some(orbit) => write_samples_with(w, &out.samples, ["r_x", "r_y", "r_z"], |s| {
+/// The rotors' speed columns and values of a spacecraft file.
+type Speeds = (Vec<String>, Vec<f64>);
+
+/// Write the telemetry CSV, with the orbit position columns when there is an orbit and the
+/// rotors' speed columns instead of `rho_*` when there is a spacecraft file.
+fn write_csv(w: &mut dyn Write, out: &SimOutput, speeds: Option<&Speeds>) -> std::io::Result<()> {
+    let position = |s: &inertia::sample::Sample| -> Vec<f64> {
+        out.orbit
+            .map(|o| o.position_m(s.t_s).as_slice().to_vec())
+            .unwrap_or_default()
+    };
+    let orbit_columns: &[&str] = if out.orbit.is_some() {
+        &["r_x", "r_y", "r_z"]
+    } else {
+        &[]
+    };
+    match (speeds, out.orbit) {
+        (Some((names, values)), _) => {
+            write_samples_with_speeds(w, &out.samples, names, values, (orbit_columns, &position))
+        }
+        (None, None) => write_samples(w, &out.samples),
+        (None, Some(orbit)) => write_samples_with(w, &out.samples, ["r_x", "r_y", "r_z"], |s| {
             orbit.position_m(s.t_s).into()
         }),
     }
@@ -270,6 +289,11 @@ fn write_csv(w: &mut dyn Write, out: &SimOutput) -> std::io::Result<()> {
 /// Run the command.
 pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     let (sc, common) = settings(a)?;
+    let spacecraft = a
+        .spacecraft
+        .as_deref()
+        .map(|p| inertia::spacecraft::Spacecraft::load(p).map_err(|e| input(e.to_string())))
+        .transpose()?;
     let stdout = is_stdio(&a.output);
     // Create both files first: an unwritable destination fails before the simulation.
     let csv = (!stdout).then(|| Pending::create(&a.output)).transpose()?;
@@ -280,12 +304,18 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         .then(|| Pending::create(&truth_file))
         .transpose()?;
     let out = sc.simulate(&common).map_err(sim_error)?;
+    let speeds = spacecraft
+        .map(|s| -> Result<Speeds, CliError> {
+            let v = inertia::sim::rotors::speeds(&out.samples, &s).map_err(sim_error)?;
+            Ok((s.speed_columns(), v))
+        })
+        .transpose()?;
     match csv {
         Some((pending, mut w)) => {
-            write_csv(&mut w, &out).map_err(|e| write_failed(&a.output, e))?;
+            write_csv(&mut w, &out, speeds.as_ref()).map_err(|e| write_failed(&a.output, e))?;
             pending.commit(w)?;
         }
-        None => to_stdout(|w| write_csv(w, &out))?,
+        None => to_stdout(|w| write_csv(w, &out, speeds.as_ref()))?,
     }
     let written = if let Some((pending, mut w)) = truth {
         // The truth file holds the inertia at the end of the run (after any change).

@@ -4,6 +4,8 @@
 mod bad_inputs;
 #[path = "cli/simulate_options.rs"]
 mod simulate_options;
+#[path = "cli/spacecraft.rs"]
+mod spacecraft;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

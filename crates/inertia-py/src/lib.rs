@@ -41,6 +41,21 @@ pub struct Telemetry {
     pub q_columns: String,
     /// The name in reports and messages: the file's, `<arrays>` or `<simulated>`.
     pub label: String,
+    /// The spacecraft file's rotors, where the file was read with one.
+    pub rotors: Option<Rotors>,
+}
+
+/// What pickling keeps of [`Rotors`]: the spacecraft file's text and name, the speeds.
+type RotorsState<'py> = (String, String, Bound<'py, PyArray2<f64>>);
+
+/// A spacecraft file's rotors and their speeds, as `read_csv(spacecraft=…)` read them.
+#[derive(Clone)]
+pub struct Rotors {
+    pub spacecraft: inertia::spacecraft::Spacecraft,
+    /// The file's text and name (to rebuild it when unpickled).
+    pub source: (String, String),
+    /// One stored speed per rotor and sample, flat.
+    pub speeds: Vec<f64>,
 }
 
 fn column<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -138,6 +153,20 @@ impl Telemetry {
     fn label(&self) -> String {
         self.label.clone()
     }
+    /// The spacecraft file's text, name and the rotors' speeds (N, rotors), or None.
+    fn rotors_state<'py>(&self, py: Python<'py>) -> PyResult<Option<RotorsState<'py>>> {
+        let Some(r) = &self.rotors else {
+            return Ok(None);
+        };
+        let m = r.spacecraft.rotors.len();
+        let a = numpy::ndarray::Array2::from_shape_vec((self.samples.len(), m), r.speeds.clone())
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(Some((
+            r.source.0.clone(),
+            r.source.1.clone(),
+            a.into_pyarray(py),
+        )))
+    }
 
     /// Estimate from these samples (see `inertia.estimate`).
     #[pyo3(signature = (kwargs=None))]
@@ -178,7 +207,16 @@ impl Telemetry {
             },
         };
         let out = py
-            .allow_threads(|| run::run(&self.samples, &self.stats, &origin, config, &s))
+            .allow_threads(|| {
+                run::run(
+                    &self.samples,
+                    self.rotors.as_ref(),
+                    &self.stats,
+                    &origin,
+                    config,
+                    &s,
+                )
+            })
             .map_err(|f| f.into_py(py))?;
         result(py, &out.report, out.history.as_deref())
     }
@@ -276,6 +314,19 @@ fn read_csv(
             }
         }
     }
+    let spacecraft = kw
+        .string("spacecraft")?
+        .map(
+            |p| -> PyResult<(inertia::spacecraft::Spacecraft, (String, String))> {
+                let text = std::fs::read_to_string(&p).map_err(|e| {
+                    pyo3::exceptions::PyOSError::new_err(format!("cannot read {p}: {e}"))
+                })?;
+                let sc = inertia::spacecraft::Spacecraft::parse(&text, &p)
+                    .map_err(|e| value_error(e.to_string()))?;
+                Ok((sc, (text, p)))
+            },
+        )
+        .transpose()?;
     kw.finish()?;
     let options = CsvOptions {
         quaternion: conv.format,
@@ -285,8 +336,11 @@ fn read_csv(
         delimiter: b',',
         negate_rho: conv.negate_rho,
         gyro_unit: conv.gyro_unit,
+        speed_columns: spacecraft
+            .as_ref()
+            .map_or_else(Vec::new, |s| s.0.speed_columns()),
     };
-    py.allow_threads(|| read(&path, options))
+    py.allow_threads(|| read(&path, options, spacecraft))
         .map_err(|f| f.into_py(py))
 }
 
@@ -302,14 +356,24 @@ fn telemetry_failure(e: TelemetryError) -> Failure {
     }
 }
 
-fn read(path: &std::path::Path, options: CsvOptions) -> Result<Telemetry, Failure> {
+fn read(
+    path: &std::path::Path,
+    options: CsvOptions,
+    spacecraft: Option<(inertia::spacecraft::Spacecraft, (String, String))>,
+) -> Result<Telemetry, Failure> {
     let f = std::fs::File::open(path)
         .map_err(|e| Failure::Io(format!("cannot read {}: {e}", path.display())))?;
     let name = path.display().to_string();
     let mut reader = TelemetryReader::new(f, &name, options).map_err(telemetry_failure)?;
-    let (mut samples, mut lines) = (Vec::new(), Vec::new());
+    let (mut samples, mut lines, mut speeds) = (Vec::new(), Vec::new(), Vec::new());
     while let Some(item) = reader.next() {
-        samples.push(item.map_err(telemetry_failure)?);
+        let mut s = item.map_err(telemetry_failure)?;
+        if let Some((sc, _)) = &spacecraft {
+            // The rotor momentum as the run computes it (for `.rho`; the run recomputes).
+            s.rho_nms = sc.momentum_nms(reader.last_speeds());
+            speeds.extend_from_slice(reader.last_speeds());
+        }
+        samples.push(s);
         lines.push(reader.last_line());
     }
     let st = reader.stats();
@@ -320,6 +384,11 @@ fn read(path: &std::path::Path, options: CsvOptions) -> Result<Telemetry, Failur
         stats: st,
         q_columns: reader.quaternion_columns(),
         label: reader.file().to_string(),
+        rotors: spacecraft.map(|(spacecraft, source)| Rotors {
+            spacecraft,
+            source,
+            speeds,
+        }),
     })
 }
 
@@ -422,7 +491,7 @@ fn estimate_arrays<'py>(
     let out = py
         .allow_threads(|| {
             let (samples, stats) = check_rows(&rows, &conv, &naming)?;
-            run::run(&samples, &stats, &origin, config, &s)
+            run::run(&samples, None, &stats, &origin, config, &s)
         })
         .map_err(|f| f.into_py(py))?;
     result(py, &out.report, out.history.as_deref())
@@ -454,13 +523,14 @@ fn samples_from_arrays<'py>(
         stats,
         q_columns: "q".into(),
         label: "<arrays>".into(),
+        rotors: None,
     })
 }
 
 /// Telemetry rebuilt from what a `Telemetry` held (unpickling): the values were
 /// checked when it was made, so they are taken as they are, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label))]
+#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label, rotors=None))]
 #[allow(clippy::too_many_arguments)]
 fn restore<'py>(
     t: PyReadonlyArrayDyn<'py, f64>,
@@ -473,8 +543,24 @@ fn restore<'py>(
     stats: (usize, usize, usize, f64, f64),
     q_columns: String,
     label: String,
+    rotors: Option<(String, String, PyReadonlyArrayDyn<'py, f64>)>,
 ) -> PyResult<Telemetry> {
     let rows = rows(&t, &q, &rho, Some(&tau), w.as_ref())?;
+    let rotors = rotors
+        .map(|(text, name, speeds)| -> PyResult<Rotors> {
+            let spacecraft = inertia::spacecraft::Spacecraft::parse(&text, &name)
+                .map_err(|e| value_error(e.to_string()))?;
+            let speeds: Vec<f64> = speeds.as_array().iter().copied().collect();
+            if speeds.len() != rows.len() * spacecraft.rotors.len() {
+                return Err(value_error("rotors: one speed per rotor and sample"));
+            }
+            Ok(Rotors {
+                spacecraft,
+                source: (text, name),
+                speeds,
+            })
+        })
+        .transpose()?;
     if lines.as_ref().is_some_and(|l| l.len() != rows.len()) {
         return Err(value_error("lines: one per sample"));
     }
@@ -503,6 +589,7 @@ fn restore<'py>(
         },
         q_columns,
         label,
+        rotors,
     })
 }
 

@@ -147,6 +147,7 @@ pub struct Output {
 /// Estimate from `samples` as `inertia estimate` does from a file: the library's [`Run`].
 pub fn run(
     samples: &[Sample],
+    rotors: Option<&crate::Rotors>,
     stats: &Stats,
     origin: &Origin,
     config: PipelineConfig,
@@ -168,8 +169,20 @@ pub fn run(
             h.push(*e);
         }
     };
-    for s in samples {
-        run.push(s, &mut keep).map_err(|e| origin.run_error(&e))?;
+    match rotors {
+        Some(r) => {
+            run = run.with_spacecraft(r.spacecraft.clone());
+            let m = r.spacecraft.rotors.len();
+            for (s, w) in samples.iter().zip(r.speeds.chunks_exact(m)) {
+                run.push_with_speeds(s, w, &mut keep)
+                    .map_err(|e| origin.run_error(&e))?;
+            }
+        }
+        None => {
+            for s in samples {
+                run.push(s, &mut keep).map_err(|e| origin.run_error(&e))?;
+            }
+        }
     }
     run.finish(&mut keep).map_err(|e| origin.run_error(&e))?;
     let report = run

@@ -258,6 +258,7 @@ pub fn simulate<'py>(
                     stats: checker.stats(),
                     q_columns: "q".into(),
                     label: "<simulated>".into(),
+                    rotors: None,
                 },
                 out.inertia_at(t_end),
                 out.inertia_kg_m2,

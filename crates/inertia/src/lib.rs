@@ -104,6 +104,8 @@ pub mod sample;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod solver;
+#[cfg(feature = "std")]
+pub mod spacecraft;
 pub mod telemetry;
 pub mod tensor;
 #[cfg(test)]

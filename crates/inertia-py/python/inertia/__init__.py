@@ -288,7 +288,7 @@ class Telemetry:
         return (
             _restore_telemetry,
             (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state,
-             self._native.q_columns, self._native.label),
+             self._native.q_columns, self._native.label, self._native.rotors_state()),
         )
 
 
@@ -307,6 +307,7 @@ def read_csv(
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
     period_tolerance: Optional[float] = None,
+    spacecraft: Union[None, str, "os.PathLike[str]"] = None,
 ) -> Telemetry:
     """Read a telemetry CSV file as ``inertia estimate`` reads it.
 
@@ -329,6 +330,10 @@ def read_csv(
         unit_tolerance: largest ``| |q| − 1 |`` renormalised (default 1e-3).
         period_tolerance: strict mode: a step differing from the first by more than
             this (relative) is an error.
+        spacecraft: a spacecraft file (TOML, ``--spacecraft``): the rotors' axes, spin
+            inertias ± σ and speed columns. ``rho`` is computed from the wheel speeds
+            (the file then has no ``rho_*`` columns), and the spin inertias' σ widen
+            the estimate's σ.
 
     Raises:
         DataError: the CLI's message, ``FILE:LINE: column …``; ``.line`` is the line.
@@ -346,6 +351,7 @@ def read_csv(
                 columns=None if columns is None else dict(columns),
                 unit_tolerance=unit_tolerance,
                 period_tolerance=period_tolerance,
+                spacecraft=None if spacecraft is None else os.fspath(spacecraft),
             ),
         )
     )
@@ -488,6 +494,7 @@ def estimate(
     columns: Optional[Mapping[str, str]] = None,
     unit_tolerance: Optional[float] = None,
     period_tolerance: Optional[float] = None,
+    spacecraft: Union[None, str, "os.PathLike[str]"] = None,
 ) -> Estimate:
     """Estimate the inertia tensor, as ``inertia estimate`` does.
 
@@ -549,7 +556,8 @@ def estimate(
 
     Input conventions (arrays, DataFrame, path): ``scalar_first``, ``jpl``,
     ``conjugate``, ``gyro_unit``, ``negate_rho``, ``unit_tolerance``,
-    ``period_tolerance``; ``columns`` for a DataFrame or a path.
+    ``period_tolerance``; ``columns`` for a DataFrame or a path; ``spacecraft`` (a
+    spacecraft file, :func:`read_csv`) for a path.
 
     The GIL is released while the data are checked and the estimator runs.
 
@@ -566,8 +574,12 @@ def estimate(
             raise TypeError(
                 "estimate(data): q, rho, tau and w are given only with arrays (t, q, rho)"
             )
+    if spacecraft is not None and not isinstance(t, (str, os.PathLike)):
+        raise TypeError(
+            "spacecraft: give it with a path, or to read_csv (the wheel speeds are read from the file)"
+        )
     if isinstance(t, (str, os.PathLike)):
-        telemetry = read_csv(t, columns=columns, **conventions)
+        telemetry = read_csv(t, columns=columns, spacecraft=spacecraft, **conventions)
         return Estimate._from_native(telemetry._native.estimate(kwargs=settings))
     if isinstance(t, Telemetry):
         if columns is not None:

@@ -94,6 +94,7 @@ def read_csv(
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
     period_tolerance: Optional[float] = ...,
+    spacecraft: Union[None, str, os.PathLike[str]] = ...,
 ) -> Telemetry: ...
 
 def estimate(
@@ -139,6 +140,7 @@ def estimate(
     columns: Optional[Mapping[str, str]] = ...,
     unit_tolerance: Optional[float] = ...,
     period_tolerance: Optional[float] = ...,
+    spacecraft: Union[None, str, os.PathLike[str]] = ...,
 ) -> Estimate: ...
 
 class Estimator:

@@ -15,6 +15,11 @@
 //!   degrees of freedom when the truth satisfies the constraints, exceeds
 //!   [`CONFLICT_CHI2`] → [`Unobservable::ConflictsWithConstraints`], reported as an answer
 //!   that leans on the constraint set ([`Observability::FromPrior`]), not on the data.
+//!   Where the user stated a relative σ `r` of the rotor momentum (the wheels' spin
+//!   inertia: [`crate::pipeline::PipelineSettings::rotor_scale_sigma`], a spacecraft
+//!   file's rotors), the unconstrained answer is itself uncertain by about `r ‖Ĵ‖_F` per
+//!   element beyond the noise, and the move is measured against both:
+//!   `χ² = Δᵀ (s²(RᵀR)⁻¹ + (r ‖Ĵ‖_F)² I)⁻¹ Δ`, `Δ = ĵ − j_ls`.
 
 // The crate-internal helpers here serve the std front ends (pipeline, estimators).
 #![cfg_attr(not(feature = "std"), allow(dead_code))]
@@ -34,11 +39,19 @@ pub(crate) fn audit(
     qr: &RecursiveQr,
     epsilon_kg_m2: f64,
     max_relative_sigma: f64,
+    stated_relative_sigma: f64,
 ) {
     let moments = e
         .j()
         .map(|j| crate::eigen3::symmetric_eigen3(&matrix_from_j(&j)).0);
-    audit_at(e, qr, epsilon_kg_m2, max_relative_sigma, moments.as_ref());
+    audit_at(
+        e,
+        qr,
+        epsilon_kg_m2,
+        max_relative_sigma,
+        stated_relative_sigma,
+        moments.as_ref(),
+    );
 }
 
 /// [`audit`] given the principal moments of `e`'s `J` (any order), for a caller that has
@@ -48,6 +61,7 @@ pub(crate) fn audit_at(
     qr: &RecursiveQr,
     epsilon_kg_m2: f64,
     max_relative_sigma: f64,
+    stated_relative_sigma: f64,
     moments: Option<&nalgebra::Vector3<f64>>,
 ) {
     if !matches!(
@@ -85,7 +99,20 @@ pub(crate) fn audit_at(
     {
         let s2 = qr.rss / dof;
         let gain = (qr.r * j - qr.z).norm_squared() - (qr.r * u - qr.z).norm_squared();
-        let chi2 = gain / s2;
+        let chi2 = if stated_relative_sigma > 0.0 {
+            // Δᵀ (s²(RᵀR)⁻¹ + c² I)⁻¹ Δ; the noise-only χ² where that cannot be formed.
+            let c = stated_relative_sigma * m.norm();
+            (qr.r.transpose() * qr.r)
+                .try_inverse()
+                .map(|p| p * s2 + nalgebra::Matrix6::identity() * (c * c))
+                .and_then(nalgebra::Matrix6::try_inverse)
+                .map_or(gain / s2, |w| {
+                    let d = j - u;
+                    (d.transpose() * w * d)[(0, 0)]
+                })
+        } else {
+            gain / s2
+        };
         if chi2 > CONFLICT_CHI2 {
             e.observability =
                 Observability::FromPrior(Unobservable::ConflictsWithConstraints { chi2 });

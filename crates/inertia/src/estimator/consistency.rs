@@ -276,7 +276,14 @@ impl ResidualSegments {
     /// after it is never inconsistent: the ratio alone does not tell a failed model from
     /// honest residuals of unequal size (module docs).
     #[must_use]
-    pub(crate) fn inconsistent(&self, j: &InertiaVector) -> Option<Worst> {
+    ///
+    /// `stated` is the rotor momentum's relative σ the user stated (the wheels' spin
+    /// inertia): a wheel whose inertia is off by that much leaves residuals where it
+    /// spins and moves the answer by up to about `stated ‖Ĵ‖_F`, which σ then covers
+    /// ([`crate::estimator::rotor_inertia`]), so each element's reference σ is widened by
+    /// it here: a span is inconsistent only if it moved the answer beyond what the
+    /// stated uncertainties allow.
+    pub(crate) fn inconsistent(&self, j: &InertiaVector, stated: f64) -> Option<Worst> {
         // No span beyond the ratio: nothing to compare (the common case, without a pass
         // over the spans at every solve).
         if !self.worst.is_some_and(|w| w.ratio > INCONSISTENT_RATIO) {
@@ -284,7 +291,10 @@ impl ResidualSegments {
         }
         self.spans()
             .filter(|s| s.worst.ratio > INCONSISTENT_RATIO)
-            .filter(|s| s.reference.is_some_and(|r| shift_z(j, &r) > SHIFT_Z))
+            .filter(|s| {
+                s.reference
+                    .is_some_and(|r| shift_z(j, &r, stated) > SHIFT_Z)
+            })
             .map(|s| s.worst)
             .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
     }
@@ -297,10 +307,11 @@ fn sum(segments: &[Segment]) -> (f64, f64) {
         .fold((0.0, 0.0), |(r, d), s| (r + s.rss, d + s.dof))
 }
 
-/// `max_k |j_k − r.j_k| / r.σ_k`.
-fn shift_z(j: &InertiaVector, r: &Snapshot) -> f64 {
+/// `max_k |j_k − r.j_k| / σ_k`, `σ_k = √(r.σ_k² + (stated ‖r.J‖_F)²)`.
+fn shift_z(j: &InertiaVector, r: &Snapshot, stated: f64) -> f64 {
+    let scale = stated * crate::tensor::matrix_from_j(&r.j).norm();
     (0..6)
-        .map(|k| (j[k] - r.j[k]).abs() / r.sigma[k])
+        .map(|k| (j[k] - r.j[k]).abs() / crate::math::sqrt(r.sigma[k] * r.sigma[k] + scale * scale))
         .filter(|z| !z.is_nan())
         .fold(0.0, f64::max)
 }
@@ -319,6 +330,7 @@ pub(crate) fn check(
     e: &mut Estimate,
     segments: Option<&ResidualSegments>,
     density_ratio: Option<f64>,
+    stated: f64,
 ) {
     if !matches!(
         e.observability,
@@ -327,7 +339,7 @@ pub(crate) fn check(
         return;
     }
     let Some(j) = e.j() else { return };
-    let why = if let Some(w) = segments.and_then(|r| r.inconsistent(&j)) {
+    let why = if let Some(w) = segments.and_then(|r| r.inconsistent(&j, stated)) {
         Unobservable::Inconsistent {
             ratio: w.ratio,
             t_start_s: w.t_start_s,
@@ -403,7 +415,7 @@ mod tests {
             let w = r.worst().unwrap();
             assert!(r.segments() >= MAX_SEGMENTS / 2 && r.segments() <= MAX_SEGMENTS);
             assert!(w.ratio < 1.5, "ratio {}", w.ratio);
-            assert!(r.inconsistent(&far).is_none());
+            assert!(r.inconsistent(&far, 0.0).is_none());
         }
     }
 
@@ -412,9 +424,9 @@ mod tests {
         // One residual of 1e7 s² at row 20,000 (t = 1999.9 s).
         let r = white(50_000, 1.0, Some((20_000, 1e7)));
         // Flagged when the answer moved beyond SHIFT_Z of its σ, not when it did not.
-        assert!(r.inconsistent(&InertiaVector::zeros()).is_none());
+        assert!(r.inconsistent(&InertiaVector::zeros(), 0.0).is_none());
         let w = r
-            .inconsistent(&InertiaVector::repeat(1.0))
+            .inconsistent(&InertiaVector::repeat(1.0), 0.0)
             .expect("flagged");
         assert!(w.t_start_s <= 1999.9 && 1999.9 <= w.t_end_s, "{w:?}");
         assert!(w.ratio > 3.0 * INCONSISTENT_RATIO);
@@ -429,7 +441,7 @@ mod tests {
             r.record(rss, k as f64 + 1.0, k as f64);
         }
         let w = r
-            .inconsistent(&InertiaVector::repeat(1.0))
+            .inconsistent(&InertiaVector::repeat(1.0), 0.0)
             .expect("flagged");
         assert!(
             w.ratio.is_infinite() && w.t_start_s <= 1000.0 && 1000.0 <= w.t_end_s,

@@ -26,10 +26,14 @@ pub mod momentum;
 pub mod momentum_rows;
 pub mod normal_equations;
 pub mod observability;
+#[cfg(feature = "std")]
+pub(crate) mod plain_fit;
 pub mod prior;
 pub mod qr;
 pub mod recursive;
 pub mod resample;
+#[cfg(feature = "std")]
+pub mod rotor_inertia;
 pub mod rows;
 pub mod shared_qr;
 pub mod svd_tracker;

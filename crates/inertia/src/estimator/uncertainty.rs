@@ -40,6 +40,9 @@ pub struct Uncertainty {
     /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m² (zero
     /// unless one was estimated, [`Uncertainty::with_time_tag`]).
     pub time_tag_kg_m2: [f64; 6],
+    /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
+    /// unless given, [`Uncertainty::with_rotor_inertia`]).
+    pub rotor_inertia_kg_m2: [f64; 6],
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
     pub principal_sigma_kg_m2: [f64; 3],
@@ -78,6 +81,20 @@ impl Uncertainty {
             sigma_kg_m2: widened.sigma_kg_m2,
             principal_sigma_kg_m2: widened.principal_sigma_kg_m2,
             time_tag_kg_m2: *c,
+            ..*self
+        }
+    }
+
+    /// This σ widened by the rotors' spin-inertia consider term `c` per element, kg m²
+    /// ([`crate::estimator::rotor_inertia`]): `√(σ² + c²)`, propagated to the principal
+    /// moments of `j` as [`with_bias`] does.
+    #[must_use]
+    pub fn with_rotor_inertia(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
+        let widened = with_bias(&self.sigma_kg_m2, c, j);
+        Uncertainty {
+            sigma_kg_m2: widened.sigma_kg_m2,
+            principal_sigma_kg_m2: widened.principal_sigma_kg_m2,
+            rotor_inertia_kg_m2: *c,
             ..*self
         }
     }
@@ -169,6 +186,7 @@ pub fn with_bias_at(
         bias_kg_m2: bias,
         rotor_scale_kg_m2: [0.0; 6],
         time_tag_kg_m2: [0.0; 6],
+        rotor_inertia_kg_m2: [0.0; 6],
         principal_sigma_kg_m2: principal,
     }
 }

@@ -110,6 +110,9 @@ pub struct Report {
     /// σ, whether estimated, and its consider part of `sigma` per element, kg m²;
     /// `null` without one.
     pub wheel_delay: Option<WheelDelayEntry>,
+    /// The spacecraft file's rotors and their spin-inertia consider term
+    /// ([`crate::estimator::rotor_inertia`]); `null` without rotors with a σ.
+    pub rotor_inertia: Option<RotorInertiaEntry>,
     /// Principal moments, ascending, kg m².
     pub principal_moments: Option<[f64; 3]>,
     /// Their standard deviations, kg m².
@@ -162,6 +165,8 @@ pub struct Report {
     #[serde(skip)]
     held_speeds: Option<(usize, f64)>,
     #[serde(skip)]
+    rotor_inertia_error: Option<(crate::estimator::rotor_inertia::RotorInertiaError, f64)>,
+    #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
     physical: Option<PhysicalMargin>,
@@ -189,6 +194,25 @@ pub enum Warning {
     /// The wheel speeds change only every this many samples (held between updates of this
     /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]).
     HeldWheelSpeeds(usize, f64),
+    /// The rotors' consider term could not be computed: σ was widened as if every rotor
+    /// shared the largest relative σ (this, relative).
+    RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
+}
+
+/// The rotors' spin-inertia consider term as the report carries it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RotorInertiaEntry {
+    /// The rotors' names, in the spacecraft file's order.
+    pub rotors: std::vec::Vec<String>,
+    /// Each rotor's relative σ of its spin inertia.
+    pub relative_sigma: std::vec::Vec<f64>,
+    /// How their errors are related (`shared` or `independent`).
+    pub errors: crate::spacecraft::RotorErrors,
+    /// The answer's move for each independent 1σ error source, kg m²: one for shared
+    /// errors, one per rotor for independent ones.
+    pub moves_kg_m2: std::vec::Vec<[f64; 6]>,
+    /// Its consider part of σ per element, kg m².
+    pub sigma_kg_m2: [f64; 6],
 }
 
 /// The wheel-speed time tag as the report carries it.
@@ -224,6 +248,7 @@ impl Warning {
             Warning::Excitation(_) => "excitation",
             Warning::WheelDelayNotEstimated(_) => "wheel_delay_not_estimated",
             Warning::HeldWheelSpeeds(..) => "held_wheel_speeds",
+            Warning::RotorInertiaNotComputed(..) => "rotor_inertia_not_computed",
         }
     }
 }
@@ -277,6 +302,11 @@ impl fmt::Display for Warning {
                  biases J; the wheel-speed time tag (wheel_delay: estimate) corrects it",
                 Num(*period_s),
                 Num(0.5 * period_s * (*every as f64 - 1.0) / *every as f64)
+            ),
+            Warning::RotorInertiaNotComputed(e, r) => write!(
+                f,
+                "{e}; σ is widened as if every rotor's spin inertia shared the largest relative σ, {}",
+                Num(*r)
             ),
         }
     }
@@ -353,6 +383,8 @@ impl Report {
             wheel_delay: None,
             wheel_delay_error: None,
             held_speeds: None,
+            rotor_inertia: None,
+            rotor_inertia_error: None,
             observability: estimate.observability,
             physical: super::status::physical_margin(estimate),
             attitude: None,
@@ -389,6 +421,9 @@ impl Report {
         if let Some((every, period_s)) = self.held_speeds {
             w.push(Warning::HeldWheelSpeeds(every, period_s));
         }
+        if let Some((e, r)) = self.rotor_inertia_error {
+            w.push(Warning::RotorInertiaNotComputed(e, r));
+        }
         w
     }
 
@@ -424,6 +459,45 @@ impl Report {
             }
             Some(Err(e)) => self.wheel_delay_error = Some(*e),
             None => {}
+        }
+        self.refreshed()
+    }
+
+    /// With the rotors' spin-inertia consider term the run computed (`spacecraft`'s
+    /// rotors), or why it could not be.
+    #[must_use]
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_rotor_inertia(
+        mut self,
+        spacecraft: Option<&crate::spacecraft::Spacecraft>,
+        consider: Option<
+            &Result<
+                crate::estimator::rotor_inertia::RotorInertiaConsider,
+                crate::estimator::rotor_inertia::RotorInertiaError,
+            >,
+        >,
+    ) -> Self {
+        let (Some(sc), Some(c)) = (spacecraft, consider) else {
+            return self;
+        };
+        match c {
+            Ok(c) => {
+                self.rotor_inertia = Some(RotorInertiaEntry {
+                    rotors: sc.rotors.iter().map(|r| r.name.clone()).collect(),
+                    relative_sigma: c.relative_sigma.clone(),
+                    errors: c.errors,
+                    moves_kg_m2: c.moves_kg_m2.clone(),
+                    sigma_kg_m2: c.consider_kg_m2(),
+                });
+            }
+            Err(e) => {
+                let r = sc
+                    .rotors
+                    .iter()
+                    .map(crate::spacecraft::Rotor::relative_sigma)
+                    .fold(0.0, f64::max);
+                self.rotor_inertia_error = Some((*e, r));
+            }
         }
         self.refreshed()
     }

@@ -18,174 +18,23 @@
 //! * The messages describe the fix in words; [`RunError::fixes`] carries it typed, for each
 //!   front end to name in its own vocabulary ([`crate::fix`]).
 
-use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError, MAX_RESAMPLE_FACTOR};
-use crate::error_kind::ErrorKind;
+mod error;
+
+pub use error::{RunError, RunErrorKind};
+
+use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError};
+use crate::estimator::rotor_inertia::{self, RotorInertiaConsider, RotorInertiaError};
 use crate::estimator::wheel_delay::{self, DelayError, DelayFit, WheelDelay};
 use crate::estimator::Estimate;
-use crate::fix::Fix;
 use crate::sample::Sample;
-use crate::telemetry::gate::{Order, SampleError};
+use crate::spacecraft::Spacecraft;
+use crate::telemetry::gate::{Field, Order, SampleError};
 use crate::telemetry::held_speeds::HeldSpeeds;
-use crate::text::Num;
 use std::collections::VecDeque;
 use std::vec::Vec;
 
 /// How many recent samples a run keeps to find the sample that ends a step.
 pub const RECENT: usize = 8;
-
-/// Why a run cannot go on, and at which input sample.
-///
-/// Its message names no place (a front end puts its file line or array row first) and no
-/// front end's option ([`Self::fixes`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunError {
-    /// 0-based index of the input sample at fault (`None`: the whole input).
-    pub sample: Option<usize>,
-    /// What is wrong.
-    pub kind: RunErrorKind,
-}
-
-/// What is wrong with a run's input or settings.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum RunErrorKind {
-    /// The estimator needs gyro rates and the input has none.
-    #[error("the {estimator} estimator needs gyro rates (w_x,w_y,w_z)")]
-    NeedsGyro {
-        /// The estimator.
-        estimator: &'static str,
-    },
-    /// A sample the sample gate refuses ([`crate::telemetry::gate::Order`]): time not
-    /// increasing, gyro rates given for some samples and not for others.
-    #[error(transparent)]
-    Sample(SampleError),
-    /// A memory shorter than the sample period forgets each sample before the next.
-    #[error("the memory {} s is shorter than the sample period {} s; the memory must span several samples", Num(*.memory_s), Num(*.step_s))]
-    MemoryShorterThanStep {
-        /// The memory time constant, s.
-        memory_s: f64,
-        /// The sample period (the resampling period where resampling), s.
-        step_s: f64,
-    },
-    /// The input ended before the estimator could make one estimate.
-    #[error("too few samples for an estimate: the {estimator} estimator needs at least {need}, got {got}{}", resampled(*.got, *.read))]
-    TooFewSamples {
-        /// The estimator.
-        estimator: &'static str,
-        /// Its minimum ([`super::Capabilities::min_samples`]).
-        need: usize,
-        /// Samples it saw (after resampling).
-        got: usize,
-        /// Input samples read.
-        read: usize,
-    },
-    /// An earlier error stopped the run.
-    #[error("the run stopped on an earlier error ({0}); start a new one")]
-    Stopped(std::string::String),
-    /// The pipeline or the estimator stopped.
-    #[error(transparent)]
-    Pipeline(PipelineError),
-}
-
-fn resampled(got: usize, read: usize) -> std::string::String {
-    if got == read {
-        std::string::String::new()
-    } else {
-        std::format!(" ({read} read, {got} on the resampling grid)")
-    }
-}
-
-impl core::fmt::Display for RunError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        use crate::estimator::EstimatorError;
-        match &self.kind {
-            // The place is the front end's to name: not the pipeline's "input sample i: ".
-            RunErrorKind::Pipeline(PipelineError::Estimator { source, .. }) => match source {
-                EstimatorError::Solve(s) => write!(f, "the solver failed on these data: {s}"),
-                other => write!(f, "{other}"),
-            },
-            RunErrorKind::Pipeline(PipelineError::ReversedMomentum {
-                tau_given,
-                quaternions,
-                ..
-            }) => write!(
-                f,
-                "{}",
-                super::checks::ReversedMessage {
-                    sample: &None,
-                    tau_given,
-                    quaternions,
-                }
-            ),
-            RunErrorKind::Pipeline(PipelineError::OutOfRange { source, .. }) => {
-                write!(f, "{source}")
-            }
-            RunErrorKind::Pipeline(PipelineError::ResampleTooFine {
-                step_s, period_s, ..
-            }) => write!(
-                f,
-                "resampling to {} s would make {} samples of the step of {} s (at most {})",
-                Num(*period_s),
-                Num((*step_s / *period_s).round()),
-                Num(*step_s),
-                Num(MAX_RESAMPLE_FACTOR)
-            ),
-            other => write!(f, "{other}"),
-        }
-    }
-}
-
-impl std::error::Error for RunError {}
-
-impl RunError {
-    /// Whether a step of the attitude was too large for the rows (`|φ| ≥ 1`): a front end
-    /// names its quaternion columns.
-    #[must_use]
-    pub fn is_step_too_large(&self) -> bool {
-        self.pipeline()
-            .and_then(PipelineError::step_end_s)
-            .is_some()
-    }
-
-    fn at(sample: usize, kind: RunErrorKind) -> Self {
-        Self {
-            sample: Some(sample),
-            kind,
-        }
-    }
-
-    /// The settings its message recommends changing ([`crate::fix`]).
-    #[must_use]
-    pub fn fixes(&self) -> &'static [Fix] {
-        match &self.kind {
-            RunErrorKind::MemoryShorterThanStep { .. } => &[Fix::Memory],
-            RunErrorKind::Pipeline(e) => e.fixes(),
-            _ => &[],
-        }
-    }
-
-    /// Its kind, as every front end reports it.
-    #[must_use]
-    pub fn error_kind(&self) -> ErrorKind {
-        match &self.kind {
-            RunErrorKind::NeedsGyro { .. } => ErrorKind::NeedsGyro,
-            RunErrorKind::Sample(e) => e.error_kind(),
-            RunErrorKind::MemoryShorterThanStep { .. } => ErrorKind::MemoryShorterThanStep,
-            RunErrorKind::TooFewSamples { .. } => ErrorKind::TooFewSamples,
-            RunErrorKind::Stopped(_) => ErrorKind::Stopped,
-            RunErrorKind::Pipeline(e) => e.error_kind(),
-        }
-    }
-
-    /// The pipeline's error, where the pipeline or the estimator stopped.
-    #[must_use]
-    pub(crate) fn pipeline(&self) -> Option<&PipelineError> {
-        match &self.kind {
-            RunErrorKind::Pipeline(e) => Some(e),
-            _ => None,
-        }
-    }
-}
 
 /// A setting that the first step `dt` (s) of the data shows to be meaningless: a memory
 /// shorter than the sample period (`resample_s` where resampling, else `dt`). Resampling
@@ -247,6 +96,13 @@ pub struct Run {
     delay: Option<Result<DelayFit, DelayError>>,
     /// Whether the wheel speeds look held between updates ([`HeldSpeeds`]).
     speeds: HeldSpeeds,
+    /// The spacecraft file's rotors, whose speeds give each sample's rotor momentum.
+    rotors: Option<Spacecraft>,
+    /// Their stored speeds, one per rotor and sample (kept only where a rotor's spin
+    /// inertia has a σ, for its consider term at [`Self::finish`]).
+    rotor_speeds: Vec<f64>,
+    /// The rotors' consider term, once computed, or why it could not be.
+    rotor_consider: Option<Result<RotorInertiaConsider, RotorInertiaError>>,
 }
 
 impl core::fmt::Debug for Run {
@@ -285,7 +141,93 @@ impl Run {
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
             delay: None,
             speeds: HeldSpeeds::default(),
+            rotors: None,
+            rotor_speeds: Vec::new(),
+            rotor_consider: None,
         })
+    }
+
+    /// This run with a spacecraft file's rotors ([`crate::spacecraft`]): every sample's
+    /// rotor momentum is computed from its rotors' speeds ([`Self::push_with_speeds`]),
+    /// and where a rotor's spin inertia has a σ the run keeps the samples until
+    /// [`Self::finish`], which measures their consider term by running the estimator once
+    /// more per such rotor, plus once ([`crate::estimator::rotor_inertia`]), and widens
+    /// σ by it.
+    #[must_use]
+    pub fn with_spacecraft(mut self, spacecraft: Spacecraft) -> Self {
+        if spacecraft.has_inertia_sigma() && matches!(self.mode, Mode::Streaming(_)) {
+            self.held.get_or_insert_with(Vec::new);
+        }
+        self.config.rotor_inertia_relative_sigma = crate::math::sqrt(
+            spacecraft
+                .rotors
+                .iter()
+                .map(|r| r.relative_sigma() * r.relative_sigma())
+                .sum(),
+        );
+        self.rotors = Some(spacecraft);
+        self
+    }
+
+    /// [`Self::push`] for a run with a spacecraft file's rotors: `speeds` are the sample's
+    /// rotor speeds in the file's order and stored units, and the sample's `rho_nms` is
+    /// replaced by the momentum they give. Without rotors, `speeds` must be empty.
+    pub fn push_with_speeds(
+        &mut self,
+        s: &Sample,
+        speeds: &[f64],
+        on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), RunError> {
+        let index = self.input;
+        let expected = self.rotors.as_ref().map_or(0, |r| r.rotors.len());
+        if speeds.len() != expected {
+            let names = self
+                .rotors
+                .as_ref()
+                .map_or_else(std::string::String::new, |r| {
+                    r.rotors
+                        .iter()
+                        .map(|x| x.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                });
+            return Err(RunError::at(
+                index,
+                RunErrorKind::RotorSpeeds {
+                    expected,
+                    got: speeds.len(),
+                    names,
+                },
+            ));
+        }
+        let Some(rotors) = &self.rotors else {
+            return self.push_sample(s, on_estimate);
+        };
+        let mut sample = *s;
+        sample.rho_nms = rotors.momentum_nms(speeds);
+        if let Err(e) = crate::sample::check_range(&sample) {
+            let (limit, unit) = e.quantity.limit();
+            let field = match e.quantity {
+                crate::sample::Quantity::Rho(i) => Field::Rho(i),
+                _ => Field::Time,
+            };
+            return Err(RunError::at(
+                index,
+                RunErrorKind::Sample(SampleError::OutOfRange {
+                    field,
+                    value: e.value,
+                    limit,
+                    unit,
+                }),
+            ));
+        }
+        let keep = rotors.has_inertia_sigma();
+        let before = self.input;
+        let r = self.push_sample(&sample, on_estimate);
+        if keep && self.input > before {
+            self.rotor_speeds.extend_from_slice(speeds);
+        }
+        r
     }
 
     /// Where the input's columns are known before its samples (a file's header): refuse
@@ -306,7 +248,19 @@ impl Run {
     /// Feed input sample [`Self::input_samples`]; `on_estimate` receives every estimate it
     /// produced, in time order (none in batch mode, nor while the run holds the samples
     /// for a wheel-speed time tag, before [`Self::finish`], which then gives them all).
+    /// With a spacecraft file's rotors, [`Self::push_with_speeds`] it is.
     pub fn push(&mut self, s: &Sample, on_estimate: impl FnMut(&Estimate)) -> Result<(), RunError> {
+        if self.rotors.is_some() {
+            return self.push_with_speeds(s, &[], on_estimate);
+        }
+        self.push_sample(s, on_estimate)
+    }
+
+    fn push_sample(
+        &mut self,
+        s: &Sample,
+        on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), RunError> {
         let index = self.input;
         if let Some(m) = &self.stopped {
             return Err(RunError::at(index, RunErrorKind::Stopped(m.clone())));
@@ -397,6 +351,7 @@ impl Run {
         };
         if let Some(mut held) = self.held.take() {
             self.apply_delay(&mut held);
+            self.apply_rotor_consider(&held);
             let Mode::Streaming(p) = &mut self.mode else {
                 unreachable!("only a streaming run holds its samples")
             };
@@ -422,6 +377,12 @@ impl Run {
                 if let Mode::Batch { samples, .. } = &mut self.mode {
                     *samples = taken;
                 }
+            }
+        }
+        if let Mode::Batch { samples, out: None } = &self.mode {
+            if self.rotor_consider.is_none() {
+                let taken = samples.clone();
+                self.apply_rotor_consider(&taken);
             }
         }
         match &mut self.mode {
@@ -472,6 +433,64 @@ impl Run {
             self.config.wheel_delay_consider = Some(f.consider_kg_m2());
         }
         self.delay = Some(fit);
+    }
+
+    /// Compute the rotors' consider term from the run's `samples` (where a spacecraft file's
+    /// rotor has a spin-inertia σ) and put it into the configuration ([`super::status`]).
+    /// Where it cannot be computed, σ is widened as if every rotor shared the largest
+    /// relative σ (the common scale's term, [`super::status`]), and the reason kept
+    /// ([`Self::rotor_inertia`]).
+    fn apply_rotor_consider(&mut self, samples: &[Sample]) {
+        let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
+            return;
+        };
+        if self.rotor_consider.is_some() {
+            return;
+        }
+        let delay_s = match &self.delay {
+            Some(Ok(d)) => d.delay_s,
+            _ => 0.0,
+        };
+        let config = self.config.with_delay_applied();
+        let batch_mode = matches!(self.mode, Mode::Batch { .. });
+        let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
+            if batch_mode {
+                return batch(s, &config).ok()?.estimate.j();
+            }
+            let mut p = Pipeline::from_config(config).ok()?;
+            for x in s {
+                p.push_each(x, |_| {}).ok()?;
+            }
+            p.last()?.j()
+        };
+        let c = rotor_inertia::consider(samples, &self.rotor_speeds, sc, delay_s, solve);
+        match &c {
+            Ok(c) => self.config.rotor_inertia_consider = Some(c.consider_kg_m2()),
+            Err(_) => {
+                let r = sc
+                    .rotors
+                    .iter()
+                    .map(crate::spacecraft::Rotor::relative_sigma)
+                    .fold(0.0, f64::max);
+                let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
+                self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
+            }
+        }
+        self.rotor_consider = Some(c);
+        self.rotor_speeds = Vec::new();
+    }
+
+    /// The rotors' spin-inertia consider term (`None` without a spacecraft file whose
+    /// rotors have a σ, or before [`Self::finish`]), or why it could not be computed.
+    #[must_use]
+    pub fn rotor_inertia(&self) -> Option<&Result<RotorInertiaConsider, RotorInertiaError>> {
+        self.rotor_consider.as_ref()
+    }
+
+    /// The spacecraft file's rotors, if the run has them.
+    #[must_use]
+    pub fn spacecraft(&self) -> Option<&Spacecraft> {
+        self.rotors.as_ref()
     }
 
     /// The wheel-speed time tag applied (`None` without one asked, or before
@@ -554,6 +573,7 @@ impl Run {
         Some(
             report
                 .with_wheel_delay(self.delay.as_ref())
+                .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
                 .with_held_speeds(
                     self.held_speeds_period_samples()
                         .map(|p| (p, p as f64 * self.sample_period_s())),

@@ -62,6 +62,8 @@ pub struct Constrained<S: RowSource, B: Backend> {
     residuals: Option<ResidualSegments>,
     observability: crate::estimator::observability::ObservabilitySettings,
     epsilon_kg_m2: f64,
+    /// The rotor momentum's stated relative σ ([`PipelineConfig::stated_relative_sigma`]).
+    stated_relative_sigma: f64,
 }
 
 impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
@@ -100,6 +102,7 @@ impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
             residuals: residual_test.then(ResidualSegments::new),
             observability: settings.observability,
             epsilon_kg_m2: constraints.set().epsilon_kg_m2,
+            stated_relative_sigma: 0.0,
         })
     }
 }
@@ -130,6 +133,7 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
             self.main.solved(),
             self.epsilon_kg_m2,
             self.observability.max_relative_sigma,
+            self.stated_relative_sigma,
         );
         // The density test is the discrete momentum estimator's: the paper's rows share
         // their noise between neighbours, and their residual variance came out at 0.46 of
@@ -138,7 +142,12 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
         if let (Some(r), Some(j), Some(sigma)) = (self.residuals.as_mut(), e.j(), e.sigma_kg_m2()) {
             r.note(&j, &sigma);
         }
-        consistency::check(&mut e, self.residuals.as_ref(), None);
+        consistency::check(
+            &mut e,
+            self.residuals.as_ref(),
+            None,
+            self.stated_relative_sigma,
+        );
         Ok(Some(e))
     }
 
@@ -167,7 +176,7 @@ fn settings(c: &PipelineConfig) -> RecursiveSettings {
 fn build<S: RowSource + Default + Send + 'static>(
     c: &PipelineConfig,
 ) -> Result<Box<dyn Estimator>, PipelineError> {
-    let adapter = Constrained::<S, Box<dyn Backend + Send>>::new(
+    let mut adapter = Constrained::<S, Box<dyn Backend + Send>>::new(
         c.constraints,
         settings(c),
         c.uncertainty,
@@ -178,6 +187,7 @@ fn build<S: RowSource + Default + Send + 'static>(
         sample: None,
         source,
     })?;
+    adapter.stated_relative_sigma = c.stated_relative_sigma();
     Ok(Box::new(adapter))
 }
 
@@ -227,6 +237,7 @@ fn run_batch<S: RowSource + Default>(
         &crate::estimator::prior::augment(&qr, &c.constraints).0,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
+        c.stated_relative_sigma(),
     );
     Ok(BatchOutput {
         gyro_density_ratio: None,

@@ -146,6 +146,11 @@ pub struct PipelineConfig {
     pub(crate) wheel_delay: WheelDelay,
     /// The time tag's consider term per element, kg m², once a run has applied it.
     pub(crate) wheel_delay_consider: Option<[f64; 6]>,
+    /// The rotors' spin-inertia consider term per element, kg m², once a run with a
+    /// spacecraft file has computed it ([`crate::estimator::rotor_inertia`]).
+    pub(crate) rotor_inertia_consider: Option<[f64; 6]>,
+    /// `√Σ_i s_i²` of a spacecraft file's rotors' relative spin-inertia σ (0 without).
+    pub(crate) rotor_inertia_relative_sigma: f64,
 }
 
 fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
@@ -328,6 +333,8 @@ impl PipelineSettings {
             glitches: self.glitches,
             wheel_delay: self.wheel_delay,
             wheel_delay_consider: None,
+            rotor_inertia_consider: None,
+            rotor_inertia_relative_sigma: 0.0,
         })
     }
 }
@@ -353,6 +360,18 @@ impl PipelineConfig {
     pub(crate) fn with_delay_applied(mut self) -> Self {
         self.wheel_delay = WheelDelay::Off;
         self
+    }
+
+    /// The relative σ of the rotor momentum the user stated: the common scale's
+    /// ([`PipelineSettings::rotor_scale_sigma`]) and a spacecraft file's rotors'
+    /// (`√Σ_i (σ_i/J_i)²`), in quadrature; 0 without either. The residual-span test widens
+    /// its reference σ by it ([`crate::estimator::consistency`]).
+    #[must_use]
+    pub(crate) fn stated_relative_sigma(&self) -> f64 {
+        let r = self.rotor_scale_sigma.unwrap_or(0.0);
+        crate::math::sqrt(
+            r * r + self.rotor_inertia_relative_sigma * self.rotor_inertia_relative_sigma,
+        )
     }
 
     /// The estimator's registry entry.

@@ -30,7 +30,9 @@
 //!   above are applied, and a determined answer whose widened relative σ
 //!   (`σ_F/‖Ĵ‖_F`) exceeds the observability threshold `max_relative_sigma` is not
 //!   determined ([`Unobservable::Uncertain`]): the data cannot give J's scale better than
-//!   the wheels'.
+//!   the wheels'. A spacecraft file's per-rotor spin inertia ± σ is the same kind of
+//!   term, per rotor ([`crate::estimator::rotor_inertia`]); so is the wheel-speed time
+//!   tag's σ ([`crate::estimator::wheel_delay`]).
 
 use super::PipelineConfig;
 use crate::constraints::Consistency;
@@ -106,12 +108,16 @@ pub(crate) fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 
 /// Apply every rule ([module docs](self)) to `e`, an answer of a run with `config`: the
 /// wheel-speed time tag's consider term where one was applied
-/// ([`crate::estimator::wheel_delay`]), the rotor scale's where one is given
+/// ([`crate::estimator::wheel_delay`]), the rotors' spin-inertia term of a spacecraft file
+/// ([`crate::estimator::rotor_inertia`]), the rotor scale's where one is given
 /// ([`widen_for_rotor_scale`]), then [`settle`].
 pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     let threshold = config.observability.max_relative_sigma;
     if let Some(c) = config.wheel_delay_consider {
         widen(e, threshold, |u, j| u.with_time_tag(j, &c));
+    }
+    if let Some(c) = config.rotor_inertia_consider {
+        widen(e, threshold, |u, j| u.with_rotor_inertia(j, &c));
     }
     if let Some(r) = config.rotor_scale_sigma {
         widen_for_rotor_scale(e, r, threshold);

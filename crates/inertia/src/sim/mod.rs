@@ -37,6 +37,7 @@ pub mod gyro;
 pub mod mekf;
 pub mod presets;
 pub mod realism;
+pub mod rotors;
 pub mod run;
 pub mod scenario;
 pub mod sensors;

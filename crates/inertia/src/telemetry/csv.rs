@@ -44,13 +44,12 @@
 //! The reader is an iterator and holds one row at a time: memory does not grow with the
 //! file.
 
-use super::gate::{Field, Gate, GateOptions, RawSample, SampleError};
+use super::gate::{Field, Gate, GateOptions, RawSample};
 pub use super::gate::{GyroUnit, QuaternionFormat, ReadStats, DEFAULT_UNIT_TOLERANCE};
 use super::line_cap::{LineCap, LineTooLong};
 use super::time_stamp::{Clock, StampError};
-use crate::error_kind::ErrorKind;
 use crate::sample::Sample;
-use crate::text::{Clipped, Quoted};
+
 use std::collections::HashMap;
 use std::fs::File;
 use std::io::Read;
@@ -137,6 +136,12 @@ pub struct CsvOptions {
     pub negate_rho: bool,
     /// The unit of the `w_*` columns. Default rad/s.
     pub gyro_unit: GyroUnit,
+    /// Columns of the rotors' speeds (a spacecraft file's, [`crate::spacecraft`]), each
+    /// required and read as a finite number in its stored unit
+    /// ([`TelemetryReader::last_speeds`]; negated with [`Self::negate_rho`]). When given,
+    /// the rotor momentum comes from them (the run computes it) and the file must not also
+    /// have the `rho_*` columns. Default none.
+    pub speed_columns: Vec<String>,
 }
 
 impl Default for CsvOptions {
@@ -149,139 +154,20 @@ impl Default for CsvOptions {
             delimiter: b',',
             negate_rho: false,
             gyro_unit: GyroUnit::RadPerS,
+            speed_columns: Vec::new(),
         }
     }
 }
 
-/// What is wrong, where.
-#[derive(Debug, thiserror::Error)]
-pub enum TelemetryError {
-    /// The file could not be opened or read.
-    #[error("{file}: {source}")]
-    Io {
-        /// File name.
-        file: String,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// A line is longer than `MAX_LINE_BYTES` (1 MiB) (found before it is read whole).
-    #[error("{file}:{line}: line longer than {limit} bytes (no line break?)")]
-    LineTooLong {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// The limit, bytes.
-        limit: usize,
-    },
-    /// Two header columns have the same name.
-    #[error("{file}:1: column `{}` appears twice (columns {first} and {second})", Clipped::new(.column))]
-    DuplicateColumn {
-        /// File name.
-        file: String,
-        /// The name.
-        column: String,
-        /// Its first position (1-based).
-        first: usize,
-        /// Its second position (1-based).
-        second: usize,
-    },
-    /// The CSV structure is broken (e.g. a row with a different number of fields).
-    #[error("{file}:{line}: malformed CSV: {}", Clipped::with_limit(.message, 300))]
-    Malformed {
-        /// File name.
-        file: String,
-        /// Line (1-based).
-        line: u64,
-        /// The parser's message.
-        message: String,
-    },
-    /// A required column is absent from the header.
-    #[error("{file}:1: missing column `{}` (columns present: {})", Clipped::new(.column), Clipped::new(.present))]
-    MissingColumn {
-        /// File name.
-        file: String,
-        /// The column.
-        column: String,
-        /// The header's columns.
-        present: String,
-    },
-    /// A field is not a number (or, in the time column, not a time stamp).
-    #[error("{file}:{line}: column `{}`: cannot parse {} as a number{hint}", Clipped::new(.column), Quoted(.value))]
-    Parse {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// Column.
-        column: String,
-        /// The field.
-        value: String,
-        /// Extra explanation (may be empty).
-        hint: &'static str,
-    },
-    /// A value the sample gate refused ([`super::gate`]).
-    #[error("{file}:{line}: {} `{}`: {source}", noun(.source), Clipped::new(.column))]
-    Sample {
-        /// File name.
-        file: String,
-        /// Line.
-        line: u64,
-        /// The column (the quaternion's columns, comma-separated, for its norm).
-        column: String,
-        /// What is wrong.
-        source: SampleError,
-    },
-}
-
-/// `column`, or `columns` for the quaternion's norm.
-fn noun(e: &SampleError) -> &'static str {
-    if e.field() == Field::QuaternionNorm {
-        "columns"
-    } else {
-        "column"
-    }
-}
-
-impl TelemetryError {
-    /// The 1-based line of the problem, when it is tied to one.
-    #[must_use]
-    pub fn line(&self) -> Option<u64> {
-        match self {
-            TelemetryError::Io { .. } => None,
-            TelemetryError::MissingColumn { .. } | TelemetryError::DuplicateColumn { .. } => {
-                Some(1)
-            }
-            TelemetryError::LineTooLong { line, .. }
-            | TelemetryError::Malformed { line, .. }
-            | TelemetryError::Parse { line, .. }
-            | TelemetryError::Sample { line, .. } => Some(*line),
-        }
-    }
-
-    /// Its kind, as every front end reports it.
-    #[must_use]
-    pub fn error_kind(&self) -> ErrorKind {
-        match self {
-            TelemetryError::Io { .. } => ErrorKind::Io,
-            TelemetryError::DuplicateColumn { .. } | TelemetryError::MissingColumn { .. } => {
-                ErrorKind::Columns
-            }
-            TelemetryError::LineTooLong { .. }
-            | TelemetryError::Malformed { .. }
-            | TelemetryError::Parse { .. } => ErrorKind::Unparsable,
-            TelemetryError::Sample { source, .. } => source.error_kind(),
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct Indices {
     t: usize,
     q: [usize; 4],
-    rho: [usize; 3],
+    /// `None` where the rotor momentum comes from the rotors' speeds.
+    rho: Option<[usize; 3]>,
     tau: Option<[usize; 3]>,
     w: Option<[usize; 3]>,
+    speeds: Vec<usize>,
 }
 
 /// A streaming, validating CSV telemetry reader.
@@ -300,6 +186,9 @@ pub struct TelemetryReader<R: Read> {
     /// Converts ISO time stamps, counting leap seconds.
     clock: Clock,
     failed: bool,
+    /// The last row's rotor speeds, as stored (negated with `negate_rho`).
+    speeds: Vec<f64>,
+    negate_speeds: bool,
 }
 
 impl TelemetryReader<File> {
@@ -364,9 +253,24 @@ impl<R: Read> TelemetryReader<R> {
                 need(&c.q[2])?,
                 need(&c.q[3])?,
             ],
-            rho: [need(&c.rho[0])?, need(&c.rho[1])?, need(&c.rho[2])?],
+            rho: if options.speed_columns.is_empty() {
+                Some([need(&c.rho[0])?, need(&c.rho[1])?, need(&c.rho[2])?])
+            } else {
+                if let Some(present) = c.rho.iter().find(|n| find(n).is_some()) {
+                    return Err(TelemetryError::MomentumTwice {
+                        file: file.to_string(),
+                        column: present.clone(),
+                    });
+                }
+                None
+            },
             tau: optional3(&c.tau)?,
             w: optional3(&c.w)?,
+            speeds: options
+                .speed_columns
+                .iter()
+                .map(|n| need(n))
+                .collect::<Result<_, _>>()?,
         };
         let gate = Gate::new(GateOptions {
             quaternion: options.quaternion,
@@ -386,6 +290,8 @@ impl<R: Read> TelemetryReader<R> {
             clock: Clock::default(),
             failed: false,
             line: 0,
+            speeds: Vec::with_capacity(options.speed_columns.len()),
+            negate_speeds: options.negate_rho,
         })
     }
 
@@ -405,6 +311,13 @@ impl<R: Read> TelemetryReader<R> {
     #[must_use]
     pub fn has_torque(&self) -> bool {
         self.idx.tau.is_some()
+    }
+
+    /// The last row's rotor speeds ([`CsvOptions::speed_columns`], in their order and
+    /// stored units); empty without speed columns.
+    #[must_use]
+    pub fn last_speeds(&self) -> &[f64] {
+        &self.speeds
     }
 
     /// Bytes consumed so far (for progress reporting).
@@ -458,11 +371,42 @@ impl<R: Read> TelemetryReader<R> {
             Field::Time => self.idx.t,
             Field::Quaternion(k) => self.idx.q[k],
             Field::QuaternionNorm => return self.quaternion_columns(),
-            Field::Rho(k) => self.idx.rho[k],
+            Field::Rho(k) => match self.idx.rho {
+                Some(c) => c[k],
+                None => {
+                    return self
+                        .idx
+                        .speeds
+                        .iter()
+                        .map(|&i| self.headers[i].clone())
+                        .collect::<Vec<_>>()
+                        .join(",")
+                }
+            },
             Field::Tau(k) => self.idx.tau.map_or(self.idx.t, |c| c[k]),
             Field::Rate(k) => self.idx.w.map_or(self.idx.t, |c| c[k]),
         };
         self.headers[i].clone()
+    }
+
+    /// The rotors' speeds of this row into [`Self::speeds`]: finite numbers.
+    fn read_speeds(&mut self, line: u64) -> Result<(), TelemetryError> {
+        self.speeds.clear();
+        for k in 0..self.idx.speeds.len() {
+            let i = self.idx.speeds[k];
+            let v = self.field(line, i)?;
+            if !v.is_finite() {
+                return Err(TelemetryError::Parse {
+                    file: self.file.clone(),
+                    line,
+                    column: self.headers[i].clone(),
+                    value: self.record.get(i).unwrap_or("").trim().to_string(),
+                    hint: " (a rotor speed must be finite)",
+                });
+            }
+            self.speeds.push(if self.negate_speeds { -v } else { v });
+        }
+        Ok(())
     }
 
     /// The names of the quaternion columns, comma-separated (for messages).
@@ -531,11 +475,17 @@ impl<R: Read> TelemetryReader<R> {
                 self.field(line, self.idx.q[2])?,
                 self.field(line, self.idx.q[3])?,
             ],
-            rho_nms: [
-                self.field(line, self.idx.rho[0])?,
-                self.field(line, self.idx.rho[1])?,
-                self.field(line, self.idx.rho[2])?,
-            ],
+            rho_nms: match self.idx.rho {
+                Some(i) => [
+                    self.field(line, i[0])?,
+                    self.field(line, i[1])?,
+                    self.field(line, i[2])?,
+                ],
+                None => {
+                    self.read_speeds(line)?;
+                    [0.0; 3]
+                }
+            },
             tau_nm: match self.idx.tau {
                 Some(i) => Some([
                     self.field(line, i[0])?,
@@ -633,8 +583,11 @@ impl<R: Read> Iterator for TelemetryReader<R> {
     }
 }
 
+mod error;
 #[cfg(test)]
 mod tests;
 mod write;
 
-pub use write::{write_samples, write_samples_with};
+pub use error::TelemetryError;
+
+pub use write::{write_samples, write_samples_with, write_samples_with_speeds, ExtraColumns};

@@ -26,6 +26,8 @@ struct Item {
     sample: Result<Sample, TelemetryError>,
     line: u64,
     byte_position: u64,
+    /// The rotors' speeds ([`TelemetryReader::last_speeds`]; empty without them).
+    speeds: Vec<f64>,
 }
 
 /// A [`TelemetryReader`] running on its own thread ([module docs](self)).
@@ -35,6 +37,7 @@ pub struct ReadAhead {
     thread: Option<JoinHandle<ReadStats>>,
     last_line: u64,
     byte_position: u64,
+    speeds: Vec<f64>,
 }
 
 impl ReadAhead {
@@ -49,6 +52,7 @@ impl ReadAhead {
                     sample,
                     line: reader.last_line(),
                     byte_position: reader.byte_position(),
+                    speeds: reader.last_speeds().to_vec(),
                 });
                 if batch.len() == BATCH_SAMPLES {
                     let full = core::mem::replace(&mut batch, Vec::with_capacity(BATCH_SAMPLES));
@@ -69,6 +73,7 @@ impl ReadAhead {
             thread: Some(thread),
             last_line: 0,
             byte_position: 0,
+            speeds: Vec::new(),
         }
     }
 
@@ -76,6 +81,13 @@ impl ReadAhead {
     #[must_use]
     pub fn last_line(&self) -> u64 {
         self.last_line
+    }
+
+    /// The rotors' speeds of the last item returned, as
+    /// [`TelemetryReader::last_speeds`].
+    #[must_use]
+    pub fn last_speeds(&self) -> &[f64] {
+        &self.speeds
     }
 
     /// Bytes consumed up to the last item returned (for progress reporting).
@@ -105,6 +117,7 @@ impl Iterator for ReadAhead {
         let item = self.current.pop_front()?;
         self.last_line = item.line;
         self.byte_position = item.byte_position;
+        self.speeds = item.speeds;
         Some(item.sample)
     }
 }

@@ -20,6 +20,7 @@ mod lab_realism;
 mod numeric_range;
 mod pipeline;
 mod prior;
+mod rotor_inertia;
 mod rotor_scale;
 mod short_records;
 mod sim_realism;

@@ -78,13 +78,14 @@ pub(super) fn finish<V: Evidence>(
     let eig = e
         .j()
         .map_or(NO_EIGEN, |j| symmetric_eigen3(&matrix_from_j(&j)));
-    let (uncertainty, gyro, epsilon, max_relative_sigma) = {
+    let (uncertainty, gyro, epsilon, max_relative_sigma, stated) = {
         let c = evidence.config();
         (
             c.uncertainty,
             c.gyro_noise_rad_s_rthz,
             c.constraints.set().epsilon_kg_m2,
             c.observability.max_relative_sigma,
+            c.stated_relative_sigma(),
         )
     };
     if uncertainty {
@@ -101,6 +102,7 @@ pub(super) fn finish<V: Evidence>(
             evidence.solved(),
             epsilon,
             max_relative_sigma,
+            stated,
             Some(&eig.0),
         );
         return Ok(Finished::Reversed);
@@ -115,6 +117,7 @@ pub(super) fn finish<V: Evidence>(
         evidence.solved(),
         epsilon,
         max_relative_sigma,
+        stated,
         Some(&eig.0),
     );
     scale_from_prior(e, evidence.data(), &evidence.config().constraints);
@@ -122,7 +125,6 @@ pub(super) fn finish<V: Evidence>(
         (Some(g), Some(j)) => evidence.density_ratio(&j, g),
         _ => None,
     };
-    let residuals = evidence.residuals(e);
-    consistency::check(e, residuals, density_ratio);
+    consistency::check(e, evidence.residuals(e), density_ratio, stated);
     Ok(Finished::Checked { density_ratio })
 }

@@ -81,11 +81,18 @@ impl fmt::Display for ReportText<'_> {
             writeln!(s, "  [ {:>12.6} {:>12.6} {:>12.6} ]", r[0], r[1], r[2])?;
         }
         if let Some(sig) = r.sigma {
-            let parts = if r.rotor_scale_sigma_kg_m2.is_some() {
-                "noise, discretisation bias and the wheels' stated scale"
-            } else {
-                "noise and discretisation bias"
-            };
+            let mut parts = std::vec!["noise", "discretisation bias"];
+            if r.wheel_delay.is_some_and(|d| d.estimated) {
+                parts.push("the wheel speeds' time tag");
+            }
+            if r.rotor_inertia.is_some() {
+                parts.push("the rotors' spin inertia");
+            }
+            if r.rotor_scale_sigma_kg_m2.is_some() {
+                parts.push("the wheels' stated scale");
+            }
+            let last = parts.pop().unwrap_or_default();
+            let parts = format!("{} and {last}", parts.join(", "));
             writeln!(s, "elements, ± one standard deviation ({parts}) [kg m²]:")?;
             for (k, name) in COMPONENT_NAMES.iter().enumerate() {
                 match r.rotor_scale_sigma_kg_m2 {
@@ -172,6 +179,20 @@ impl fmt::Display for ReportText<'_> {
                 format!("given: {:.3e} s", d.delay_s)
             };
             writeln!(s, "wheel speeds read later than time-tagged by δ ({how})")?;
+        }
+        if let Some(ri) = &r.rotor_inertia {
+            let largest = ri.relative_sigma.iter().fold(0.0f64, |a, &b| a.max(b));
+            let errors = match ri.errors {
+                crate::spacecraft::RotorErrors::Shared => "shared",
+                crate::spacecraft::RotorErrors::Independent => "independent",
+            };
+            writeln!(
+                s,
+                "rotors' spin inertia ({} rotors, {errors} errors, up to {:.2} % each): its σ in each element's σ up to {:.1e} kg m²",
+                ri.rotors.len(),
+                100.0 * largest,
+                ri.sigma_kg_m2.iter().fold(0.0f64, |a, &b| a.max(b))
+            )?;
         }
         if let Some(t) = r.torque_bias_nm {
             let test = r

@@ -17,6 +17,42 @@ pub fn write_samples_with<W: std::io::Write, const N: usize>(
     names: [&str; N],
     extra: impl Fn(&Sample) -> [f64; N],
 ) -> std::io::Result<()> {
+    write_columns(out, samples, true, &names, |k| extra(&samples[k]).to_vec())
+}
+
+/// Extra columns: their names, and their values for a sample.
+pub type ExtraColumns<'a> = (&'a [&'a str], &'a dyn Fn(&Sample) -> Vec<f64>);
+
+/// [`write_samples_with`] for a spacecraft file's rotors: the rotors' speed columns
+/// `names` (valued `speeds`, one row of `names.len()` per sample, flat) instead of the
+/// `rho_*` columns, then the `extra` columns.
+pub fn write_samples_with_speeds<W: std::io::Write>(
+    out: W,
+    samples: &[Sample],
+    names: &[String],
+    speeds: &[f64],
+    extra: ExtraColumns<'_>,
+) -> std::io::Result<()> {
+    let m = names.len();
+    let all: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .chain(extra.0.iter().copied())
+        .collect();
+    write_columns(out, samples, false, &all, |k| {
+        let mut v = speeds[k * m..(k + 1) * m].to_vec();
+        v.extend((extra.1)(&samples[k]));
+        v
+    })
+}
+
+fn write_columns<W: std::io::Write>(
+    out: W,
+    samples: &[Sample],
+    with_rho: bool,
+    names: &[&str],
+    extra: impl Fn(usize) -> Vec<f64>,
+) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
     let with_rates = samples.iter().all(|s| s.omega_rad_s.is_some());
     let header = [
@@ -24,8 +60,16 @@ pub fn write_samples_with<W: std::io::Write, const N: usize>(
         "w_x", "w_y", "w_z",
     ];
     let n = if with_rates { 14 } else { 11 };
-    w.write_record(header[..n].iter().chain(&names))?;
-    for s in samples {
+    let keep = |i: &usize| with_rho || !(5..8).contains(i);
+    w.write_record(
+        header[..n]
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| keep(i))
+            .map(|x| *x.1)
+            .chain(names.iter().copied()),
+    )?;
+    for (k, s) in samples.iter().enumerate() {
         let rate = s.omega_rad_s.unwrap_or_default();
         let v = [
             s.t_s,
@@ -43,7 +87,15 @@ pub fn write_samples_with<W: std::io::Write, const N: usize>(
             rate.y,
             rate.z,
         ];
-        w.write_record(v[..n].iter().chain(&extra(s)).map(|x| format!("{x:?}")))?;
+        w.write_record(
+            v[..n]
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep(i))
+                .map(|x| x.1)
+                .chain(&extra(k))
+                .map(|x| format!("{x:?}")),
+        )?;
     }
     w.flush()
 }

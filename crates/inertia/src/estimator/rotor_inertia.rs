@@ -1,0 +1,167 @@
+//! The rotors' spin-inertia uncertainty as a consider parameter (issue #30, "What the user
+//! said"): how far `ĵ` moves for each independent 1σ error of the rotors' spin inertias,
+//! and the σ that this adds.
+//!
+//! A relative error `ε_i` of rotor `i`'s spin inertia scales its momentum `ρ_i` by
+//! `1 + ε_i`. The error sources are independent standard normal `z_v`, each moving some
+//! rotors' inertia by their σ (`s_i = σ_i/J_i`):
+//!
+//! * **shared** errors (the default): one source for every rotor, `ε_i = z s_i` (wheels of
+//!   one model whose catalogue value is off);
+//! * **independent** errors: one source per rotor with a σ, `ε_i = z_i s_i`.
+//!
+//! Each source's move `m_v = ĵ(z_v = 1) − ĵ` is measured on the estimator itself: the
+//! run's estimator (same settings, same samples, the run's wheel-speed time tag applied to
+//! each rotor's momentum as to the sum) is run once more with the momenta scaled by that
+//! 1σ error. It is a secant over one σ, so it includes what the estimator does (its
+//! stencil, chains, torque test, constraints). The consider term per element is
+//!
+//! ```text
+//! c_k = √(Σ_v m_v,k²)
+//! ```
+//!
+//! (one source: `|m_k|`, which with equal `s_i = r` and no known torque is `r |ĵ_k|`, the
+//! common scale's, [`super::uncertainty::Uncertainty::with_rotor_scale`]). Cost: one run of
+//! the estimator per source, plus one. What it leaves out: the curvature of `ĵ(z)` beyond
+//! one σ (`tests/integration/rotor_inertia.rs` measures the move over 0.1 σ against the one
+//! over 1σ).
+
+use crate::sample::Sample;
+use crate::spacecraft::{RotorErrors, Spacecraft};
+use crate::tensor::InertiaVector;
+use std::vec::Vec;
+
+/// What the rotors' spin-inertia uncertainty does to the answer.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct RotorInertiaConsider {
+    /// How the errors are related.
+    pub errors: RotorErrors,
+    /// Each rotor's relative σ `σ_i/J_i`, in the spacecraft file's order.
+    pub relative_sigma: Vec<f64>,
+    /// The answer's move `m_v` for each independent 1σ error source, kg m²: one for shared
+    /// errors; for independent ones, one per rotor in the file's order (zero for a rotor
+    /// without a σ).
+    pub moves_kg_m2: Vec<[f64; 6]>,
+}
+
+impl RotorInertiaConsider {
+    /// The consider term per element, `√(Σ_v m_v,k²)`, kg m² ([module docs](self)).
+    #[must_use]
+    pub fn consider_kg_m2(&self) -> [f64; 6] {
+        core::array::from_fn(|k| {
+            self.moves_kg_m2
+                .iter()
+                .map(|m| m[k] * m[k])
+                .sum::<f64>()
+                .sqrt()
+        })
+    }
+}
+
+/// Why the consider term could not be computed.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RotorInertiaError {
+    /// The estimator gave no answer on the data, or on the data with the rotors'
+    /// inertia changed.
+    #[error("the rotors' share of the answer cannot be computed: {0}")]
+    NotComputable(&'static str),
+}
+
+/// The moves of `spacecraft`'s 1σ error sources ([module docs](self)) from the run's
+/// `samples`, the rotors' stored speeds `speeds` (`samples.len()` rows of one value per
+/// rotor, flat) and the wheel-speed time tag `delay_s` the run applied; `solve` runs the
+/// estimator over samples and gives its final answer.
+pub fn consider(
+    samples: &[Sample],
+    speeds: &[f64],
+    spacecraft: &Spacecraft,
+    delay_s: f64,
+    mut solve: impl FnMut(&[Sample]) -> Option<InertiaVector>,
+) -> Result<RotorInertiaConsider, RotorInertiaError> {
+    let m = spacecraft.rotors.len();
+    if m == 0 || speeds.len() != samples.len() * m {
+        return Err(RotorInertiaError::NotComputable(
+            "one speed per rotor and sample is needed",
+        ));
+    }
+    let relative_sigma: Vec<f64> = spacecraft
+        .rotors
+        .iter()
+        .map(crate::spacecraft::Rotor::relative_sigma)
+        .collect();
+    // The sources: for each, the relative error of every rotor at z = 1.
+    let sources: Vec<Vec<f64>> = match spacecraft.rotor_errors {
+        RotorErrors::Shared => vec![relative_sigma.clone()],
+        RotorErrors::Independent => (0..m)
+            .map(|i| {
+                (0..m)
+                    .map(|j| if i == j { relative_sigma[i] } else { 0.0 })
+                    .collect()
+            })
+            .collect(),
+    };
+    let base = solve(samples).ok_or(RotorInertiaError::NotComputable(
+        "the estimator gave no answer",
+    ))?;
+    // Each rotor's momentum alone, read at the run's time tag (as the sum was).
+    let mut rotor: Vec<Sample> = samples.to_vec();
+    let mut scaled: Vec<Sample> = samples.to_vec();
+    let mut moves = Vec::with_capacity(sources.len());
+    for errors in &sources {
+        if errors.iter().all(|e| *e == 0.0) {
+            moves.push([0.0; 6]);
+            continue;
+        }
+        for (x, s) in scaled.iter_mut().zip(samples) {
+            x.rho_nms = s.rho_nms;
+        }
+        for (i, (r, &e)) in spacecraft.rotors.iter().zip(errors).enumerate() {
+            if e == 0.0 {
+                continue;
+            }
+            let per_unit = r.momentum_per_unit();
+            for (k, x) in rotor.iter_mut().enumerate() {
+                x.rho_nms = per_unit * speeds[k * m + i];
+            }
+            super::wheel_delay::shift_rho(&mut rotor, delay_s);
+            for (x, part) in scaled.iter_mut().zip(&rotor) {
+                x.rho_nms += part.rho_nms * e;
+            }
+        }
+        let j = solve(&scaled).ok_or(RotorInertiaError::NotComputable(
+            "the estimator gave no answer with the rotors' inertia changed",
+        ))?;
+        moves.push(core::array::from_fn(|k| j[k] - base[k]));
+    }
+    Ok(RotorInertiaConsider {
+        errors: spacecraft.rotor_errors,
+        relative_sigma,
+        moves_kg_m2: moves,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_moves_add_in_quadrature() {
+        let c = RotorInertiaConsider {
+            errors: RotorErrors::Independent,
+            relative_sigma: vec![0.1, 0.2],
+            moves_kg_m2: vec![
+                [0.1, -0.2, 0.0, 0.0, 0.0, 0.3],
+                [0.2, 0.4, 0.0, 0.0, 0.0, 0.8],
+            ],
+        };
+        let x = c.consider_kg_m2();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(
+            close(x[0], 0.05f64.sqrt()) && close(x[1], 0.2f64.sqrt()),
+            "{x:?}"
+        );
+        assert!(close(x[5], 0.73f64.sqrt()) && x[2] == 0.0, "{x:?}");
+    }
+}

@@ -1,0 +1,121 @@
+//! Per-rotor speed telemetry from the simulated rotor momentum, for a spacecraft file's
+//! rotors ([`crate::spacecraft`]).
+//!
+//! The simulator's wheels are three orthogonal-wheel equivalents whose sum `ρ` (body
+//! axes) it integrates ([`super::wheels`]). A spacecraft with `m` rotors on axes `a_i`
+//! (`A = [a_1 … a_m]`, which must span the three body axes) carries that momentum as the
+//! minimum-norm split `h = Aᵀ(AAᵀ)⁻¹ ρ` (as a pseudo-inverse wheel allocator does), and
+//! rotor `i` spins at `ω_i = h_i / J_i`, telemetered in its speed unit:
+//! `ω̃_i = ω_i / u_i`. So `Σ_i J_i u_i ω̃_i a_i = ρ` exactly, and a spacecraft file whose
+//! spin inertias differ from the ones used here is a file with those inertias wrong.
+
+use super::SimError;
+use crate::sample::Sample;
+use crate::spacecraft::Spacecraft;
+use nalgebra::{Matrix3, Vector3};
+use std::vec::Vec;
+
+/// The rotors' stored speeds for each sample (flat: one row of `m` per sample), from each
+/// sample's rotor momentum, with the true spin inertias of `spacecraft`.
+pub fn speeds(samples: &[Sample], spacecraft: &Spacecraft) -> Result<Vec<f64>, SimError> {
+    let axes: Vec<Vector3<f64>> = spacecraft
+        .rotors
+        .iter()
+        .map(|r| Vector3::from(r.axis))
+        .collect();
+    let aat: Matrix3<f64> = axes.iter().map(|a| a * a.transpose()).sum();
+    // The axes must span the body: the smallest eigenvalue of AAᵀ away from zero.
+    let smallest = aat.symmetric_eigenvalues().min();
+    let inverse = aat
+        .try_inverse()
+        .filter(|_| smallest > 1e-6 * aat.trace())
+        .ok_or(SimError::InvalidSetting {
+            field: "spacecraft rotor axes",
+            value: smallest,
+            why: "the rotors' axes must span the three body axes (smallest eigenvalue of A Aᵀ shown)",
+        })?;
+    let per_unit: Vec<f64> = spacecraft
+        .rotors
+        .iter()
+        .map(|r| r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s())
+        .collect();
+    let mut out = Vec::with_capacity(samples.len() * axes.len());
+    for s in samples {
+        let y = inverse * s.rho_nms;
+        out.extend(axes.iter().zip(&per_unit).map(|(a, u)| a.dot(&y) / u));
+    }
+    Ok(out)
+}
+
+#[cfg(all(test, feature = "spacecraft"))]
+mod tests {
+    use super::*;
+
+    const PYRAMID: &str = r#"
+[[rotor]]
+name = "rw1"
+axis = [0.816497, 0.0, 0.577350]
+spin_inertia_kg_m2 = 1.5e-3
+speed_column = "s1"
+speed_unit = "rpm"
+[[rotor]]
+name = "rw2"
+axis = [0.0, 0.816497, 0.577350]
+spin_inertia_kg_m2 = 1.6e-3
+speed_column = "s2"
+[[rotor]]
+name = "rw3"
+axis = [-0.816497, 0.0, 0.577350]
+spin_inertia_kg_m2 = 1.7e-3
+speed_column = "s3"
+speed_unit = "deg/s"
+[[rotor]]
+name = "rw4"
+axis = [0.0, -0.816497, 0.577350]
+spin_inertia_kg_m2 = 1.8e-3
+speed_column = "s4"
+"#;
+
+    fn sample(rho: Vector3<f64>) -> Sample {
+        Sample {
+            t_s: 0.0,
+            q: crate::attitude::Quaternion::IDENTITY,
+            rho_nms: rho,
+            tau_nm: Vector3::zeros(),
+            omega_rad_s: None,
+        }
+    }
+
+    #[test]
+    fn the_speeds_give_back_the_momentum_and_the_split_has_least_norm() {
+        let sc = Spacecraft::parse(PYRAMID, "p.toml").unwrap();
+        let rho = [Vector3::new(0.1, -0.2, 0.05), Vector3::new(-0.3, 0.0, 0.7)];
+        let samples: Vec<Sample> = rho.iter().map(|&r| sample(r)).collect();
+        let w = speeds(&samples, &sc).unwrap();
+        for (k, r) in rho.iter().enumerate() {
+            let back = sc.momentum_nms(&w[4 * k..4 * k + 4]);
+            assert!((back - r).norm() < 1e-12 * r.norm(), "{back} vs {r}");
+            // Least norm: the wheel momenta h are orthogonal to the null space of A,
+            // here (1, -1, 1, -1)/2 in the pyramid's order.
+            let h: Vec<f64> = (0..4)
+                .map(|i| {
+                    w[4 * k + i]
+                        * sc.rotors[i].spin_inertia_kg_m2
+                        * sc.rotors[i].speed_unit.to_rad_s()
+                })
+                .collect();
+            let null = h[0] - h[1] + h[2] - h[3];
+            assert!(null.abs() < 1e-12, "{h:?}");
+        }
+    }
+
+    #[test]
+    fn axes_that_miss_a_body_axis_are_refused() {
+        let flat = PYRAMID
+            .replace("0.577350", "0.0")
+            .replace("0.816497", "1.0");
+        let sc = Spacecraft::parse(&flat, "p.toml").unwrap();
+        let e = speeds(&[sample(Vector3::x())], &sc).unwrap_err();
+        assert!(e.to_string().contains("span the three body axes"), "{e}");
+    }
+}

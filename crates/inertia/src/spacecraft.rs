@@ -1,0 +1,387 @@
+//! The spacecraft file: what the telemetry alone cannot say about
+//! the vehicle. Today its rotors: each wheel's spin axis, spin inertia ± σ, and the
+//! telemetry column that holds its speed, so that the rotor momentum is computed from
+//! the wheel speeds the attitude system telemeters instead of being pre-summed by hand,
+//! and the wheels' inertia uncertainty widens σ (a consider parameter, issue #30).
+//!
+//! # Format (TOML; reading it needs the feature `spacecraft`)
+//!
+//! ```toml
+//! # How the rotors' spin-inertia errors are related: "shared" (default: the same
+//! # relative error for every rotor, as for wheels of one model whose catalogue value
+//! # is off) or "independent" (each rotor calibrated on its own).
+//! rotor_errors = "shared"
+//!
+//! [[rotor]]
+//! name = "rw1"
+//! axis = [1.0, 0.0, 0.0]              # spin axis, body axes, unit (to 1e-3)
+//! spin_inertia_kg_m2 = 1.2e-3         # about the spin axis
+//! spin_inertia_sigma_kg_m2 = 2.4e-5   # its 1σ uncertainty (default 0: exact)
+//! speed_column = "rw1_speed"          # the telemetry column of its speed
+//! speed_unit = "rpm"                  # rad/s (default), rpm or deg/s
+//! ```
+//!
+//! # Convention
+//!
+//! A rotor's speed `ω_i` is its spin rate relative to the body about `+axis`; its
+//! angular momentum is `J_i ω_i a_i` (the rotor's momentum about its own axis, eq. 3's
+//! `ρ`), and the rotor momentum of the sample is their sum, body axes:
+//!
+//! ```text
+//! ρ = Σ_i J_i u_i ω̃_i a_i        (u_i: the speed unit's factor to rad/s)
+//! ```
+//!
+//! # The consider term
+//!
+//! The momentum rows are linear in `ρ`, so a relative error `ε_i` of rotor `i`'s spin
+//! inertia moves the answer by `ε_i ĵ_i` to first order, `ĵ_i` the part of `ĵ` that
+//! rotor `i`'s momentum explains ([`crate::estimator::rotor_inertia`]). With `s_i =
+//! σ_i/J_i`, σ widens per element by `|Σ_i s_i ĵ_i|` where the errors are shared (one
+//! error, every rotor by its own σ) and by `√Σ_i (s_i ĵ_i)²` where they are independent.
+//!
+//! # Validation
+//!
+//! Unknown keys, a missing key, a non-unit axis, a spin inertia that is not positive, a
+//! σ not in `[0, J_i)`, an unknown speed unit, two rotors with one name or one column,
+//! more than [`MAX_ROTORS`] rotors or none: each refused with the file, the line and the
+//! key ([`SpacecraftError`]).
+
+use crate::text::Clipped;
+use nalgebra::Vector3;
+#[cfg(feature = "spacecraft")]
+use serde::Deserialize;
+use std::string::String;
+#[cfg(feature = "spacecraft")]
+use std::string::ToString;
+use std::vec::Vec;
+
+/// The most rotors a spacecraft file may list.
+pub const MAX_ROTORS: usize = 16;
+
+/// How far an axis's norm may differ from 1 (it is then normalised).
+pub const AXIS_NORM_TOLERANCE: f64 = 1e-3;
+
+/// The unit of a rotor's speed column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub enum SpeedUnit {
+    /// rad/s (the default).
+    #[default]
+    #[cfg_attr(feature = "serde", serde(rename = "rad/s"))]
+    RadPerS,
+    /// Revolutions per minute.
+    #[cfg_attr(feature = "serde", serde(rename = "rpm"))]
+    Rpm,
+    /// deg/s.
+    #[cfg_attr(feature = "serde", serde(rename = "deg/s"))]
+    DegPerS,
+}
+
+impl SpeedUnit {
+    /// Every unit's name, as a spacecraft file spells it.
+    pub const NAMES: [&'static str; 3] = ["rad/s", "rpm", "deg/s"];
+
+    /// The factor that turns a speed in this unit into rad/s.
+    #[must_use]
+    pub fn to_rad_s(self) -> f64 {
+        match self {
+            SpeedUnit::RadPerS => 1.0,
+            SpeedUnit::Rpm => core::f64::consts::PI / 30.0,
+            SpeedUnit::DegPerS => core::f64::consts::PI / 180.0,
+        }
+    }
+}
+
+impl core::str::FromStr for SpeedUnit {
+    type Err = ();
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "rad/s" => Ok(SpeedUnit::RadPerS),
+            "rpm" => Ok(SpeedUnit::Rpm),
+            "deg/s" => Ok(SpeedUnit::DegPerS),
+            _ => Err(()),
+        }
+    }
+}
+
+/// How the rotors' spin-inertia errors are related ([module docs](self), "The consider
+/// term").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum RotorErrors {
+    /// One relative error for every rotor, each by its own σ (the default: the
+    /// conservative reading of one catalogue value for wheels of one model).
+    #[default]
+    Shared,
+    /// Each rotor's error on its own.
+    Independent,
+}
+
+/// One rotor (reaction wheel, momentum wheel, flywheel).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Rotor {
+    /// Its name (for messages and the report).
+    pub name: String,
+    /// Spin axis, body axes, unit.
+    pub axis: [f64; 3],
+    /// Spin inertia about the axis, kg m².
+    pub spin_inertia_kg_m2: f64,
+    /// Its 1σ uncertainty, kg m² (0: exact).
+    pub spin_inertia_sigma_kg_m2: f64,
+    /// The telemetry column that holds its speed.
+    pub speed_column: String,
+    /// The unit of that column.
+    pub speed_unit: SpeedUnit,
+}
+
+impl Rotor {
+    /// The momentum per stored speed unit, N m s per unit, body axes: `J_i u_i a_i`.
+    #[must_use]
+    pub fn momentum_per_unit(&self) -> Vector3<f64> {
+        Vector3::from(self.axis) * (self.spin_inertia_kg_m2 * self.speed_unit.to_rad_s())
+    }
+
+    /// The relative σ of its spin inertia, `σ_i/J_i`.
+    #[must_use]
+    pub fn relative_sigma(&self) -> f64 {
+        self.spin_inertia_sigma_kg_m2 / self.spin_inertia_kg_m2
+    }
+}
+
+/// A spacecraft file's contents, validated.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Spacecraft {
+    /// The rotors, in the file's order.
+    pub rotors: Vec<Rotor>,
+    /// How their spin-inertia errors are related.
+    pub rotor_errors: RotorErrors,
+}
+
+/// A spacecraft file that cannot be used: the file, the line (where the problem has
+/// one), the key, and what is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}:{}{}{message}", .line.map_or_else(String::new, |l| format!("{l}:")), .key.as_ref().map_or_else(String::new, |k| format!(" `{}`:", Clipped::new(k))))]
+pub struct SpacecraftError {
+    /// The file (as the caller named it).
+    pub file: String,
+    /// 1-based line, where the problem has one.
+    pub line: Option<usize>,
+    /// The key at fault (`rotor[2].axis`), where there is one.
+    pub key: Option<String>,
+    /// What is wrong (one line, control characters escaped).
+    pub message: String,
+}
+
+#[cfg(feature = "spacecraft")]
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    #[serde(default)]
+    rotor_errors: Option<toml::Spanned<String>>,
+    #[serde(default, rename = "rotor")]
+    rotors: Vec<toml::Spanned<RawRotor>>,
+}
+
+#[cfg(feature = "spacecraft")]
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRotor {
+    name: toml::Spanned<String>,
+    axis: toml::Spanned<[f64; 3]>,
+    spin_inertia_kg_m2: toml::Spanned<f64>,
+    #[serde(default)]
+    spin_inertia_sigma_kg_m2: Option<toml::Spanned<f64>>,
+    speed_column: toml::Spanned<String>,
+    #[serde(default)]
+    speed_unit: Option<toml::Spanned<String>>,
+}
+
+impl Spacecraft {
+    /// Read and validate a spacecraft file.
+    #[cfg(feature = "spacecraft")]
+    pub fn load(path: &std::path::Path) -> Result<Self, SpacecraftError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SpacecraftError {
+            file: file.clone(),
+            line: None,
+            key: None,
+            message: format!(" {}", Clipped::new(&e.to_string())),
+        })?;
+        Self::parse(&text, &file)
+    }
+
+    /// Validate a spacecraft file's text; `file` names it in messages.
+    #[cfg(feature = "spacecraft")]
+    pub fn parse(text: &str, file: &str) -> Result<Self, SpacecraftError> {
+        let line_of = |offset: usize| 1 + text[..offset.min(text.len())].matches('\n').count();
+        let err = |span: Option<core::ops::Range<usize>>, key: Option<String>, message: String| {
+            SpacecraftError {
+                file: file.to_string(),
+                line: span.map(|s| line_of(s.start)),
+                key,
+                message: format!(" {}", Clipped::with_limit(&message, 300)),
+            }
+        };
+        let raw: RawFile = toml::from_str(text).map_err(|e| {
+            // toml's message spans several lines (it quotes the file); keep its first.
+            let m = e.message().lines().next().unwrap_or("").to_string();
+            err(e.span(), None, m)
+        })?;
+        let rotor_errors = match &raw.rotor_errors {
+            None => RotorErrors::Shared,
+            Some(s) => match s.get_ref().as_str() {
+                "shared" => RotorErrors::Shared,
+                "independent" => RotorErrors::Independent,
+                other => {
+                    return Err(err(
+                        Some(s.span()),
+                        Some("rotor_errors".into()),
+                        format!("{other:?} is not one of \"shared\", \"independent\""),
+                    ))
+                }
+            },
+        };
+        if raw.rotors.is_empty() {
+            return Err(err(
+                None,
+                None,
+                "no rotor: list each wheel as a [[rotor]] table".into(),
+            ));
+        }
+        if raw.rotors.len() > MAX_ROTORS {
+            return Err(err(
+                Some(raw.rotors[MAX_ROTORS].span()),
+                None,
+                format!(
+                    "{} rotors; at most {MAX_ROTORS} are supported",
+                    raw.rotors.len()
+                ),
+            ));
+        }
+        let mut rotors: Vec<Rotor> = Vec::with_capacity(raw.rotors.len());
+        for (i, r) in raw.rotors.iter().enumerate() {
+            let r = r.get_ref();
+            let key = |k: &str| Some(format!("rotor[{i}].{k}"));
+            let name = r.name.get_ref().trim().to_string();
+            if name.is_empty() {
+                return Err(err(Some(r.name.span()), key("name"), "empty name".into()));
+            }
+            let axis = *r.axis.get_ref();
+            let norm = Vector3::from(axis).norm();
+            if !(axis.iter().all(|x| x.is_finite()) && (norm - 1.0).abs() <= AXIS_NORM_TOLERANCE) {
+                return Err(err(
+                    Some(r.axis.span()),
+                    key("axis"),
+                    format!(
+                        "not a unit vector (norm {}; within {AXIS_NORM_TOLERANCE} of 1 it is normalised)",
+                        crate::text::Num(norm)
+                    ),
+                ));
+            }
+            let j = *r.spin_inertia_kg_m2.get_ref();
+            if !(j.is_finite() && j > 0.0 && j <= 1e4) {
+                return Err(err(
+                    Some(r.spin_inertia_kg_m2.span()),
+                    key("spin_inertia_kg_m2"),
+                    format!(
+                        "{} is not a spin inertia (positive, at most 1e4 kg m²)",
+                        crate::text::Num(j)
+                    ),
+                ));
+            }
+            let sigma = r
+                .spin_inertia_sigma_kg_m2
+                .as_ref()
+                .map_or(0.0, |s| *s.get_ref());
+            if !(sigma.is_finite() && (0.0..j).contains(&sigma)) {
+                return Err(err(
+                    r.spin_inertia_sigma_kg_m2.as_ref().map(toml::Spanned::span),
+                    key("spin_inertia_sigma_kg_m2"),
+                    format!(
+                        "{} must be at least 0 and less than the spin inertia {}",
+                        crate::text::Num(sigma),
+                        crate::text::Num(j)
+                    ),
+                ));
+            }
+            let speed_column = r.speed_column.get_ref().trim().to_string();
+            if speed_column.is_empty() {
+                return Err(err(
+                    Some(r.speed_column.span()),
+                    key("speed_column"),
+                    "empty column name".into(),
+                ));
+            }
+            let speed_unit = match &r.speed_unit {
+                None => SpeedUnit::RadPerS,
+                Some(u) => u.get_ref().parse().map_err(|()| {
+                    err(
+                        Some(u.span()),
+                        key("speed_unit"),
+                        format!(
+                            "{:?} is not one of {}",
+                            u.get_ref(),
+                            SpeedUnit::NAMES.join(", ")
+                        ),
+                    )
+                })?,
+            };
+            if let Some(other) = rotors.iter().position(|o| o.name == name) {
+                return Err(err(
+                    Some(r.name.span()),
+                    key("name"),
+                    format!("rotor[{other}] has the same name"),
+                ));
+            }
+            if let Some(other) = rotors.iter().position(|o| o.speed_column == speed_column) {
+                return Err(err(
+                    Some(r.speed_column.span()),
+                    key("speed_column"),
+                    format!("rotor[{other}] reads the same column"),
+                ));
+            }
+            rotors.push(Rotor {
+                name,
+                axis: (Vector3::from(axis) / norm).into(),
+                spin_inertia_kg_m2: j,
+                spin_inertia_sigma_kg_m2: sigma,
+                speed_column,
+                speed_unit,
+            });
+        }
+        Ok(Spacecraft {
+            rotors,
+            rotor_errors,
+        })
+    }
+
+    /// The rotor momentum of one sample from its rotors' stored speeds (in the file's
+    /// order and units), N m s, body axes: `Σ_i J_i u_i ω̃_i a_i`.
+    #[must_use]
+    pub fn momentum_nms(&self, speeds: &[f64]) -> Vector3<f64> {
+        self.rotors
+            .iter()
+            .zip(speeds)
+            .map(|(r, &w)| r.momentum_per_unit() * w)
+            .sum()
+    }
+
+    /// The speed columns, in the file's order.
+    #[must_use]
+    pub fn speed_columns(&self) -> Vec<String> {
+        self.rotors.iter().map(|r| r.speed_column.clone()).collect()
+    }
+
+    /// Whether any rotor's spin inertia carries an uncertainty (a consider term applies).
+    #[must_use]
+    pub fn has_inertia_sigma(&self) -> bool {
+        self.rotors.iter().any(|r| r.spin_inertia_sigma_kg_m2 > 0.0)
+    }
+}
+
+#[cfg(all(test, feature = "spacecraft"))]
+mod tests;

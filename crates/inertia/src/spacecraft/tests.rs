@@ -1,0 +1,108 @@
+//! The spacecraft file: problem/reference pairs and every refusal.
+
+use super::*;
+
+const GOOD: &str = r#"
+rotor_errors = "independent"
+
+[[rotor]]
+name = "rw1"
+axis = [1.0, 0.0, 0.0]
+spin_inertia_kg_m2 = 1.0e-3
+spin_inertia_sigma_kg_m2 = 2.0e-5
+speed_column = "rw1_speed"
+speed_unit = "rpm"
+
+[[rotor]]
+name = "rw2"
+axis = [0.0, 0.6, 0.8]
+spin_inertia_kg_m2 = 2.0e-3
+speed_column = "rw2_speed"
+"#;
+
+#[test]
+fn a_good_file_is_read_with_its_units_and_defaults() {
+    let s = Spacecraft::parse(GOOD, "sc.toml").unwrap();
+    assert_eq!(s.rotor_errors, RotorErrors::Independent);
+    assert_eq!(s.rotors.len(), 2);
+    assert_eq!(s.rotors[0].speed_unit, SpeedUnit::Rpm);
+    assert_eq!(s.rotors[1].speed_unit, SpeedUnit::RadPerS);
+    assert_eq!(s.rotors[1].spin_inertia_sigma_kg_m2, 0.0);
+    assert!((s.rotors[0].relative_sigma() - 0.02).abs() < 1e-15);
+    assert!(s.has_inertia_sigma());
+    // 60 rpm = 2π rad/s on rw1; 10 rad/s on rw2.
+    let rho = s.momentum_nms(&[60.0, 10.0]);
+    let expected = Vector3::new(
+        1e-3 * 2.0 * core::f64::consts::PI,
+        2e-3 * 10.0 * 0.6,
+        2e-3 * 10.0 * 0.8,
+    );
+    assert!((rho - expected).norm() < 1e-15, "{rho} vs {expected}");
+    assert_eq!(s.speed_columns(), ["rw1_speed", "rw2_speed"]);
+}
+
+#[test]
+fn an_axis_within_tolerance_is_normalised() {
+    let text = GOOD.replace("[0.0, 0.6, 0.8]", "[0.0, 0.6, 0.8005]");
+    let s = Spacecraft::parse(&text, "sc.toml").unwrap();
+    assert!((Vector3::from(s.rotors[1].axis).norm() - 1.0).abs() < 1e-15);
+    assert_eq!(
+        Spacecraft::parse(&text, "sc.toml").unwrap().rotor_errors,
+        RotorErrors::Independent
+    );
+    let shared = GOOD.replace("rotor_errors = \"independent\"\n", "");
+    assert_eq!(
+        Spacecraft::parse(&shared, "sc.toml").unwrap().rotor_errors,
+        RotorErrors::Shared
+    );
+}
+
+/// Each bad file's message names the file, the line and the key.
+#[test]
+fn bad_files_are_refused_with_file_line_and_key() {
+    let cases: &[(&str, &str, &str)] = &[
+        ("[0.0, 0.6, 0.8]", "[0.0, 0.6, 0.9]", "sc.toml:14: `rotor[1].axis`: not a unit vector"),
+        ("spin_inertia_kg_m2 = 2.0e-3", "spin_inertia_kg_m2 = -2.0e-3", "sc.toml:15: `rotor[1].spin_inertia_kg_m2`: -0.002 is not a spin inertia"),
+        ("spin_inertia_sigma_kg_m2 = 2.0e-5", "spin_inertia_sigma_kg_m2 = 2.0e-3", "sc.toml:8: `rotor[0].spin_inertia_sigma_kg_m2`: 0.002 must be at least 0 and less than"),
+        ("speed_unit = \"rpm\"", "speed_unit = \"RPM\"", "sc.toml:10: `rotor[0].speed_unit`: \"RPM\" is not one of rad/s, rpm, deg/s"),
+        ("rotor_errors = \"independent\"", "rotor_errors = \"both\"", "sc.toml:2: `rotor_errors`: \"both\" is not one of"),
+        ("rw2_speed", "rw1_speed", "sc.toml:16: `rotor[1].speed_column`: rotor[0] reads the same column"),
+        ("name = \"rw2\"", "name = \"rw1\"", "sc.toml:13: `rotor[1].name`: rotor[0] has the same name"),
+        ("speed_unit = \"rpm\"", "speed_units = \"rpm\"", "sc.toml:10:"),
+        ("speed_column = \"rw2_speed\"", "", "missing field `speed_column`"),
+        ("spin_inertia_kg_m2 = 1.0e-3", "spin_inertia_kg_m2 = \"heavy\"", "sc.toml:7:"),
+    ];
+    for (from, to, expected) in cases {
+        let text = GOOD.replace(from, to);
+        assert_ne!(text, GOOD, "{from}");
+        let e = Spacecraft::parse(&text, "sc.toml").unwrap_err().to_string();
+        assert!(
+            e.starts_with("sc.toml:") && e.contains(expected),
+            "{to}: {e}"
+        );
+        assert!(!e.contains('\n'), "one line: {e:?}");
+    }
+    let e = Spacecraft::parse("rotor_errors = \"shared\"\n", "sc.toml").unwrap_err();
+    assert!(e.to_string().contains("no rotor"), "{e}");
+    let many: String = (0..=MAX_ROTORS)
+        .map(|i| format!("[[rotor]]\nname = \"r{i}\"\naxis = [1.0, 0.0, 0.0]\nspin_inertia_kg_m2 = 1.0\nspeed_column = \"c{i}\"\n"))
+        .collect();
+    let e = Spacecraft::parse(&many, "sc.toml").unwrap_err();
+    assert!(e.to_string().contains("at most 16"), "{e}");
+}
+
+#[test]
+fn control_characters_in_a_file_are_escaped() {
+    let text = GOOD.replace(
+        "speed_unit = \"rpm\"",
+        "speed_unit = \"\u{1b}]0;pwned\u{7}\"",
+    );
+    let e = Spacecraft::parse(&text, "sc.toml").unwrap_err().to_string();
+    assert!(!e.contains('\u{1b}') && !e.contains('\u{7}'), "{e:?}");
+}
+
+#[test]
+fn a_missing_file_is_named() {
+    let e = Spacecraft::load(std::path::Path::new("/nonexistent/sc.toml")).unwrap_err();
+    assert!(e.to_string().starts_with("/nonexistent/sc.toml:"), "{e}");
+}
