@@ -12,8 +12,10 @@
 //! 1.8 g m², speeds in rpm, `sim::rotors`).
 //!
 //! **What is stated.** Spin inertias drawn off the truth by relative errors of σ `s`
-//! (1 % or 5 %): one error for all (`shared`) or one per wheel (`independent`), and the
-//! file says so with that σ. The seed of the draw is the run's.
+//! (1 %, 2 % or 5 %): one error for all (`shared`) or one per wheel (`independent`), and
+//! the file says so with that σ; and/or each wheel's true axis tilted from the file's by
+//! two angles of σ 0.1° or 0.5°, the file stating that σ. The draws are seeded by the
+//! run's seed.
 //!
 //! **Columns.** Median relative Frobenius error; "3σ cov.": the fraction of runs with
 //! every element within ±3σ, with the σ stated and with the same wrong inertias stated
@@ -46,6 +48,7 @@ fn pyramid(j: [f64; 4], sigma: f64, errors: RotorErrors) -> Spacecraft {
                 axis: axes[i],
                 spin_inertia_kg_m2: j[i],
                 spin_inertia_sigma_kg_m2: sigma * j[i],
+                spin_axis_sigma_deg: 0.0,
                 speed_column: format!("rw{}_rpm", i + 1),
                 speed_unit: SpeedUnit::Rpm,
             })
@@ -98,77 +101,147 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// One row: spin-inertia errors (how related, relative σ) and axis tilt σ, deg.
+struct Case {
+    errors: RotorErrors,
+    inertia_sigma: f64,
+    tilt_sigma_deg: f64,
+}
+
+impl Case {
+    fn label(&self) -> String {
+        let errors = match self.errors {
+            RotorErrors::Shared => "shared",
+            RotorErrors::Independent => "independent",
+        };
+        match (self.inertia_sigma > 0.0, self.tilt_sigma_deg > 0.0) {
+            (true, false) => format!(
+                "spin inertia, {errors} | {:.0} %",
+                self.inertia_sigma * 100.0
+            ),
+            (false, true) => format!("axis tilt | {} deg", self.tilt_sigma_deg),
+            _ => format!(
+                "spin inertia, {errors}, and axis tilt | {:.0} %, {} deg",
+                self.inertia_sigma * 100.0,
+                self.tilt_sigma_deg
+            ),
+        }
+    }
+
+    /// The stated file (inertias drawn off the truth by their σ, nominal axes), and the
+    /// true wheels (true inertias, axes tilted by draws of the tilt σ), for one seed.
+    fn draw(&self, seed: u64, sigma_stated: bool) -> (Spacecraft, Spacecraft) {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + seed);
+        let normal = Normal::new(0.0, 1.0).expect("normal");
+        let common = normal.sample(&mut rng);
+        let stated_j: [f64; 4] = core::array::from_fn(|_| {
+            let z = match self.errors {
+                RotorErrors::Shared => common,
+                RotorErrors::Independent => normal.sample(&mut rng),
+            };
+            1.0 + z * self.inertia_sigma
+        });
+        let stated_j: [f64; 4] = core::array::from_fn(|i| TRUE_J[i] * stated_j[i]);
+        let scale = if sigma_stated { 1.0 } else { 0.0 };
+        let mut stated = pyramid(stated_j, self.inertia_sigma * scale, self.errors);
+        let mut truth = pyramid(TRUE_J, 0.0, self.errors);
+        let t = self.tilt_sigma_deg.to_radians();
+        for (r, s) in truth.rotors.iter_mut().zip(&mut stated.rotors) {
+            let [e1, e2] = r.tilt_directions();
+            let a = nalgebra::Vector3::from(r.axis)
+                + e1 * (t * normal.sample(&mut rng))
+                + e2 * (t * normal.sample(&mut rng));
+            r.axis = a.normalize().into();
+            s.spin_axis_sigma_deg = self.tilt_sigma_deg * scale;
+        }
+        (stated, truth)
+    }
+}
+
 fn main() {
     let seeds: u64 = std::env::args()
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(50);
     let start = std::time::Instant::now();
+    let cases = [
+        Case {
+            errors: RotorErrors::Shared,
+            inertia_sigma: 0.01,
+            tilt_sigma_deg: 0.0,
+        },
+        Case {
+            errors: RotorErrors::Shared,
+            inertia_sigma: 0.05,
+            tilt_sigma_deg: 0.0,
+        },
+        Case {
+            errors: RotorErrors::Independent,
+            inertia_sigma: 0.01,
+            tilt_sigma_deg: 0.0,
+        },
+        Case {
+            errors: RotorErrors::Independent,
+            inertia_sigma: 0.05,
+            tilt_sigma_deg: 0.0,
+        },
+        Case {
+            errors: RotorErrors::Shared,
+            inertia_sigma: 0.0,
+            tilt_sigma_deg: 0.1,
+        },
+        Case {
+            errors: RotorErrors::Shared,
+            inertia_sigma: 0.0,
+            tilt_sigma_deg: 0.5,
+        },
+        Case {
+            errors: RotorErrors::Independent,
+            inertia_sigma: 0.02,
+            tilt_sigma_deg: 0.5,
+        },
+    ];
     println!("| data | errors | σ stated | median error | 3σ cov. | determined beyond 3σ | stated exact: 3σ cov. | determined beyond 3σ | withheld |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for data in ["slew", "small-sat"] {
-        for errors in [RotorErrors::Shared, RotorErrors::Independent] {
-            for sigma in [0.01, 0.05] {
-                let rows: Vec<_> = (1..=seeds)
-                    .into_par_iter()
-                    .map(|seed| {
-                        let out = match data {
-                            "slew" => Scenario::slew().simulate(&Common {
-                                seed,
-                                ..Common::physical()
-                            }),
-                            _ => {
-                                let mut p = Preset::small_sat();
-                                p.common.seed = seed;
-                                p.simulate()
-                            }
+        for case in &cases {
+            let rows: Vec<_> = (1..=seeds)
+                .into_par_iter()
+                .map(|seed| {
+                    let out = match data {
+                        "slew" => Scenario::slew().simulate(&Common {
+                            seed,
+                            ..Common::physical()
+                        }),
+                        _ => {
+                            let mut p = Preset::small_sat();
+                            p.common.seed = seed;
+                            p.simulate()
                         }
-                        .expect("sim");
-                        let truth = out.inertia_kg_m2;
-                        let speeds = inertia::sim::rotors::speeds(
-                            &out.samples,
-                            &pyramid(TRUE_J, 0.0, errors),
-                        )
-                        .expect("speeds");
-                        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + seed);
-                        let normal = Normal::new(0.0, sigma).expect("normal");
-                        let common = normal.sample(&mut rng);
-                        let stated: [f64; 4] = core::array::from_fn(|i| {
-                            let e = match errors {
-                                RotorErrors::Shared => common,
-                                RotorErrors::Independent => normal.sample(&mut rng),
-                            };
-                            TRUE_J[i] * (1.0 + e)
-                        });
-                        let with = judge(
-                            run(&out.samples, &speeds, pyramid(stated, sigma, errors)),
-                            &truth,
-                        );
-                        let exact = judge(
-                            run(&out.samples, &speeds, pyramid(stated, 0.0, errors)),
-                            &truth,
-                        );
-                        (with, exact)
-                    })
-                    .collect();
-                let n = rows.len() as f64;
-                let frac =
-                    |f: &dyn Fn(&Pair) -> bool| rows.iter().filter(|r| f(r)).count() as f64 / n;
-                println!(
-                    "| {data} | {} | {:.0} % | {:.2e} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
-                    match errors {
-                        RotorErrors::Shared => "shared",
-                        RotorErrors::Independent => "independent",
-                    },
-                    sigma * 100.0,
-                    median(rows.iter().map(|r| r.0 .0).collect()),
-                    frac(&|r| r.0 .1),
-                    frac(&|r| r.0 .2),
-                    frac(&|r| r.1 .1),
-                    frac(&|r| r.1 .2),
-                    frac(&|r| r.1 .3),
-                );
-            }
+                    }
+                    .expect("sim");
+                    let truth = out.inertia_kg_m2;
+                    let (stated, true_wheels) = case.draw(seed, true);
+                    let (exact, _) = case.draw(seed, false);
+                    let speeds =
+                        inertia::sim::rotors::speeds(&out.samples, &true_wheels).expect("speeds");
+                    let with = judge(run(&out.samples, &speeds, stated), &truth);
+                    let exact = judge(run(&out.samples, &speeds, exact), &truth);
+                    (with, exact)
+                })
+                .collect();
+            let n = rows.len() as f64;
+            let frac = |f: &dyn Fn(&Pair) -> bool| rows.iter().filter(|r| f(r)).count() as f64 / n;
+            println!(
+                "| {data} | {} | {:.2e} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+                case.label(),
+                median(rows.iter().map(|r| r.0 .0).collect()),
+                frac(&|r| r.0 .1),
+                frac(&|r| r.0 .2),
+                frac(&|r| r.1 .1),
+                frac(&|r| r.1 .2),
+                frac(&|r| r.1 .3),
+            );
         }
     }
     eprintln!(

@@ -138,6 +138,7 @@ impl Telemetry {
         d.set_item("sign_flips", self.stats.sign_flips)?;
         d.set_item("min_step_s", self.stats.min_step_s)?;
         d.set_item("max_step_s", self.stats.max_step_s)?;
+        d.set_item("attitude_from_gyro", self.stats.attitude_from_gyro)?;
         Ok(d)
     }
     fn __len__(&self) -> usize {
@@ -540,7 +541,7 @@ fn restore<'py>(
     w: Option<PyReadonlyArrayDyn<'py, f64>>,
     file: Option<String>,
     lines: Option<Vec<u64>>,
-    stats: (usize, usize, usize, f64, f64),
+    stats: (usize, usize, usize, f64, f64, bool),
     q_columns: String,
     label: String,
     rotors: Option<(String, String, PyReadonlyArrayDyn<'py, f64>)>,
@@ -574,7 +575,7 @@ fn restore<'py>(
             omega_rad_s: r.w.map(Into::into),
         })
         .collect();
-    let (rows_read, renormalised, sign_flips, min_step_s, max_step_s) = stats;
+    let (rows_read, renormalised, sign_flips, min_step_s, max_step_s, attitude_from_gyro) = stats;
     Ok(Telemetry {
         samples,
         lines,
@@ -586,6 +587,7 @@ fn restore<'py>(
             min_step_s,
             max_step_s,
             rejected: 0,
+            attitude_from_gyro,
         },
         q_columns,
         label,

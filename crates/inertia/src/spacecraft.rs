@@ -17,6 +17,7 @@
 //! axis = [1.0, 0.0, 0.0]              # spin axis, body axes, unit (to 1e-3)
 //! spin_inertia_kg_m2 = 1.2e-3         # about the spin axis
 //! spin_inertia_sigma_kg_m2 = 2.4e-5   # its 1σ uncertainty (default 0: exact)
+//! spin_axis_sigma_deg = 0.5           # 1σ tilt of the axis, each way (default 0)
 //! speed_column = "rw1_speed"          # the telemetry column of its speed
 //! speed_unit = "rpm"                  # rad/s (default), rpm or deg/s
 //! ```
@@ -33,11 +34,10 @@
 //!
 //! # The consider term
 //!
-//! The momentum rows are linear in `ρ`, so a relative error `ε_i` of rotor `i`'s spin
-//! inertia moves the answer by `ε_i ĵ_i` to first order, `ĵ_i` the part of `ĵ` that
-//! rotor `i`'s momentum explains ([`crate::estimator::rotor_inertia`]). With `s_i =
-//! σ_i/J_i`, σ widens per element by `|Σ_i s_i ĵ_i|` where the errors are shared (one
-//! error, every rotor by its own σ) and by `√Σ_i (s_i ĵ_i)²` where they are independent.
+//! Each rotor's spin inertia ± σ (errors shared by every rotor, or independent) and its
+//! axis's tilt ± σ (two small angles, independent per rotor) are consider parameters:
+//! the answer's move for each 1σ error source is measured by re-running the estimator,
+//! and σ widens by their root sum square ([`crate::estimator::rotor_inertia`]).
 //!
 //! # Validation
 //!
@@ -131,6 +131,8 @@ pub struct Rotor {
     pub spin_inertia_kg_m2: f64,
     /// Its 1σ uncertainty, kg m² (0: exact).
     pub spin_inertia_sigma_kg_m2: f64,
+    /// The 1σ tilt of its axis about each of two perpendicular directions, deg (0: exact).
+    pub spin_axis_sigma_deg: f64,
     /// The telemetry column that holds its speed.
     pub speed_column: String,
     /// The unit of that column.
@@ -148,6 +150,17 @@ impl Rotor {
     #[must_use]
     pub fn relative_sigma(&self) -> f64 {
         self.spin_inertia_sigma_kg_m2 / self.spin_inertia_kg_m2
+    }
+
+    /// Two unit vectors perpendicular to its axis and to each other (the directions its
+    /// axis tilts towards): the axis crossed with the body axis it is least aligned
+    /// with, then the axis crossed with that.
+    #[must_use]
+    pub fn tilt_directions(&self) -> [Vector3<f64>; 2] {
+        let a = Vector3::from(self.axis);
+        let k = a.iamin();
+        let e1 = a.cross(&Vector3::ith(k, 1.0)).normalize();
+        [e1, a.cross(&e1)]
     }
 }
 
@@ -195,6 +208,8 @@ struct RawRotor {
     spin_inertia_kg_m2: toml::Spanned<f64>,
     #[serde(default)]
     spin_inertia_sigma_kg_m2: Option<toml::Spanned<f64>>,
+    #[serde(default)]
+    spin_axis_sigma_deg: Option<toml::Spanned<f64>>,
     speed_column: toml::Spanned<String>,
     #[serde(default)]
     speed_unit: Option<toml::Spanned<String>>,
@@ -308,6 +323,17 @@ impl Spacecraft {
                     ),
                 ));
             }
+            let tilt = r.spin_axis_sigma_deg.as_ref().map_or(0.0, |s| *s.get_ref());
+            if !(tilt.is_finite() && (0.0..=10.0).contains(&tilt)) {
+                return Err(err(
+                    r.spin_axis_sigma_deg.as_ref().map(toml::Spanned::span),
+                    key("spin_axis_sigma_deg"),
+                    format!(
+                        "{} must be at least 0 and at most 10 deg (a small tilt)",
+                        crate::text::Num(tilt)
+                    ),
+                ));
+            }
             let speed_column = r.speed_column.get_ref().trim().to_string();
             if speed_column.is_empty() {
                 return Err(err(
@@ -349,6 +375,7 @@ impl Spacecraft {
                 axis: (Vector3::from(axis) / norm).into(),
                 spin_inertia_kg_m2: j,
                 spin_inertia_sigma_kg_m2: sigma,
+                spin_axis_sigma_deg: tilt,
                 speed_column,
                 speed_unit,
             });
@@ -376,10 +403,28 @@ impl Spacecraft {
         self.rotors.iter().map(|r| r.speed_column.clone()).collect()
     }
 
-    /// Whether any rotor's spin inertia carries an uncertainty (a consider term applies).
+    /// Whether any rotor's spin inertia or axis carries an uncertainty (a consider term
+    /// applies).
     #[must_use]
     pub fn has_inertia_sigma(&self) -> bool {
-        self.rotors.iter().any(|r| r.spin_inertia_sigma_kg_m2 > 0.0)
+        self.rotors
+            .iter()
+            .any(|r| r.spin_inertia_sigma_kg_m2 > 0.0 || r.spin_axis_sigma_deg > 0.0)
+    }
+
+    /// The relative σ of the rotor momentum the file states, for the checks that compare
+    /// moves of the answer with its σ: `√Σ_i (s_i² + 2 θ_i²)`, `s_i` the relative σ of
+    /// the spin inertia and `θ_i` the axis tilt's, rad.
+    #[must_use]
+    pub fn stated_relative_sigma(&self) -> f64 {
+        self.rotors
+            .iter()
+            .map(|r| {
+                let t = r.spin_axis_sigma_deg.to_radians();
+                r.relative_sigma() * r.relative_sigma() + 2.0 * t * t
+            })
+            .sum::<f64>()
+            .sqrt()
     }
 }
 

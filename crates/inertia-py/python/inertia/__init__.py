@@ -283,7 +283,8 @@ class Telemetry:
 
     def __reduce__(self):
         st = self.stats
-        state = (st["rows"], st["renormalised"], st["sign_flips"], st["min_step_s"], st["max_step_s"])
+        state = (st["rows"], st["renormalised"], st["sign_flips"], st["min_step_s"], st["max_step_s"],
+                 st["attitude_from_gyro"])
         lines = None if self.lines is None else [int(x) for x in self.lines]
         return (
             _restore_telemetry,

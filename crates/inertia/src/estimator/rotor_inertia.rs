@@ -1,14 +1,18 @@
-//! The rotors' spin-inertia uncertainty as a consider parameter (issue #30, "What the user
-//! said"): how far `ĵ` moves for each independent 1σ error of the rotors' spin inertias,
-//! and the σ that this adds.
+//! The rotors' uncertainty as a consider parameter (issues #30 "What the user said", #31
+//! "Per-rotor parameters"): how far `ĵ` moves for each independent 1σ error of the
+//! rotors' spin inertias and axes, and the σ that this adds.
 //!
 //! A relative error `ε_i` of rotor `i`'s spin inertia scales its momentum `ρ_i` by
-//! `1 + ε_i`. The error sources are independent standard normal `z_v`, each moving some
-//! rotors' inertia by their σ (`s_i = σ_i/J_i`):
+//! `1 + ε_i`; a small tilt of its axis by angles `(θ_1, θ_2)` towards the two directions
+//! perpendicular to it ([`crate::spacecraft::Rotor::tilt_directions`]) adds
+//! `|ρ_i| (θ_1 e_1 + θ_2 e_2)`. The error sources are independent standard normal `z_v`,
+//! each moving some rotors by their σ (`s_i = σ_i/J_i`, `σ_θ,i` the tilt's):
 //!
-//! * **shared** errors (the default): one source for every rotor, `ε_i = z s_i` (wheels of
-//!   one model whose catalogue value is off);
-//! * **independent** errors: one source per rotor with a σ, `ε_i = z_i s_i`.
+//! * **shared** spin-inertia errors (the default): one source for every rotor,
+//!   `ε_i = z s_i` (wheels of one model whose catalogue value is off);
+//! * **independent** spin-inertia errors: one source per rotor with a σ, `ε_i = z_i s_i`;
+//! * **axis tilts**: two sources per rotor with a tilt σ, `θ_j = z σ_θ,i` (mounting
+//!   errors are each wheel's own).
 //!
 //! Each source's move `m_v = ĵ(z_v = 1) − ĵ` is measured on the estimator itself: the
 //! run's estimator (same settings, same samples, the run's wheel-speed time tag applied to
@@ -29,19 +33,21 @@
 use crate::sample::Sample;
 use crate::spacecraft::{RotorErrors, Spacecraft};
 use crate::tensor::InertiaVector;
+use nalgebra::Vector3;
 use std::vec::Vec;
 
-/// What the rotors' spin-inertia uncertainty does to the answer.
+/// What the rotors' uncertainty does to the answer.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RotorInertiaConsider {
-    /// How the errors are related.
+    /// How the spin-inertia errors are related.
     pub errors: RotorErrors,
     /// Each rotor's relative σ `σ_i/J_i`, in the spacecraft file's order.
     pub relative_sigma: Vec<f64>,
-    /// The answer's move `m_v` for each independent 1σ error source, kg m²: one for shared
-    /// errors; for independent ones, one per rotor in the file's order (zero for a rotor
-    /// without a σ).
+    /// Each independent 1σ error source: `spin inertia` (shared), `rw1 spin inertia`,
+    /// `rw1 axis tilt 1`, ….
+    pub sources: Vec<std::string::String>,
+    /// The answer's move `m_v` for each source, kg m², in the order of [`Self::sources`].
     pub moves_kg_m2: Vec<[f64; 6]>,
 }
 
@@ -91,55 +97,93 @@ pub fn consider(
         .iter()
         .map(crate::spacecraft::Rotor::relative_sigma)
         .collect();
-    // The sources: for each, the relative error of every rotor at z = 1.
-    let sources: Vec<Vec<f64>> = match spacecraft.rotor_errors {
-        RotorErrors::Shared => vec![relative_sigma.clone()],
-        RotorErrors::Independent => (0..m)
-            .map(|i| {
-                (0..m)
-                    .map(|j| if i == j { relative_sigma[i] } else { 0.0 })
-                    .collect()
-            })
-            .collect(),
-    };
+    let sources = sources(spacecraft);
+    if sources.is_empty() {
+        return Err(RotorInertiaError::NotComputable("no rotor has a σ"));
+    }
     let base = solve(samples).ok_or(RotorInertiaError::NotComputable(
         "the estimator gave no answer",
     ))?;
-    // Each rotor's momentum alone, read at the run's time tag (as the sum was).
+    // Each rotor's perturbation alone, read at the run's time tag (as the sum was).
     let mut rotor: Vec<Sample> = samples.to_vec();
     let mut scaled: Vec<Sample> = samples.to_vec();
     let mut moves = Vec::with_capacity(sources.len());
-    for errors in &sources {
-        if errors.iter().all(|e| *e == 0.0) {
-            moves.push([0.0; 6]);
-            continue;
-        }
+    for (_, directions) in &sources {
         for (x, s) in scaled.iter_mut().zip(samples) {
             x.rho_nms = s.rho_nms;
         }
-        for (i, (r, &e)) in spacecraft.rotors.iter().zip(errors).enumerate() {
-            if e == 0.0 {
+        for (i, (r, d)) in spacecraft.rotors.iter().zip(directions).enumerate() {
+            if *d == Vector3::zeros() {
                 continue;
             }
-            let per_unit = r.momentum_per_unit();
+            let per_unit = d * (r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s());
             for (k, x) in rotor.iter_mut().enumerate() {
                 x.rho_nms = per_unit * speeds[k * m + i];
             }
             super::wheel_delay::shift_rho(&mut rotor, delay_s);
             for (x, part) in scaled.iter_mut().zip(&rotor) {
-                x.rho_nms += part.rho_nms * e;
+                x.rho_nms += part.rho_nms;
             }
         }
         let j = solve(&scaled).ok_or(RotorInertiaError::NotComputable(
-            "the estimator gave no answer with the rotors' inertia changed",
+            "the estimator gave no answer with the rotors changed",
         ))?;
         moves.push(core::array::from_fn(|k| j[k] - base[k]));
     }
     Ok(RotorInertiaConsider {
         errors: spacecraft.rotor_errors,
         relative_sigma,
+        sources: sources.into_iter().map(|s| s.0).collect(),
         moves_kg_m2: moves,
     })
+}
+
+/// The independent 1σ error sources of `spacecraft` ([module docs](self)): a label, and
+/// per rotor the change of its momentum's direction per unit of its momentum (`s_i a_i`
+/// for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
+fn sources(spacecraft: &Spacecraft) -> Vec<(std::string::String, Vec<Vector3<f64>>)> {
+    let rotors = &spacecraft.rotors;
+    let axis = |i: usize| Vector3::from(rotors[i].axis);
+    let only = |i: usize, d: Vector3<f64>| -> Vec<Vector3<f64>> {
+        (0..rotors.len())
+            .map(|k| if k == i { d } else { Vector3::zeros() })
+            .collect()
+    };
+    let mut out = Vec::new();
+    match spacecraft.rotor_errors {
+        RotorErrors::Shared => {
+            if rotors.iter().any(|r| r.relative_sigma() > 0.0) {
+                out.push((
+                    "spin inertia".into(),
+                    (0..rotors.len())
+                        .map(|i| axis(i) * rotors[i].relative_sigma())
+                        .collect(),
+                ));
+            }
+        }
+        RotorErrors::Independent => {
+            for (i, r) in rotors.iter().enumerate() {
+                if r.relative_sigma() > 0.0 {
+                    out.push((
+                        std::format!("{} spin inertia", r.name),
+                        only(i, axis(i) * r.relative_sigma()),
+                    ));
+                }
+            }
+        }
+    }
+    for (i, r) in rotors.iter().enumerate() {
+        if r.spin_axis_sigma_deg > 0.0 {
+            let t = r.spin_axis_sigma_deg.to_radians();
+            for (j, e) in r.tilt_directions().iter().enumerate() {
+                out.push((
+                    std::format!("{} axis tilt {}", r.name, j + 1),
+                    only(i, e * t),
+                ));
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -151,6 +195,7 @@ mod tests {
         let c = RotorInertiaConsider {
             errors: RotorErrors::Independent,
             relative_sigma: vec![0.1, 0.2],
+            sources: vec!["a".into(), "b".into()],
             moves_kg_m2: vec![
                 [0.1, -0.2, 0.0, 0.0, 0.0, 0.3],
                 [0.2, 0.4, 0.0, 0.0, 0.0, 0.8],

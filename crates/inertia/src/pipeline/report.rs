@@ -65,6 +65,9 @@ pub struct InputSummary {
     pub min_step_s: f64,
     /// Longest step, s.
     pub max_step_s: f64,
+    /// Whether the attitude was integrated from the gyro rates (the input had no
+    /// quaternions).
+    pub attitude_from_gyro: bool,
 }
 
 /// The report of one run.
@@ -195,7 +198,7 @@ pub enum Warning {
     /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]).
     HeldWheelSpeeds(usize, f64),
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
-    /// shared the largest relative σ (this, relative).
+    /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
 }
 
@@ -206,10 +209,13 @@ pub struct RotorInertiaEntry {
     pub rotors: std::vec::Vec<String>,
     /// Each rotor's relative σ of its spin inertia.
     pub relative_sigma: std::vec::Vec<f64>,
-    /// How their errors are related (`shared` or `independent`).
+    /// How their spin-inertia errors are related (`shared` or `independent`).
     pub errors: crate::spacecraft::RotorErrors,
-    /// The answer's move for each independent 1σ error source, kg m²: one for shared
-    /// errors, one per rotor for independent ones.
+    /// Each rotor's axis tilt σ, deg.
+    pub axis_sigma_deg: std::vec::Vec<f64>,
+    /// The independent 1σ error sources (`spin inertia`, `rw1 axis tilt 1`, …).
+    pub sources: std::vec::Vec<String>,
+    /// The answer's move for each source, kg m².
     pub moves_kg_m2: std::vec::Vec<[f64; 6]>,
     /// Its consider part of σ per element, kg m².
     pub sigma_kg_m2: [f64; 6],
@@ -305,7 +311,7 @@ impl fmt::Display for Warning {
             ),
             Warning::RotorInertiaNotComputed(e, r) => write!(
                 f,
-                "{e}; σ is widened as if every rotor's spin inertia shared the largest relative σ, {}",
+                "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
             ),
         }
@@ -486,17 +492,14 @@ impl Report {
                     rotors: sc.rotors.iter().map(|r| r.name.clone()).collect(),
                     relative_sigma: c.relative_sigma.clone(),
                     errors: c.errors,
+                    axis_sigma_deg: sc.rotors.iter().map(|r| r.spin_axis_sigma_deg).collect(),
+                    sources: c.sources.clone(),
                     moves_kg_m2: c.moves_kg_m2.clone(),
                     sigma_kg_m2: c.consider_kg_m2(),
                 });
             }
             Err(e) => {
-                let r = sc
-                    .rotors
-                    .iter()
-                    .map(crate::spacecraft::Rotor::relative_sigma)
-                    .fold(0.0, f64::max);
-                self.rotor_inertia_error = Some((*e, r));
+                self.rotor_inertia_error = Some((*e, sc.stated_relative_sigma()));
             }
         }
         self.refreshed()

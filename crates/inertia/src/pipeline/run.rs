@@ -158,13 +158,7 @@ impl Run {
         if spacecraft.has_inertia_sigma() && matches!(self.mode, Mode::Streaming(_)) {
             self.held.get_or_insert_with(Vec::new);
         }
-        self.config.rotor_inertia_relative_sigma = crate::math::sqrt(
-            spacecraft
-                .rotors
-                .iter()
-                .map(|r| r.relative_sigma() * r.relative_sigma())
-                .sum(),
-        );
+        self.config.rotor_inertia_relative_sigma = spacecraft.stated_relative_sigma();
         self.rotors = Some(spacecraft);
         self
     }
@@ -437,8 +431,10 @@ impl Run {
 
     /// Compute the rotors' consider term from the run's `samples` (where a spacecraft file's
     /// rotor has a spin-inertia σ) and put it into the configuration ([`super::status`]).
-    /// Where it cannot be computed, σ is widened as if every rotor shared the largest
-    /// relative σ (the common scale's term, [`super::status`]), and the reason kept
+    /// Where it cannot be computed, σ is widened as if every rotor shared the file's
+    /// relative σ, the root sum square of all
+    /// ([`crate::spacecraft::Spacecraft::stated_relative_sigma`]; the common scale's term,
+    /// [`super::status`]), and the reason kept
     /// ([`Self::rotor_inertia`]).
     fn apply_rotor_consider(&mut self, samples: &[Sample]) {
         let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
@@ -467,11 +463,7 @@ impl Run {
         match &c {
             Ok(c) => self.config.rotor_inertia_consider = Some(c.consider_kg_m2()),
             Err(_) => {
-                let r = sc
-                    .rotors
-                    .iter()
-                    .map(crate::spacecraft::Rotor::relative_sigma)
-                    .fold(0.0, f64::max);
+                let r = sc.stated_relative_sigma();
                 let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
                 self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
             }
@@ -585,6 +577,7 @@ impl Run {
                     sign_flips: stats.sign_flips,
                     min_step_s: stats.min_step_s,
                     max_step_s: stats.max_step_s,
+                    attitude_from_gyro: stats.attitude_from_gyro,
                 }),
         )
     }

@@ -162,7 +162,9 @@ impl Default for CsvOptions {
 #[derive(Debug, Clone)]
 struct Indices {
     t: usize,
-    q: [usize; 4],
+    /// `None` where the file has no quaternion columns and the attitude is integrated from
+    /// the gyro rates ([`GateOptions::attitude_from_gyro`]).
+    q: Option<[usize; 4]>,
     /// `None` where the rotor momentum comes from the rotors' speeds.
     rho: Option<[usize; 3]>,
     tau: Option<[usize; 3]>,
@@ -245,14 +247,21 @@ impl<R: Read> TelemetryReader<R> {
             // Some present: all must be.
             Ok(Some([need(&names[0])?, need(&names[1])?, need(&names[2])?]))
         };
+        // No quaternion column at all, and gyro rates: the attitude is integrated from them.
+        let from_gyro =
+            c.q.iter().all(|n| find(n).is_none()) && c.w.iter().all(|n| find(n).is_some());
         let idx = Indices {
             t: need(&c.t)?,
-            q: [
-                need(&c.q[0])?,
-                need(&c.q[1])?,
-                need(&c.q[2])?,
-                need(&c.q[3])?,
-            ],
+            q: if from_gyro {
+                None
+            } else {
+                Some([
+                    need(&c.q[0])?,
+                    need(&c.q[1])?,
+                    need(&c.q[2])?,
+                    need(&c.q[3])?,
+                ])
+            },
             rho: if options.speed_columns.is_empty() {
                 Some([need(&c.rho[0])?, need(&c.rho[1])?, need(&c.rho[2])?])
             } else {
@@ -278,6 +287,7 @@ impl<R: Read> TelemetryReader<R> {
             period_tolerance: options.period_tolerance,
             negate_rho: options.negate_rho,
             gyro_unit: options.gyro_unit,
+            attitude_from_gyro: idx.q.is_none(),
         });
         Ok(Self {
             reader,
@@ -369,7 +379,10 @@ impl<R: Read> TelemetryReader<R> {
     fn column(&self, field: Field) -> String {
         let i = match field {
             Field::Time => self.idx.t,
-            Field::Quaternion(k) => self.idx.q[k],
+            Field::Quaternion(k) => match self.idx.q {
+                Some(c) => c[k],
+                None => return self.quaternion_columns(),
+            },
             Field::QuaternionNorm => return self.quaternion_columns(),
             Field::Rho(k) => match self.idx.rho {
                 Some(c) => c[k],
@@ -412,7 +425,10 @@ impl<R: Read> TelemetryReader<R> {
     /// The names of the quaternion columns, comma-separated (for messages).
     #[must_use]
     pub fn quaternion_columns(&self) -> String {
-        self.idx.q.map(|i| self.headers[i].clone()).join(",")
+        match self.idx.q {
+            Some(q) => q.map(|i| self.headers[i].clone()).join(","),
+            None => "(attitude from the gyro)".into(),
+        }
     }
 
     /// The time column: seconds, or an ISO-8601/RFC 3339 time stamp converted to seconds
@@ -469,12 +485,15 @@ impl<R: Read> TelemetryReader<R> {
         }
         let raw = RawSample {
             t_s: self.time(line)?,
-            q: [
-                self.field(line, self.idx.q[0])?,
-                self.field(line, self.idx.q[1])?,
-                self.field(line, self.idx.q[2])?,
-                self.field(line, self.idx.q[3])?,
-            ],
+            q: match self.idx.q {
+                Some(i) => [
+                    self.field(line, i[0])?,
+                    self.field(line, i[1])?,
+                    self.field(line, i[2])?,
+                    self.field(line, i[3])?,
+                ],
+                None => [0.0, 0.0, 0.0, 1.0],
+            },
             rho_nms: match self.idx.rho {
                 Some(i) => [
                     self.field(line, i[0])?,

@@ -150,6 +150,10 @@ pub enum SampleError {
         /// The relative tolerance.
         tolerance: f64,
     },
+    /// Without quaternions the attitude is integrated from the gyro rates, and this
+    /// sample has none.
+    #[error("no attitude: without quaternion columns the attitude is integrated from the gyro rates (w_x,w_y,w_z), which this sample lacks")]
+    NoAttitude,
     /// Gyro rates given for some samples and not for others.
     #[error("gyro rates {} here but {} for the earlier samples: give them for every sample or none", given(*.given_here), given(!*.given_here))]
     GyroChanged {
@@ -176,7 +180,7 @@ impl SampleError {
             SampleError::TimeNotIncreasing { .. } | SampleError::NonUniformPeriod { .. } => {
                 Field::Time
             }
-            SampleError::GyroChanged { .. } => Field::Rate(0),
+            SampleError::GyroChanged { .. } | SampleError::NoAttitude => Field::Rate(0),
         }
     }
 
@@ -190,6 +194,7 @@ impl SampleError {
             SampleError::TimeNotIncreasing { .. } => ErrorKind::TimeNotIncreasing,
             SampleError::NonUniformPeriod { .. } => ErrorKind::NonUniformPeriod,
             SampleError::GyroChanged { .. } => ErrorKind::GyroChanged,
+            SampleError::NoAttitude => ErrorKind::NeedsGyro,
         }
     }
 }
@@ -209,6 +214,9 @@ pub struct ReadStats {
     pub min_step_s: f64,
     /// Longest step, s.
     pub max_step_s: f64,
+    /// Whether the attitude was integrated from the gyro rates (no quaternions given,
+    /// [`GateOptions::attitude_from_gyro`]).
+    pub attitude_from_gyro: bool,
 }
 
 impl ReadStats {
@@ -282,6 +290,14 @@ pub struct GateOptions {
     pub negate_rho: bool,
     /// The unit of the stored gyro rates. Default rad/s.
     pub gyro_unit: GyroUnit,
+    /// No quaternions are given (a front end's input has no attitude): the attitude is
+    /// integrated from the gyro rates instead, `q_0 = 1` and `q_{k+1} = q_k ⊗ exp(ω̄_k
+    /// h_k)` with `ω̄_k` the rate averaged over `[t_k, t_{k+1}]` (exact for that rate;
+    /// the inertial frame is the first sample's body frame, which the momentum rows do not
+    /// care about), and every sample must have a rate ([`SampleError::NoAttitude`]). The
+    /// attitude then drifts with the gyro's noise; [`RawSample::q`] is ignored. Default
+    /// `false`.
+    pub attitude_from_gyro: bool,
 }
 
 impl Default for GateOptions {
@@ -292,6 +308,7 @@ impl Default for GateOptions {
             period_tolerance: None,
             negate_rho: false,
             gyro_unit: GyroUnit::RadPerS,
+            attitude_from_gyro: false,
         }
     }
 }
@@ -302,6 +319,8 @@ pub struct Gate {
     options: GateOptions,
     order: Order,
     prev_q: Option<Quaternion>,
+    /// The previous sample's gyro rate, rad/s (integrating the attitude).
+    prev_w: Option<Vector3<f64>>,
     period_s: Option<f64>,
     stats: ReadStats,
 }
@@ -340,6 +359,10 @@ impl Gate {
     pub fn new(options: GateOptions) -> Self {
         Self {
             options,
+            stats: ReadStats {
+                attitude_from_gyro: options.attitude_from_gyro,
+                ..ReadStats::default()
+            },
             ..Self::default()
         }
     }
@@ -369,6 +392,39 @@ impl Gate {
 
     fn checked(&mut self, raw: &RawSample) -> Result<Sample, SampleError> {
         let t_s = value(Field::Time, Quantity::Time, raw.t_s)?;
+        let (q, renormalised) = if self.options.attitude_from_gyro {
+            (Quaternion::IDENTITY, false)
+        } else {
+            self.quaternion(raw)?
+        };
+        let rho = vec3(raw.rho_nms, Field::Rho, Quantity::Rho)?;
+        let tau = match raw.tau_nm {
+            Some(v) => vec3(v, Field::Tau, Quantity::Tau)?,
+            None => Vector3::zeros(),
+        };
+        let to_rad_s = self.options.gyro_unit.to_rad_s();
+        let w = raw
+            .w_rad_s
+            .map(|v| vec3(v.map(|x| x * to_rad_s), Field::Rate, Quantity::Rate))
+            .transpose()?;
+        if self.options.attitude_from_gyro && w.is_none() {
+            return Err(SampleError::NoAttitude);
+        }
+        self.order.check(t_s, w.is_some())?;
+        let q = match (self.options.attitude_from_gyro, self.prev_q, self.prev_w) {
+            (true, Some(p), Some(pw)) => {
+                let h = t_s - self.order.last_t_s().unwrap_or(t_s);
+                let next = p.mul(&Quaternion::exp(&(pw * h)));
+                next.normalize().unwrap_or(next)
+            }
+            _ => q,
+        };
+        self.accept(t_s, q, renormalised, rho, tau, w)
+    }
+
+    /// The quaternion of `raw` in this library's convention, and whether it was
+    /// renormalised.
+    fn quaternion(&self, raw: &RawSample) -> Result<(Quaternion, bool), SampleError> {
         for (k, &v) in raw.q.iter().enumerate() {
             if !v.is_finite() {
                 return Err(SampleError::NotFinite {
@@ -396,17 +452,19 @@ impl Gate {
                 q = n;
             }
         }
-        let rho = vec3(raw.rho_nms, Field::Rho, Quantity::Rho)?;
-        let tau = match raw.tau_nm {
-            Some(v) => vec3(v, Field::Tau, Quantity::Tau)?,
-            None => Vector3::zeros(),
-        };
-        let to_rad_s = self.options.gyro_unit.to_rad_s();
-        let w = raw
-            .w_rad_s
-            .map(|v| vec3(v.map(|x| x * to_rad_s), Field::Rate, Quantity::Rate))
-            .transpose()?;
-        self.order.check(t_s, w.is_some())?;
+        Ok((q, renormalised))
+    }
+
+    /// The checks across samples (strict period), then the sample accepted.
+    fn accept(
+        &mut self,
+        t_s: f64,
+        q: Quaternion,
+        renormalised: bool,
+        rho: Vector3<f64>,
+        tau: Vector3<f64>,
+        w: Option<Vector3<f64>>,
+    ) -> Result<Sample, SampleError> {
         let mut period_s = self.period_s;
         if let (Some(previous_s), Some(tol)) =
             (self.order.last_t_s(), self.options.period_tolerance)
@@ -433,6 +491,7 @@ impl Gate {
         self.stats.rows += 1;
         self.order.accept(t_s, w.is_some());
         self.prev_q = Some(q);
+        self.prev_w = w;
         Ok(Sample {
             t_s,
             q,

@@ -7,6 +7,7 @@ mod trajectory;
 
 mod attitude;
 mod attitude_drift;
+mod attitude_from_gyro;
 mod changing_inertia;
 mod consistency;
 mod constraints;

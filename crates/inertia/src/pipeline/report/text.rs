@@ -52,6 +52,12 @@ impl fmt::Display for ReportText<'_> {
                 Counted(i.sign_flips, "sign flip"),
                 Counted(r.gaps, "gap")
             )?;
+            if i.attitude_from_gyro {
+                writeln!(
+                    s,
+                    "attitude: integrated from the gyro rates (no quaternion columns); it drifts with the gyro's noise, and the gyro's unit cannot be checked against it"
+                )?;
+            }
         }
         writeln!(
             s,
@@ -86,7 +92,7 @@ impl fmt::Display for ReportText<'_> {
                 parts.push("the wheel speeds' time tag");
             }
             if r.rotor_inertia.is_some() {
-                parts.push("the rotors' spin inertia");
+                parts.push("the rotors' stated uncertainty");
             }
             if r.rotor_scale_sigma_kg_m2.is_some() {
                 parts.push("the wheels' stated scale");
@@ -186,11 +192,18 @@ impl fmt::Display for ReportText<'_> {
                 crate::spacecraft::RotorErrors::Shared => "shared",
                 crate::spacecraft::RotorErrors::Independent => "independent",
             };
+            let tilt = ri.axis_sigma_deg.iter().fold(0.0f64, |a, &b| a.max(b));
+            let tilt = if tilt > 0.0 {
+                format!(", axis tilts up to {tilt:.2}°")
+            } else {
+                String::new()
+            };
             writeln!(
                 s,
-                "rotors' spin inertia ({} rotors, {errors} errors, up to {:.2} % each): its σ in each element's σ up to {:.1e} kg m²",
+                "rotors ({} rotors, {errors} spin-inertia errors up to {:.2} % each{tilt}; {} error sources): their σ in each element's σ up to {:.1e} kg m²",
                 ri.rotors.len(),
                 100.0 * largest,
+                ri.sources.len(),
                 ri.sigma_kg_m2.iter().fold(0.0f64, |a, &b| a.max(b))
             )?;
         }

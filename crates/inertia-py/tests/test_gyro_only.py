@@ -1,0 +1,25 @@
+"""Gyro-only telemetry through Python: a file without quaternion columns is read with its
+attitude integrated from the gyro, as the CLI reads it, and pickles with that flag."""
+
+import pickle
+
+import inertia
+from conftest import cli_estimate, run_cli
+from test_cli_agreement import TOL, differences
+
+
+def test_gyro_only_file_matches_cli(cli, files, tmp_path):
+    rows = files["slew"].read_text().splitlines()
+    f = tmp_path / "gyro.csv"
+    f.write_text("\n".join(",".join(r.split(",")[:1] + r.split(",")[5:]) for r in rows) + "\n")
+    t = inertia.read_csv(f)
+    assert t.stats["attitude_from_gyro"] is True
+    got = inertia.estimate(f)
+    expected = cli_estimate(cli, f)
+    assert expected["attitude_from_gyro"] is True
+    assert differences(expected, got.to_dict()) <= TOL
+    assert got.text == run_cli(cli, "estimate", f).stdout
+    assert "attitude: integrated from the gyro rates" in got.text
+    back = pickle.loads(pickle.dumps(t))
+    assert back.stats["attitude_from_gyro"] is True
+    assert differences(inertia.estimate(back).to_dict(), inertia.estimate(t).to_dict()) == 0.0
