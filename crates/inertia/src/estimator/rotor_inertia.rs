@@ -84,6 +84,25 @@ pub fn consider(
     speeds: &[f64],
     spacecraft: &Spacecraft,
     delay_s: f64,
+    solve: impl FnMut(&[Sample]) -> Option<InertiaVector>,
+) -> Result<RotorInertiaConsider, RotorInertiaError> {
+    consider_with(
+        samples,
+        speeds,
+        spacecraft,
+        delay_s,
+        sources(spacecraft),
+        solve,
+    )
+}
+
+/// [`consider`] over the given error `sources`.
+fn consider_with(
+    samples: &[Sample],
+    speeds: &[f64],
+    spacecraft: &Spacecraft,
+    delay_s: f64,
+    sources: Vec<Source>,
     mut solve: impl FnMut(&[Sample]) -> Option<InertiaVector>,
 ) -> Result<RotorInertiaConsider, RotorInertiaError> {
     let m = spacecraft.rotors.len();
@@ -97,33 +116,18 @@ pub fn consider(
         .iter()
         .map(crate::spacecraft::Rotor::relative_sigma)
         .collect();
-    let sources = sources(spacecraft);
     if sources.is_empty() {
         return Err(RotorInertiaError::NotComputable("no rotor has a σ"));
     }
     let base = solve(samples).ok_or(RotorInertiaError::NotComputable(
         "the estimator gave no answer",
     ))?;
-    // Each rotor's perturbation alone, read at the run's time tag (as the sum was).
-    let mut rotor: Vec<Sample> = samples.to_vec();
     let mut scaled: Vec<Sample> = samples.to_vec();
     let mut moves = Vec::with_capacity(sources.len());
     for (_, directions) in &sources {
-        for (x, s) in scaled.iter_mut().zip(samples) {
-            x.rho_nms = s.rho_nms;
-        }
-        for (i, (r, d)) in spacecraft.rotors.iter().zip(directions).enumerate() {
-            if *d == Vector3::zeros() {
-                continue;
-            }
-            let per_unit = d * (r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s());
-            for (k, x) in rotor.iter_mut().enumerate() {
-                x.rho_nms = per_unit * speeds[k * m + i];
-            }
-            super::wheel_delay::shift_rho(&mut rotor, delay_s);
-            for (x, part) in scaled.iter_mut().zip(&rotor) {
-                x.rho_nms += part.rho_nms;
-            }
+        let delta = source_momentum(samples, speeds, spacecraft, directions, delay_s);
+        for ((x, s), d) in scaled.iter_mut().zip(samples).zip(&delta) {
+            x.rho_nms = s.rho_nms + d;
         }
         let j = solve(&scaled).ok_or(RotorInertiaError::NotComputable(
             "the estimator gave no answer with the rotors changed",
@@ -138,10 +142,42 @@ pub fn consider(
     })
 }
 
+/// An error source: its label, and per rotor the change of its momentum's direction per
+/// unit of its momentum ([`sources`]).
+type Source = (std::string::String, Vec<Vector3<f64>>);
+
+/// The change of each sample's rotor momentum that a source's `directions` make:
+/// `Σ_i J_i u_i ω̃_i d_i`, read at the run's time tag `delay_s` (as the sum was).
+fn source_momentum(
+    samples: &[Sample],
+    speeds: &[f64],
+    spacecraft: &Spacecraft,
+    directions: &[Vector3<f64>],
+    delay_s: f64,
+) -> Vec<Vector3<f64>> {
+    let m = spacecraft.rotors.len();
+    let mut out = vec![Vector3::zeros(); samples.len()];
+    let mut rotor: Vec<Sample> = samples.to_vec();
+    for (i, (r, d)) in spacecraft.rotors.iter().zip(directions).enumerate() {
+        if *d == Vector3::zeros() {
+            continue;
+        }
+        let per_unit = d * (r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s());
+        for (k, x) in rotor.iter_mut().enumerate() {
+            x.rho_nms = per_unit * speeds[k * m + i];
+        }
+        super::wheel_delay::shift_rho(&mut rotor, delay_s);
+        for (o, part) in out.iter_mut().zip(&rotor) {
+            *o += part.rho_nms;
+        }
+    }
+    out
+}
+
 /// The independent 1σ error sources of `spacecraft` ([module docs](self)): a label, and
 /// per rotor the change of its momentum's direction per unit of its momentum (`s_i a_i`
 /// for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
-fn sources(spacecraft: &Spacecraft) -> Vec<(std::string::String, Vec<Vector3<f64>>)> {
+fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
     let rotors = &spacecraft.rotors;
     let axis = |i: usize| Vector3::from(rotors[i].axis);
     let only = |i: usize, d: Vector3<f64>| -> Vec<Vector3<f64>> {
