@@ -76,6 +76,8 @@ def test_pickling_keeps_the_rotors(speed_file):
     a, b = inertia.estimate(t), inertia.estimate(back)
     assert differences(a.to_dict(), b.to_dict()) == 0.0
     assert b.report["rotor_inertia"] is not None
+    with pytest.warns(UserWarning, match="do not travel with the frame"):
+        t.to_dataframe()
 
 
 def test_misuse_is_refused_by_name(speed_file, tmp_path):

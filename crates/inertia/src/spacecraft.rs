@@ -242,9 +242,19 @@ impl Spacecraft {
             }
         };
         let raw: RawFile = toml::from_str(text).map_err(|e| {
-            // toml's message spans several lines (it quotes the file); keep its first.
+            // toml's message spans several lines (it quotes the file); keep its first, and
+            // name the key of the line it points at.
             let m = e.message().lines().next().unwrap_or("").to_string();
-            err(e.span(), None, m)
+            let key = e.span().and_then(|s| {
+                let start = text[..s.start.min(text.len())]
+                    .rfind('\n')
+                    .map_or(0, |i| i + 1);
+                let line = text[start..].lines().next()?;
+                let (k, _) = line.split_once('=')?;
+                let k = k.trim();
+                (!k.is_empty() && !k.starts_with('#')).then(|| k.to_string())
+            });
+            err(e.span(), key, m)
         })?;
         let rotor_errors = match &raw.rotor_errors {
             None => RotorErrors::Shared,
@@ -413,18 +423,25 @@ impl Spacecraft {
     }
 
     /// The relative σ of the rotor momentum the file states, for the checks that compare
-    /// moves of the answer with its σ: `√Σ_i (s_i² + 2 θ_i²)`, `s_i` the relative σ of
-    /// the spin inertia and `θ_i` the axis tilt's, rad.
+    /// moves of the answer with its σ: `√(S + Σ_i 2 θ_i²)`, `θ_i` the axis tilt's σ, rad,
+    /// and `S` the spin inertias' part, `max_i s_i²` where their errors are shared (one
+    /// error) and `Σ_i s_i²` where independent (`s_i` the relative σ of each).
     #[must_use]
     pub fn stated_relative_sigma(&self) -> f64 {
-        self.rotors
+        let s2 = self
+            .rotors
             .iter()
-            .map(|r| {
-                let t = r.spin_axis_sigma_deg.to_radians();
-                r.relative_sigma() * r.relative_sigma() + 2.0 * t * t
-            })
-            .sum::<f64>()
-            .sqrt()
+            .map(|r| r.relative_sigma() * r.relative_sigma());
+        let inertia = match self.rotor_errors {
+            RotorErrors::Shared => s2.fold(0.0, f64::max),
+            RotorErrors::Independent => s2.sum(),
+        };
+        let tilts: f64 = self
+            .rotors
+            .iter()
+            .map(|r| 2.0 * r.spin_axis_sigma_deg.to_radians().powi(2))
+            .sum();
+        (inertia + tilts).sqrt()
     }
 }
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import warnings
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -270,8 +271,20 @@ class Telemetry:
         return f"<inertia.Telemetry: {len(self)} samples{src}, {gyro} gyro rates>"
 
     def to_dataframe(self):
-        """A pandas DataFrame with the CSV column names (``w_*`` only with rates)."""
+        """A pandas DataFrame with the CSV column names (``w_*`` only with rates).
+
+        ``rho`` is the rotor momentum as read; where a spacecraft file gave it from the
+        wheel speeds, their σ do not travel with the frame (a warning says so: estimate
+        the Telemetry itself to keep them). Where the attitude was integrated from the
+        gyro, ``q_*`` are those integrated quaternions."""
         pd = _pandas("Telemetry.to_dataframe")
+        if self._native.rotors_state() is not None:
+            warnings.warn(
+                "to_dataframe: rho holds the momentum from the wheel speeds, but the "
+                "spacecraft file's σ do not travel with the frame; estimate the Telemetry "
+                "itself to keep them",
+                stacklevel=2,
+            )
         cols: Dict[str, np.ndarray] = {"t": self.t}
         for name, block in (("q", self.q), ("rho", self.rho), ("tau", self.tau), ("w", self.w)):
             if block is None:

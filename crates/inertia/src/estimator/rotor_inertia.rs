@@ -16,9 +16,13 @@
 //!
 //! Each source's move `m_v = ĵ(z_v = 1) − ĵ` is measured on the estimator itself: the
 //! run's estimator (same settings, same samples, the run's wheel-speed time tag applied to
-//! each rotor's momentum as to the sum) is run once more with the momenta scaled by that
-//! 1σ error. It is a secant over one σ, so it includes what the estimator does (its
-//! stencil, chains, torque test, constraints). The consider term per element is
+//! each rotor's momentum as to the sum) is run once more with the momenta changed by that
+//! 1σ error, in the row model the run's own answer chose (rotation source, stencil, chain
+//! length, inertial torque, body torque held or estimated:
+//! `PipelineConfig::pinned_to`), so that the move is the answer's sensitivity and not a
+//! switch of model (without it, a streaming and a batch run of the same data gave moves
+//! 5× apart). It is a secant over one σ, so it includes what that model does (its
+//! constraints, its chains' momenta). The consider term per element is
 //!
 //! ```text
 //! c_k = √(Σ_v m_v,k²)
@@ -78,7 +82,8 @@ pub enum RotorInertiaError {
 /// The moves of `spacecraft`'s 1σ error sources ([module docs](self)) from the run's
 /// `samples`, the rotors' stored speeds `speeds` (`samples.len()` rows of one value per
 /// rotor, flat) and the wheel-speed time tag `delay_s` the run applied; `solve` runs the
-/// estimator over samples and gives its final answer.
+/// estimator over samples and gives its final answer, and is called first on `samples`
+/// themselves.
 pub fn consider(
     samples: &[Sample],
     speeds: &[f64],

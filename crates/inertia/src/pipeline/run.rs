@@ -28,7 +28,7 @@ use crate::estimator::wheel_delay::{self, DelayError, DelayFit, WheelDelay};
 use crate::estimator::Estimate;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
-use crate::telemetry::gate::{Field, Order, SampleError};
+use crate::telemetry::gate::Order;
 use crate::telemetry::held_speeds::HeldSpeeds;
 use std::collections::VecDeque;
 use std::vec::Vec;
@@ -149,10 +149,11 @@ impl Run {
 
     /// This run with a spacecraft file's rotors ([`crate::spacecraft`]): every sample's
     /// rotor momentum is computed from its rotors' speeds ([`Self::push_with_speeds`]),
-    /// and where a rotor's spin inertia has a σ the run keeps the samples until
+    /// and where a rotor's spin inertia or axis has a σ the run keeps the samples until
     /// [`Self::finish`], which measures their consider term by running the estimator once
-    /// more per such rotor, plus once ([`crate::estimator::rotor_inertia`]), and widens
-    /// σ by it.
+    /// more per error source (one for shared spin-inertia errors or one per rotor for
+    /// independent ones, two per tilted axis), plus once
+    /// ([`crate::estimator::rotor_inertia`]), and widens σ by it.
     #[must_use]
     pub fn with_spacecraft(mut self, spacecraft: Spacecraft) -> Self {
         if spacecraft.has_inertia_sigma() && matches!(self.mode, Mode::Streaming(_)) {
@@ -200,19 +201,13 @@ impl Run {
         let mut sample = *s;
         sample.rho_nms = rotors.momentum_nms(speeds);
         if let Err(e) = crate::sample::check_range(&sample) {
-            let (limit, unit) = e.quantity.limit();
-            let field = match e.quantity {
-                crate::sample::Quantity::Rho(i) => Field::Rho(i),
-                _ => Field::Time,
-            };
             return Err(RunError::at(
                 index,
-                RunErrorKind::Sample(SampleError::OutOfRange {
-                    field,
-                    value: e.value,
-                    limit,
-                    unit,
-                }),
+                RunErrorKind::RotorMomentumOutOfRange {
+                    value_nms: e.value,
+                    limit_nms: e.quantity.limit().0,
+                    columns: rotors.speed_columns().join(","),
+                },
             ));
         }
         let keep = rotors.has_inertia_sigma();
@@ -447,17 +442,27 @@ impl Run {
             Some(Ok(d)) => d.delay_s,
             _ => 0.0,
         };
-        let config = self.config.with_delay_applied();
+        // The first solve is the data's own; the later ones (the data changed by each
+        // error source) keep the row model it chose, so that they measure its
+        // sensitivity rather than a switch of model.
+        let mut config = self.config.with_delay_applied();
         let batch_mode = matches!(self.mode, Mode::Batch { .. });
+        let mut first = true;
         let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
-            if batch_mode {
-                return batch(s, &config).ok()?.estimate.j();
+            let (j, rows, torque) = if batch_mode {
+                let o = batch(s, &config).ok()?;
+                (o.estimate.j(), o.row_model, o.torque_test)
+            } else {
+                let mut p = Pipeline::from_config(config).ok()?;
+                for x in s {
+                    p.push_each(x, |_| {}).ok()?;
+                }
+                (p.last()?.j(), p.row_model(), p.torque_test())
+            };
+            if core::mem::take(&mut first) {
+                config = config.pinned_to(rows, torque);
             }
-            let mut p = Pipeline::from_config(config).ok()?;
-            for x in s {
-                p.push_each(x, |_| {}).ok()?;
-            }
-            p.last()?.j()
+            j
         };
         let c = rotor_inertia::consider(samples, &self.rotor_speeds, sc, delay_s, solve);
         match &c {
@@ -466,6 +471,8 @@ impl Run {
                 let r = sc.stated_relative_sigma();
                 let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
                 self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
+                // Now in the common scale's: not twice in the checks' reference σ.
+                self.config.rotor_inertia_relative_sigma = 0.0;
             }
         }
         self.rotor_consider = Some(c);

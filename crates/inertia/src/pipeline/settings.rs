@@ -151,6 +151,11 @@ pub struct PipelineConfig {
     pub(crate) rotor_inertia_consider: Option<[f64; 6]>,
     /// `√Σ_i s_i²` of a spacecraft file's rotors' relative spin-inertia σ (0 without).
     pub(crate) rotor_inertia_relative_sigma: f64,
+    /// One chain length for the discrete momentum estimator's candidates (`Some(None)`:
+    /// the whole record), in place of the choice among [`Self::max_chain_s`]'s: a run that
+    /// re-estimates perturbed data in the row model its answer used
+    /// ([`Self::pinned_to`]).
+    pub(crate) pinned_chain_s: Option<Option<f64>>,
 }
 
 fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(), PipelineError> {
@@ -335,6 +340,7 @@ impl PipelineSettings {
             wheel_delay_consider: None,
             rotor_inertia_consider: None,
             rotor_inertia_relative_sigma: 0.0,
+            pinned_chain_s: None,
         })
     }
 }
@@ -372,6 +378,39 @@ impl PipelineConfig {
         crate::math::sqrt(
             r * r + self.rotor_inertia_relative_sigma * self.rotor_inertia_relative_sigma,
         )
+    }
+
+    /// This configuration with the row model an answer used (`rows`, and whether its
+    /// constant torque was held at zero, `torque`) fixed instead of chosen from the data:
+    /// its rotation source, stencil, chain length, inertial torque, and the body torque
+    /// estimated or not. For re-running the estimator on slightly changed data (the
+    /// rotors' consider term, [`crate::estimator::rotor_inertia`]) so that the change
+    /// measures the answer's sensitivity, not a switch of the model.
+    #[must_use]
+    pub(crate) fn pinned_to(
+        mut self,
+        rows: Option<crate::estimator::momentum_rows::MomentumRowSettings>,
+        torque: Option<crate::estimator::discrete_momentum::TorqueTest>,
+    ) -> Self {
+        use crate::estimator::momentum_rows::Stencil;
+        let Some(r) = rows else {
+            return self;
+        };
+        self.rotation_source = Some(r.rotation);
+        self.rho_model = match r.stencil {
+            Stencil::Plain => RhoModel::Plain,
+            Stencil::Smooth => RhoModel::Smooth,
+            Stencil::Held => RhoModel::Held,
+            Stencil::Adaptive => RhoModel::Auto,
+        };
+        self.torque_bias = r.torque_bias && !torque.is_some_and(|t| t.held_at_zero);
+        self.inertial_torque = if r.inertial_torque {
+            InertialTorque::On
+        } else {
+            InertialTorque::Off
+        };
+        self.pinned_chain_s = Some(r.max_chain_s);
+        self
     }
 
     /// The estimator's registry entry.

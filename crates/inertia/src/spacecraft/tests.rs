@@ -68,9 +68,9 @@ fn bad_files_are_refused_with_file_line_and_key() {
         ("rotor_errors = \"independent\"", "rotor_errors = \"both\"", "sc.toml:2: `rotor_errors`: \"both\" is not one of"),
         ("rw2_speed", "rw1_speed", "sc.toml:16: `rotor[1].speed_column`: rotor[0] reads the same column"),
         ("name = \"rw2\"", "name = \"rw1\"", "sc.toml:13: `rotor[1].name`: rotor[0] has the same name"),
-        ("speed_unit = \"rpm\"", "speed_units = \"rpm\"", "sc.toml:10:"),
+        ("speed_unit = \"rpm\"", "speed_units = \"rpm\"", "sc.toml:10: `speed_units`: unknown field"),
         ("speed_column = \"rw2_speed\"", "", "missing field `speed_column`"),
-        ("spin_inertia_kg_m2 = 1.0e-3", "spin_inertia_kg_m2 = \"heavy\"", "sc.toml:7:"),
+        ("spin_inertia_kg_m2 = 1.0e-3", "spin_inertia_kg_m2 = \"heavy\"", "sc.toml:7: `spin_inertia_kg_m2`:"),
     ];
     for (from, to, expected) in cases {
         let text = GOOD.replace(from, to);

@@ -8,7 +8,7 @@
 //! | columns | meaning | required |
 //! |---|---|---|
 //! | `t` | time, s, or ISO-8601/RFC 3339 UTC time stamps (`2026-11-21T09:06:00.1Z`; converted to seconds since the first row) | yes |
-//! | `q_x,q_y,q_z,q_w` | attitude quaternion (see [`QuaternionFormat`]) | yes |
+//! | `q_x,q_y,q_z,q_w` | attitude quaternion (see [`QuaternionFormat`]) | yes, unless the file has gyro rates, no column that looks like a quaternion's, and no quaternion option or renamed quaternion column: the attitude is then integrated from the rates ([`GateOptions::attitude_from_gyro`](super::gate::GateOptions::attitude_from_gyro)) |
 //! | `rho_x,rho_y,rho_z` | total rotor angular momentum, N m s | yes |
 //! | `tau_x,tau_y,tau_z` | known external torque, N m | no (zero) |
 //! | `w_x,w_y,w_z` | gyro rate averaged over `[t_k, t_{k+1}]`, rad/s | for the finite-difference and momentum estimators |
@@ -248,8 +248,14 @@ impl<R: Read> TelemetryReader<R> {
             Ok(Some([need(&names[0])?, need(&names[1])?, need(&names[2])?]))
         };
         // No quaternion column at all, and gyro rates: the attitude is integrated from them.
-        let from_gyro =
-            c.q.iter().all(|n| find(n).is_none()) && c.w.iter().all(|n| find(n).is_some());
+        // Not where the user said anything about quaternions (a convention, renamed
+        // columns) or the header has columns that look like one under other names: then
+        // the missing column is the error, as without gyro rates.
+        let from_gyro = c.q.iter().all(|n| find(n).is_none())
+            && c.w.iter().all(|n| find(n).is_some())
+            && options.quaternion == QuaternionFormat::default()
+            && c.q == ColumnNames::default().q
+            && !headers.iter().any(|h| looks_like_quaternion(h));
         let idx = Indices {
             t: need(&c.t)?,
             q: if from_gyro {
@@ -527,6 +533,13 @@ impl<R: Read> TelemetryReader<R> {
                 source,
             })
     }
+}
+
+/// Whether a header names what may be a quaternion component (`qx`, `q0`, `q_s`,
+/// `quat_w`, …): a file with such a column is not read as gyro-only.
+fn looks_like_quaternion(header: &str) -> bool {
+    let h = header.to_ascii_lowercase();
+    h.contains("quat") || (h.starts_with('q') && h.len() <= 4)
 }
 
 /// The reader's error for a CSV error: a line over the limit, an I/O failure, or a

@@ -292,7 +292,8 @@ pub struct GateOptions {
     pub gyro_unit: GyroUnit,
     /// No quaternions are given (a front end's input has no attitude): the attitude is
     /// integrated from the gyro rates instead, `q_0 = 1` and `q_{k+1} = q_k ⊗ exp(ω̄_k
-    /// h_k)` with `ω̄_k` the rate averaged over `[t_k, t_{k+1}]` (exact for that rate;
+    /// h_k)` with `ω̄_k` the rate averaged over `[t_k, t_{k+1}]` (exact for a rate
+    /// constant over the step, no coning correction;
     /// the inertial frame is the first sample's body frame, which the momentum rows do not
     /// care about), and every sample must have a rate ([`SampleError::NoAttitude`]). The
     /// attitude then drifts with the gyro's noise; [`RawSample::q`] is ignored. Default

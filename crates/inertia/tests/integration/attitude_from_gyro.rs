@@ -134,4 +134,21 @@ fn without_quaternions_every_row_needs_its_rates() {
         .expect("refused")
         .to_string();
     assert!(e.contains("missing column `q_w`"), "{e}");
+    // Quaternions under other names, or a quaternion convention given: not gyro-only,
+    // the missing column is named.
+    let renamed = text.replacen("t,", "t,qx,qy,qz,qw,", 1);
+    let e = TelemetryReader::new(renamed.as_bytes(), "gyro.csv", CsvOptions::default())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("missing column `q_x`"), "{e}");
+    let jpl = CsvOptions {
+        quaternion: inertia::telemetry::csv::QuaternionFormat::Jpl,
+        ..CsvOptions::default()
+    };
+    let e = TelemetryReader::new(text.as_bytes(), "gyro.csv", jpl)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("missing column `q_x`"), "{e}");
 }

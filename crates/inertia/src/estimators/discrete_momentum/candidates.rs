@@ -32,14 +32,15 @@ pub(super) fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowS
     };
     // Short chains, long ones, and the whole record as one chain: the data choose
     // ([`choose`]).
-    let chains: Vec<Option<f64>> = match c.max_chain_s {
-        Some(l) => std::vec![
+    let chains: Vec<Option<f64>> = match (c.pinned_chain_s, c.max_chain_s) {
+        (Some(chain), _) => std::vec![chain],
+        (None, Some(l)) => std::vec![
             Some(l / SHORT_CHAIN_DIVISOR),
             Some(l),
             Some(LONG_CHAIN_FACTOR * l),
             None
         ],
-        None => std::vec![None],
+        (None, None) => std::vec![None],
     };
     let inertial: &[bool] = match c.inertial_torque {
         InertialTorque::Off => &[false],

@@ -64,6 +64,16 @@ pub enum RunErrorKind {
         /// The rotors' names, comma-separated.
         names: std::string::String,
     },
+    /// The rotor momentum the wheel speeds give is outside the supported range.
+    #[error("the rotor momentum from the wheel speeds (columns {columns}) is {} N m s on one axis, outside the supported range (magnitude at most {} N m s): check the speeds' unit and the spin inertias", Num(*.value_nms), Num(*.limit_nms))]
+    RotorMomentumOutOfRange {
+        /// The component, N m s.
+        value_nms: f64,
+        /// The largest magnitude supported, N m s.
+        limit_nms: f64,
+        /// The speed columns, comma-separated.
+        columns: std::string::String,
+    },
     /// An earlier error stopped the run.
     #[error("the run stopped on an earlier error ({0}); start a new one")]
     Stopped(std::string::String),
@@ -155,6 +165,7 @@ impl RunError {
         match &self.kind {
             RunErrorKind::NeedsGyro { .. } => ErrorKind::NeedsGyro,
             RunErrorKind::RotorSpeeds { .. } => ErrorKind::Columns,
+            RunErrorKind::RotorMomentumOutOfRange { .. } => ErrorKind::OutOfRange,
             RunErrorKind::Sample(e) => e.error_kind(),
             RunErrorKind::MemoryShorterThanStep { .. } => ErrorKind::MemoryShorterThanStep,
             RunErrorKind::TooFewSamples { .. } => ErrorKind::TooFewSamples,
