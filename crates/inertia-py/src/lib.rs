@@ -396,7 +396,7 @@ fn read(
 /// Rows of float64 arrays, checked for shape against `t`.
 pub fn rows(
     t: &PyReadonlyArrayDyn<'_, f64>,
-    q: &PyReadonlyArrayDyn<'_, f64>,
+    q: Option<&PyReadonlyArrayDyn<'_, f64>>,
     rho: &PyReadonlyArrayDyn<'_, f64>,
     tau: Option<&PyReadonlyArrayDyn<'_, f64>>,
     w: Option<&PyReadonlyArrayDyn<'_, f64>>,
@@ -419,9 +419,11 @@ pub fn rows(
             }
             Ok(())
         };
-    let q = q.as_array();
+    let q = q.map(|a| a.as_array());
     let rho = rho.as_array();
-    check("q", &q, 4)?;
+    if let Some(a) = &q {
+        check("q", a, 4)?;
+    }
     check("rho", &rho, 3)?;
     let tau = tau.map(|a| a.as_array());
     let w = w.map(|a| a.as_array());
@@ -436,7 +438,10 @@ pub fn rows(
     Ok((0..n)
         .map(|i| Row {
             t: t[[i]],
-            q: [q[[i, 0]], q[[i, 1]], q[[i, 2]], q[[i, 3]]],
+            // Without quaternions the gate integrates the gyro and ignores these.
+            q: q.as_ref().map_or([0.0, 0.0, 0.0, 1.0], |q| {
+                [q[[i, 0]], q[[i, 1]], q[[i, 2]], q[[i, 3]]]
+            }),
             rho: three(&rho, i),
             tau: tau.as_ref().map(|a| three(a, i)),
             w: w.as_ref().map(|a| three(a, i)),
@@ -466,7 +471,7 @@ fn check_rows(
 fn estimate_arrays<'py>(
     py: Python<'py>,
     t: PyReadonlyArrayDyn<'py, f64>,
-    q: PyReadonlyArrayDyn<'py, f64>,
+    q: Option<PyReadonlyArrayDyn<'py, f64>>,
     rho: PyReadonlyArrayDyn<'py, f64>,
     tau: Option<PyReadonlyArrayDyn<'py, f64>>,
     w: Option<PyReadonlyArrayDyn<'py, f64>>,
@@ -475,11 +480,14 @@ fn estimate_arrays<'py>(
     label: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let kw = Kwargs::new(kwargs, py, "estimate")?;
-    let conv = settings::convention(&kw)?;
+    let mut conv = settings::convention(&kw)?;
+    if q.is_none() {
+        conv = conv.without_quaternions()?;
+    }
     let s = settings::run(&kw)?;
     kw.finish()?;
     let config = s.pipeline.validate().map_err(settings::settings_error)?;
-    let rows = rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
+    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
     let naming = match frame_columns {
         Some(c) if c.len() == 14 => Naming::Frame(c),
         Some(_) => return Err(value_error("frame_columns: expected 14 names")),
@@ -504,16 +512,19 @@ fn estimate_arrays<'py>(
 fn samples_from_arrays<'py>(
     py: Python<'py>,
     t: PyReadonlyArrayDyn<'py, f64>,
-    q: PyReadonlyArrayDyn<'py, f64>,
+    q: Option<PyReadonlyArrayDyn<'py, f64>>,
     rho: PyReadonlyArrayDyn<'py, f64>,
     tau: Option<PyReadonlyArrayDyn<'py, f64>>,
     w: Option<PyReadonlyArrayDyn<'py, f64>>,
     kwargs: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Telemetry> {
     let kw = Kwargs::new(kwargs, py, "Telemetry")?;
-    let conv = settings::convention(&kw)?;
+    let mut conv = settings::convention(&kw)?;
+    if q.is_none() {
+        conv = conv.without_quaternions()?;
+    }
     kw.finish()?;
-    let rows = rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
+    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
     let (samples, stats) = py
         .allow_threads(|| check_rows(&rows, &conv, &Naming::Arrays))
         .map_err(|f| f.into_py(py))?;
@@ -546,7 +557,7 @@ fn restore<'py>(
     label: String,
     rotors: Option<(String, String, PyReadonlyArrayDyn<'py, f64>)>,
 ) -> PyResult<Telemetry> {
-    let rows = rows(&t, &q, &rho, Some(&tau), w.as_ref())?;
+    let rows = rows(&t, Some(&q), &rho, Some(&tau), w.as_ref())?;
     let rotors = rotors
         .map(|(text, name, speeds)| -> PyResult<Rotors> {
             let spacecraft = inertia::spacecraft::Spacecraft::parse(&text, &name)

@@ -100,7 +100,7 @@ impl Checker {
                 period_tolerance: c.period_tolerance,
                 negate_rho: c.negate_rho,
                 gyro_unit: c.gyro_unit,
-                attitude_from_gyro: false,
+                attitude_from_gyro: c.attitude_from_gyro,
             }),
         }
     }

@@ -29,6 +29,24 @@ pub struct Convention {
     pub negate_rho: bool,
     /// The unit of the gyro rates (`--gyro-unit`).
     pub gyro_unit: GyroUnit,
+    /// No quaternions: the attitude is integrated from the gyro rates
+    /// (`GateOptions::attitude_from_gyro`).
+    pub attitude_from_gyro: bool,
+}
+
+impl Convention {
+    /// This convention for arrays without quaternions (`q=None`): the attitude is
+    /// integrated from the gyro rates; a quaternion convention given with them is an
+    /// argument error, not silently ignored.
+    pub fn without_quaternions(mut self) -> PyResult<Self> {
+        if self.format != QuaternionFormat::HamiltonScalarLast {
+            return Err(value_error(
+                "q=None: without quaternions the attitude is integrated from the gyro rates w; scalar_first, jpl and conjugate describe quaternions that were not given",
+            ));
+        }
+        self.attitude_from_gyro = true;
+        Ok(self)
+    }
 }
 
 impl Default for Convention {
@@ -39,6 +57,7 @@ impl Default for Convention {
             period_tolerance: None,
             negate_rho: false,
             gyro_unit: GyroUnit::RadPerS,
+            attitude_from_gyro: false,
         }
     }
 }

@@ -103,7 +103,7 @@ impl Stream {
         tau: Option<PyReadonlyArrayDyn<'py, f64>>,
         w: Option<PyReadonlyArrayDyn<'py, f64>>,
     ) -> PyResult<usize> {
-        let rows = crate::rows(&t, &q, &rho, tau.as_ref(), w.as_ref())?;
+        let rows = crate::rows(&t, Some(&q), &rho, tau.as_ref(), w.as_ref())?;
         let mut guard = self.lock()?;
         let st: &mut State = &mut guard;
         py.allow_threads(|| {

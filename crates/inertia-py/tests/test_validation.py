@@ -45,8 +45,10 @@ def test_types_name_the_argument(tel):
         inertia.estimate(pos[0], np.full((len(pos[0]), 4), "a"), pos[2])
     with pytest.raises(TypeError, match="^rho: expected an array of numbers"):
         inertia.estimate(pos[0], pos[1], object())
-    with pytest.raises(TypeError, match="q and rho are required"):
+    with pytest.raises(TypeError, match="rho is required with an array t"):
         inertia.estimate(pos[0])
+    with pytest.raises(TypeError, match="and q unless w is given"):
+        inertia.estimate(pos[0], None, pos[2])
     with pytest.raises(TypeError, match="memory: expected a number"):
         inertia.estimate(*pos, **kw, memory="long")
     with pytest.raises(TypeError, match="every: expected an integer"):

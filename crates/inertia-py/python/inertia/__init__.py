@@ -389,7 +389,7 @@ def _float_array(name: str, x: Any, shape: str) -> np.ndarray:
 def _arrays(t, q, rho, tau, w):
     return (
         _float_array("t", t, "(N,)"),
-        _float_array("q", q, "(N, 4)"),
+        None if q is None else _float_array("q", q, "(N, 4)"),
         _float_array("rho", rho, "(N, 3)"),
         None if tau is None else _float_array("tau", tau, "(N, 3)"),
         None if w is None else _float_array("w", w, "(N, 3)"),
@@ -516,7 +516,8 @@ def estimate(
 
     * arrays ``t`` (N,) s, ``q`` (N, 4), ``rho`` (N, 3) N m s, and optionally
       ``tau=`` (N, 3) N m (known external torque) and ``w=`` (N, 3) rad/s (gyro rate
-      averaged over [t_k, t_{k+1}]);
+      averaged over [t_k, t_{k+1}]); ``q=None`` with ``w=``: the attitude is integrated
+      from the gyro rates (as for a file without quaternion columns);
     * a pandas DataFrame with the CSV column names (``t``, ``q_x`` …, renamed by
       ``columns=``), as the only positional argument;
     * a :class:`Telemetry` (from :func:`read_csv` or :func:`simulate`);
@@ -610,8 +611,11 @@ def estimate(
                 *arrays, kwargs={**settings, **conventions}, frame_columns=names, label="<DataFrame>"
             )
         )
-    if q is None or rho is None:
-        raise TypeError("estimate(t, q, rho): q and rho are required with an array t")
+    if rho is None or (q is None and w is None):
+        raise TypeError(
+            "estimate(t, q, rho): rho is required with an array t, and q unless w is given "
+            "(q=None: the attitude is integrated from the gyro rates)"
+        )
     return Estimate._from_native(
         _inertia.estimate_arrays(*_arrays(t, q, rho, tau, w), kwargs={**settings, **conventions})
     )

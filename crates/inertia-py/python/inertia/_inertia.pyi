@@ -37,7 +37,7 @@ class Stream:
 def read_csv(path: str, kwargs: Optional[Dict[str, Any]] = ...) -> Telemetry: ...
 def estimate_arrays(
     t: np.ndarray,
-    q: np.ndarray,
+    q: Optional[np.ndarray],
     rho: np.ndarray,
     tau: Optional[np.ndarray] = ...,
     w: Optional[np.ndarray] = ...,
@@ -47,7 +47,7 @@ def estimate_arrays(
 ) -> _Result: ...
 def samples_from_arrays(
     t: np.ndarray,
-    q: np.ndarray,
+    q: Optional[np.ndarray],
     rho: np.ndarray,
     tau: Optional[np.ndarray] = ...,
     w: Optional[np.ndarray] = ...,
