@@ -28,8 +28,9 @@ use inertia::estimator::Estimate;
 use inertia::pipeline::{PipelineSettings, Run};
 use inertia::sample::Sample;
 use inertia::sim::presets::Preset;
+use inertia::sim::rotors::pyramid;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::spacecraft::{Rotor, RotorErrors, Spacecraft, SpeedUnit};
+use inertia::spacecraft::{RotorErrors, Spacecraft};
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::Matrix3;
 use rand::SeedableRng;
@@ -37,25 +38,6 @@ use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
 const TRUE_J: [f64; 4] = [1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3];
-
-fn pyramid(j: [f64; 4], sigma: f64, errors: RotorErrors) -> Spacecraft {
-    let (c, s) = (2f64.sqrt() / 3f64.sqrt(), 1.0 / 3f64.sqrt());
-    let axes = [[c, 0.0, s], [0.0, c, s], [-c, 0.0, s], [0.0, -c, s]];
-    Spacecraft {
-        rotors: (0..4)
-            .map(|i| Rotor {
-                name: format!("rw{}", i + 1),
-                axis: axes[i],
-                spin_inertia_kg_m2: j[i],
-                spin_inertia_sigma_kg_m2: sigma * j[i],
-                spin_axis_sigma_deg: 0.0,
-                speed_column: format!("rw{}_rpm", i + 1),
-                speed_unit: SpeedUnit::Rpm,
-            })
-            .collect(),
-        rotor_errors: errors,
-    }
-}
 
 fn run(samples: &[Sample], speeds: &[f64], sc: Spacecraft) -> Option<Estimate> {
     let config = PipelineSettings::default().validate().ok()?;

@@ -89,25 +89,6 @@ pub fn consider(
     speeds: &[f64],
     spacecraft: &Spacecraft,
     delay_s: f64,
-    solve: impl FnMut(&[Sample]) -> Option<InertiaVector>,
-) -> Result<RotorInertiaConsider, RotorInertiaError> {
-    consider_with(
-        samples,
-        speeds,
-        spacecraft,
-        delay_s,
-        sources(spacecraft),
-        solve,
-    )
-}
-
-/// [`consider`] over the given error `sources`.
-fn consider_with(
-    samples: &[Sample],
-    speeds: &[f64],
-    spacecraft: &Spacecraft,
-    delay_s: f64,
-    sources: Vec<Source>,
     mut solve: impl FnMut(&[Sample]) -> Option<InertiaVector>,
 ) -> Result<RotorInertiaConsider, RotorInertiaError> {
     let m = spacecraft.rotors.len();
@@ -121,6 +102,7 @@ fn consider_with(
         .iter()
         .map(crate::spacecraft::Rotor::relative_sigma)
         .collect();
+    let sources = sources(spacecraft);
     if sources.is_empty() {
         return Err(RotorInertiaError::NotComputable("no rotor has a σ"));
     }

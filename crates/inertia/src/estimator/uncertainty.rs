@@ -76,12 +76,9 @@ impl Uncertainty {
     /// moments of `j` as [`with_bias`] does.
     #[must_use]
     pub fn with_time_tag(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
-        let widened = with_bias(&self.sigma_kg_m2, c, j);
         Uncertainty {
-            sigma_kg_m2: widened.sigma_kg_m2,
-            principal_sigma_kg_m2: widened.principal_sigma_kg_m2,
             time_tag_kg_m2: *c,
-            ..*self
+            ..self.with_consider(j, c)
         }
     }
 
@@ -90,11 +87,19 @@ impl Uncertainty {
     /// moments of `j` as [`with_bias`] does.
     #[must_use]
     pub fn with_rotor_inertia(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
+        Uncertainty {
+            rotor_inertia_kg_m2: *c,
+            ..self.with_consider(j, c)
+        }
+    }
+
+    /// This σ widened by a consider term `c` per element, `√(σ² + c²)`, and the principal
+    /// moments' σ of `j` from it ([`with_bias`]); the parts are the caller's to record.
+    fn with_consider(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
         let widened = with_bias(&self.sigma_kg_m2, c, j);
         Uncertainty {
             sigma_kg_m2: widened.sigma_kg_m2,
             principal_sigma_kg_m2: widened.principal_sigma_kg_m2,
-            rotor_inertia_kg_m2: *c,
             ..*self
         }
     }

@@ -11,9 +11,37 @@
 
 use super::SimError;
 use crate::sample::Sample;
-use crate::spacecraft::Spacecraft;
+use crate::spacecraft::{Rotor, RotorErrors, Spacecraft, SpeedUnit};
 use nalgebra::{Matrix3, Vector3};
 use std::vec::Vec;
+
+/// A four-wheel pyramid, the usual reaction-wheel layout: axes 35.26° from the body z
+/// axis, at azimuths 0°, 90°, 180°, 270° (`rw1` … `rw4`); speeds in rpm in columns
+/// `rw1_rpm` …; spin inertias `spin_inertia_kg_m2`, each ± `relative_sigma` of itself,
+/// their errors related as `errors`; axes exact.
+#[must_use]
+pub fn pyramid(
+    spin_inertia_kg_m2: [f64; 4],
+    relative_sigma: f64,
+    errors: RotorErrors,
+) -> Spacecraft {
+    let (c, s) = ((2.0f64 / 3.0).sqrt(), (1.0f64 / 3.0).sqrt());
+    let axes = [[c, 0.0, s], [0.0, c, s], [-c, 0.0, s], [0.0, -c, s]];
+    Spacecraft {
+        rotors: (0..4)
+            .map(|i| Rotor {
+                name: std::format!("rw{}", i + 1),
+                axis: axes[i],
+                spin_inertia_kg_m2: spin_inertia_kg_m2[i],
+                spin_inertia_sigma_kg_m2: relative_sigma * spin_inertia_kg_m2[i],
+                spin_axis_sigma_deg: 0.0,
+                speed_column: std::format!("rw{}_rpm", i + 1),
+                speed_unit: SpeedUnit::Rpm,
+            })
+            .collect(),
+        rotor_errors: errors,
+    }
+}
 
 /// The rotors' stored speeds for each sample (flat: one row of `m` per sample), from each
 /// sample's rotor momentum, with the true spin inertias of `spacecraft`.

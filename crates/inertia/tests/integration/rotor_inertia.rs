@@ -9,32 +9,12 @@ use inertia::estimator::observability::Observability;
 use inertia::estimator::Estimate;
 use inertia::pipeline::{PipelineSettings, Run, RunErrorKind};
 use inertia::sample::Sample;
+use inertia::sim::rotors::pyramid;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::spacecraft::{Rotor, RotorErrors, Spacecraft, SpeedUnit};
+use inertia::spacecraft::{RotorErrors, Spacecraft};
 use nalgebra::Matrix3;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-
-/// A four-wheel pyramid (axes 35.26° from the body z axis), speeds in rpm, spin
-/// inertias `j` (kg m²) each ± `sigma` (relative).
-fn pyramid(j: [f64; 4], sigma: f64, errors: RotorErrors) -> Spacecraft {
-    let (c, s) = (2f64.sqrt() / 3f64.sqrt(), 1.0 / 3f64.sqrt());
-    let axes = [[c, 0.0, s], [0.0, c, s], [-c, 0.0, s], [0.0, -c, s]];
-    Spacecraft {
-        rotors: (0..4)
-            .map(|i| Rotor {
-                name: format!("rw{}", i + 1),
-                axis: axes[i],
-                spin_inertia_kg_m2: j[i],
-                spin_inertia_sigma_kg_m2: sigma * j[i],
-                spin_axis_sigma_deg: 0.0,
-                speed_column: format!("rw{}_rpm", i + 1),
-                speed_unit: SpeedUnit::Rpm,
-            })
-            .collect(),
-        rotor_errors: errors,
-    }
-}
 
 const TRUE_J: [f64; 4] = [1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3];
 
