@@ -387,8 +387,8 @@ fn estimate(
     }
     Some(Outcome {
         estimate: p.last().copied(),
-        residual_ratio: p.residual_consistency().map(|w| w.ratio),
-        density_ratio: p.gyro_density_ratio(),
+        residual_ratio: p.diagnostics().residual_consistency.map(|w| w.ratio),
+        density_ratio: p.diagnostics().gyro_density_ratio,
     })
 }
 

@@ -2,5 +2,7 @@
 //! state and its push at the folder's root (`mod.rs`), each job of the estimator in a
 //! file of its own beside it.
 
+pub(crate) mod constrained;
 pub(crate) mod discrete_momentum;
 pub(crate) mod equation_error;
+pub(crate) mod momentum_rls;

@@ -45,10 +45,9 @@
 //! ```
 
 mod checks;
-mod momentum;
+mod diagnostics;
 pub mod registry;
 mod run;
-mod sdp;
 mod settings;
 pub mod status;
 
@@ -57,17 +56,17 @@ pub mod history;
 #[cfg(feature = "serde")]
 pub mod report;
 
+pub use crate::estimators::constrained::Constrained;
 pub use checks::AttitudeChecks;
+pub use diagnostics::Diagnostics;
 pub(crate) use registry::Estimator;
 pub use registry::{BatchOutput, Capabilities};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
-pub use sdp::Constrained;
 pub use settings::{
     parse_wheel_delay, InertialTorque, PipelineConfig, PipelineSettings, DEFAULT_MAX_CHAIN_S,
 };
 
 use crate::constraints::ConstraintError;
-use crate::estimator::excitation::Excitation;
 use crate::estimator::resample::Resampler;
 use crate::estimator::{Estimate, EstimatorError, InvalidArgument};
 use crate::fix::Fix;
@@ -447,68 +446,11 @@ impl Pipeline {
         self.last.as_ref()
     }
 
-    /// The row model in use, for estimators that choose one from the data.
+    /// What the estimator can say about the run at its latest estimate: gaps, excitation,
+    /// row model, torque and residual tests ([`Diagnostics`]).
     #[must_use]
-    pub fn row_model(&self) -> Option<crate::estimator::momentum_rows::MomentumRowSettings> {
-        self.estimator.row_model()
-    }
-
-    /// The estimated constant body-frame disturbance torque, N m, where estimated.
-    #[must_use]
-    pub fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
-        self.estimator.torque_bias_nm()
-    }
-
-    /// The test for a constant disturbance torque at the last solve, where made: whether
-    /// the torque was held at zero for want of evidence.
-    #[must_use]
-    pub fn torque_test(&self) -> Option<crate::estimator::discrete_momentum::TorqueTest> {
-        self.estimator.torque_test()
-    }
-
-    /// The span of the record whose residuals stand out most from the rest, with their
-    /// variance ratio ([`crate::estimator::consistency`]; estimators that test their
-    /// residuals, without forgetting).
-    #[must_use]
-    pub fn residual_consistency(&self) -> Option<crate::estimator::consistency::Worst> {
-        self.estimator.residual_consistency()
-    }
-
-    /// At the last solve with a stated gyro density, the residual variance over the part
-    /// that density alone implies (below
-    /// [`crate::estimator::consistency::DENSITY_OVERSTATED_RATIO`] the density is
-    /// overstated).
-    #[must_use]
-    pub fn gyro_density_ratio(&self) -> Option<f64> {
-        self.estimator.gyro_density_ratio()
-    }
-
-    /// With an attitude drift stated: whether the last answer came from the rows weighted
-    /// for it (`registry::Estimator::drift_weighted`).
-    #[must_use]
-    pub fn drift_weighted(&self) -> Option<bool> {
-        self.estimator.drift_weighted()
-    }
-
-    /// With both rotation sources in play (gyro rates in the telemetry, no
-    /// `rotation_source` set): whether the attitude was found to be the gyro's own
-    /// integral, whose rows are then not folded twice
-    /// (`registry::Estimator::attitude_is_gyro_integral`); `None` until decided.
-    #[must_use]
-    pub fn attitude_is_gyro_integral(&self) -> Option<bool> {
-        self.estimator.attitude_is_gyro_integral()
-    }
-
-    /// The excitation report of the data so far (estimators with a least-squares state).
-    #[must_use]
-    pub fn excitation(&self) -> Option<Excitation> {
-        self.estimator.excitation()
-    }
-
-    /// Gaps in the time stamps seen by the estimator.
-    #[must_use]
-    pub fn gaps(&self) -> usize {
-        self.estimator.gaps()
+    pub fn diagnostics(&self) -> Diagnostics {
+        self.estimator.diagnostics()
     }
 
     /// Input samples fed.

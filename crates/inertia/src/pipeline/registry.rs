@@ -3,66 +3,20 @@
 //! Adding a row model, an estimator or a backend is its own file plus one line in
 //! [`ESTIMATORS`] or [`BACKENDS`].
 
+use super::diagnostics::Diagnostics;
 use super::settings::PipelineConfig;
 use super::PipelineError;
-use crate::estimator::consistency::Worst;
-use crate::estimator::excitation::Excitation;
-use crate::estimator::momentum_rows::MomentumRowSettings;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use std::boxed::Box;
 
-/// A streaming estimator as the pipeline drives it.
+/// A streaming estimator as the pipeline drives it: what every estimator has.
 pub(crate) trait Estimator: Send {
     /// Feed one sample; an estimate when one is due.
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError>;
-    /// Gaps in the time stamps seen so far (no row spans a gap).
-    fn gaps(&self) -> usize {
-        0
-    }
-    /// How well the data so far excite each direction of `j`, where the estimator can
-    /// say.
-    fn excitation(&self) -> Option<Excitation> {
-        None
-    }
-    /// The row model in use, for estimators that choose one.
-    fn row_model(&self) -> Option<MomentumRowSettings> {
-        None
-    }
-    /// The estimated constant body-frame disturbance torque, N m, where estimated.
-    fn torque_bias_nm(&self) -> Option<nalgebra::Vector3<f64>> {
-        None
-    }
-    /// The test for a constant disturbance torque at the last solve, where the estimator
-    /// makes it ([`crate::estimator::discrete_momentum::torque_tested`]).
-    fn torque_test(&self) -> Option<crate::estimator::discrete_momentum::TorqueTest> {
-        None
-    }
-    /// The span of the record whose residuals stand out most, where the estimator tests
-    /// its residuals ([`crate::estimator::consistency`]).
-    fn residual_consistency(&self) -> Option<Worst> {
-        None
-    }
-    /// At the last solve with a stated gyro density, the residual variance over the part
-    /// that density alone implies ([`crate::estimator::consistency::gyro_density_ratio`]).
-    fn gyro_density_ratio(&self) -> Option<f64> {
-        None
-    }
-    /// With an attitude drift stated ([`super::PipelineSettings::attitude_drift_deg_rth`]):
-    /// whether the answer of the last solve came from the rows weighted for it
-    /// (`false`: from the unweighted rows, whose bias σ exceeded their noise σ; or no
-    /// answer yet to weight with, or none within the samples kept to refold). `None`
-    /// without a drift stated.
-    fn drift_weighted(&self) -> Option<bool> {
-        None
-    }
-    /// With both rotation sources in play: whether the attitude was found to be the
-    /// gyro's own integral, so that only the gyro's rows are folded (README, "Attitude
-    /// against gyro"); `None` until the test has decided, or without both sources.
-    fn attitude_is_gyro_integral(&self) -> Option<bool> {
-        None
-    }
+    /// What the estimator can say about its run at its latest estimate.
+    fn diagnostics(&self) -> Diagnostics;
 }
 
 /// The answer of a batch run.
@@ -70,21 +24,8 @@ pub(crate) trait Estimator: Send {
 pub struct BatchOutput {
     /// The estimate from all samples.
     pub estimate: Estimate,
-    /// The excitation report of the same least-squares state.
-    pub excitation: Option<Excitation>,
-    /// Gaps in the time stamps.
-    pub gaps: usize,
-    /// The row model used, for estimators that choose one.
-    pub row_model: Option<MomentumRowSettings>,
-    /// The residual variance over the part the stated gyro density alone implies, where
-    /// the estimator makes that test (`Estimator::gyro_density_ratio`).
-    pub gyro_density_ratio: Option<f64>,
-    /// The test for a constant disturbance torque, for estimators that make it
-    /// ([`crate::estimator::discrete_momentum::torque_tested`]).
-    pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
-    /// Whether the attitude was found to be the gyro's own integral, for estimators that
-    /// make that test (`Estimator::attitude_is_gyro_integral`).
-    pub attitude_is_gyro_integral: Option<bool>,
+    /// What the estimator can say about the run.
+    pub diagnostics: Diagnostics,
 }
 
 /// What an estimator uses and needs.
@@ -158,10 +99,10 @@ pub struct BackendEntry {
 
 /// Every estimator, the default first.
 pub static ESTIMATORS: &[EstimatorEntry] = &[
-    super::sdp::VARIATIONAL,
+    crate::estimators::constrained::VARIATIONAL,
     crate::estimators::discrete_momentum::DISCRETE_MOMENTUM,
-    super::sdp::FINITE_DIFFERENCE,
-    super::momentum::MOMENTUM,
+    crate::estimators::constrained::FINITE_DIFFERENCE,
+    crate::estimators::momentum_rls::MOMENTUM,
     crate::estimators::equation_error::EQUATION_ERROR,
 ];
 

@@ -18,6 +18,7 @@
 
 mod text;
 
+use super::diagnostics::Diagnostics;
 use super::settings::PipelineConfig;
 use super::status::{PhysicalMargin, PHYSICAL_Z};
 use crate::constraints::ActiveBound;
@@ -324,14 +325,13 @@ fn rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
 
 impl Report {
     /// The report of `estimate`, produced by a pipeline with `config` from `samples`
-    /// samples with `gaps` gaps.
+    /// samples (the estimator's diagnostics: [`Self::with_diagnostics`]).
     #[must_use]
     pub(crate) fn new(
         estimate: &Estimate,
         config: &PipelineConfig,
         batch: bool,
         samples: usize,
-        gaps: usize,
     ) -> Self {
         let m = estimate.inertia();
         let pr = m.map(|m| principal(&m));
@@ -348,7 +348,7 @@ impl Report {
             constraints: config.constraints().set().consistency.name(),
             batch,
             samples,
-            gaps,
+            gaps: 0,
             t: estimate.t_s,
             status: estimate.observability.code(),
             reason: estimate.observability.reason().map(|r| r.to_string()),
@@ -538,13 +538,8 @@ impl Report {
     pub fn of_pipeline(p: &super::Pipeline) -> Option<Self> {
         let last = p.last()?;
         Some(
-            Self::new(last, p.config(), false, p.estimator_samples(), p.gaps())
-                .with_excitation(p.excitation())
-                .with_row_model(p.row_model(), p.torque_bias_nm())
-                .with_torque_test(p.torque_test())
-                .with_drift_weighted(p.drift_weighted())
-                .with_attitude_is_gyro_integral(p.attitude_is_gyro_integral())
-                .with_residual_tests(p.residual_consistency(), p.gyro_density_ratio())
+            Self::new(last, p.config(), false, p.estimator_samples())
+                .with_diagnostics(p.diagnostics())
                 .with_glitches(Some(p.glitches()))
                 .with_attitude_check(p.attitude_check()),
         )
@@ -553,12 +548,7 @@ impl Report {
     /// The report of a batch run over `samples` samples.
     #[must_use]
     pub fn of_batch(out: &super::BatchOutput, config: &PipelineConfig, samples: usize) -> Self {
-        Self::new(&out.estimate, config, true, samples, out.gaps)
-            .with_excitation(out.excitation.clone())
-            .with_row_model(out.row_model, None)
-            .with_torque_test(out.torque_test)
-            .with_residual_tests(None, out.gyro_density_ratio)
-            .with_attitude_is_gyro_integral(out.attitude_is_gyro_integral)
+        Self::new(&out.estimate, config, true, samples).with_diagnostics(out.diagnostics.clone())
     }
 
     /// With the input summary.
@@ -569,60 +559,19 @@ impl Report {
         self
     }
 
-    /// With the excitation report.
+    /// With the estimator's diagnostics: gaps, excitation, row model and torque, the
+    /// residual tests.
     #[must_use]
-    pub(crate) fn with_excitation(mut self, excitation: Option<Excitation>) -> Self {
-        self.excitation = excitation;
-        self.refreshed()
-    }
-
-    /// With the row model and the estimated disturbance torque (N m), where the estimator
-    /// has them.
-    #[must_use]
-    pub(crate) fn with_row_model(
-        mut self,
-        row_model: Option<MomentumRowSettings>,
-        torque_bias_nm: Option<nalgebra::Vector3<f64>>,
-    ) -> Self {
-        self.row_model = row_model;
-        self.torque_bias_nm = torque_bias_nm.map(|t| [t.x, t.y, t.z]);
-        self
-    }
-
-    /// With the test for a constant disturbance torque, where the estimator makes it.
-    #[must_use]
-    pub(crate) fn with_torque_test(
-        mut self,
-        test: Option<crate::estimator::discrete_momentum::TorqueTest>,
-    ) -> Self {
-        self.torque_test = test;
-        self
-    }
-
-    /// With whether the attitude was found to be the gyro's own integral.
-    #[must_use]
-    pub(crate) fn with_attitude_is_gyro_integral(mut self, same: Option<bool>) -> Self {
-        self.attitude_is_gyro_integral = same;
-        self
-    }
-
-    /// With whether the answer came from the rows weighted for a stated attitude drift.
-    #[must_use]
-    pub(crate) fn with_drift_weighted(mut self, weighted: Option<bool>) -> Self {
-        self.drift_weighted = weighted;
-        self
-    }
-
-    /// With the residual tests' findings, where the estimator makes them: the worst span
-    /// and the ratio to the stated gyro density.
-    #[must_use]
-    pub(crate) fn with_residual_tests(
-        mut self,
-        worst: Option<Worst>,
-        density_ratio: Option<f64>,
-    ) -> Self {
-        self.residual_consistency = worst;
-        self.gyro_density_ratio = density_ratio;
+    pub(crate) fn with_diagnostics(mut self, d: Diagnostics) -> Self {
+        self.gaps = d.gaps;
+        self.excitation = d.excitation;
+        self.row_model = d.row_model;
+        self.torque_bias_nm = d.torque_bias_nm.map(|t| [t.x, t.y, t.z]);
+        self.torque_test = d.torque_test;
+        self.attitude_is_gyro_integral = d.attitude_is_gyro_integral;
+        self.drift_weighted = d.drift_weighted;
+        self.residual_consistency = d.residual_consistency;
+        self.gyro_density_ratio = d.gyro_density_ratio;
         self.refreshed()
     }
 

@@ -451,13 +451,18 @@ impl Run {
         let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
             let (j, rows, torque) = if batch_mode {
                 let o = batch(s, &config).ok()?;
-                (o.estimate.j(), o.row_model, o.torque_test)
+                (
+                    o.estimate.j(),
+                    o.diagnostics.row_model,
+                    o.diagnostics.torque_test,
+                )
             } else {
                 let mut p = Pipeline::from_config(config).ok()?;
                 for x in s {
                     p.push_each(x, |_| {}).ok()?;
                 }
-                (p.last()?.j(), p.row_model(), p.torque_test())
+                let d = p.diagnostics();
+                (p.last()?.j(), d.row_model, d.torque_test)
             };
             if core::mem::take(&mut first) {
                 config = config.pinned_to(rows, torque);

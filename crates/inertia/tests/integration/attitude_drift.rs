@@ -48,7 +48,7 @@ fn runs(scenario: &Scenario, seeds: u64) -> Vec<(f64, f64, bool, bool, Option<bo
                 if drift {
                     within = e.within_3sigma(&out.inertia_kg_m2) == Some(true);
                     determined = matches!(e.observability, Observability::Determined { .. });
-                    weighted = p.drift_weighted();
+                    weighted = p.diagnostics().drift_weighted;
                 }
             }
             (errors[0], errors[1], within, determined, weighted)
@@ -130,13 +130,21 @@ fn where_the_bias_outweighs_the_noise_the_unweighted_answer_is_given() {
                     answers += 1;
                     assert_eq!(a.j(), b.j(), "seed {seed}, t = {}", s.t_s);
                     assert_eq!(a.sigma_kg_m2(), b.sigma_kg_m2(), "seed {seed}");
-                    assert_eq!(on.drift_weighted(), Some(false), "seed {seed}");
+                    assert_eq!(on.diagnostics().drift_weighted, Some(false), "seed {seed}");
                 }
             }
         }
         assert!(answers > 0, "seed {seed}: no answer");
-        assert_eq!(off.torque_test(), on.torque_test(), "seed {seed}");
-        assert_eq!(off.row_model(), on.row_model(), "seed {seed}");
+        assert_eq!(
+            off.diagnostics().torque_test,
+            on.diagnostics().torque_test,
+            "seed {seed}"
+        );
+        assert_eq!(
+            off.diagnostics().row_model,
+            on.diagnostics().row_model,
+            "seed {seed}"
+        );
     }
 }
 
@@ -210,5 +218,5 @@ fn the_drift_setting_is_refused_where_it_cannot_be_used() {
     for s in &out.samples {
         p.push(s).unwrap();
     }
-    assert_eq!(p.drift_weighted(), None);
+    assert_eq!(p.diagnostics().drift_weighted, None);
 }

@@ -50,7 +50,7 @@ fn run(settings: PipelineSettings, samples: &[Sample]) -> (Estimate, Option<f64>
     for s in samples {
         p.push(s).unwrap();
     }
-    let ratio = p.residual_consistency().map(|w| w.ratio);
+    let ratio = p.diagnostics().residual_consistency.map(|w| w.ratio);
     (*p.last().unwrap(), ratio)
 }
 
@@ -190,7 +190,7 @@ fn an_overstated_gyro_density_is_caught() {
                 p.push(x).unwrap();
             }
             let e = p.last().unwrap();
-            let ratio = p.gyro_density_ratio();
+            let ratio = p.diagnostics().gyro_density_ratio;
             eprintln!(
                 "{name}, density x{factor}: ratio {ratio:.3?}, {:?}",
                 e.observability
@@ -220,7 +220,10 @@ fn an_overstated_gyro_density_is_caught() {
             .validate()
             .unwrap();
             let out = inertia::pipeline::batch(&s, &config).unwrap();
-            let batch_ratio = out.gyro_density_ratio.expect("batch density ratio");
+            let batch_ratio = out
+                .diagnostics
+                .gyro_density_ratio
+                .expect("batch density ratio");
             eprintln!(
                 "{name} batch, density x{factor}: ratio {batch_ratio:.3}, {:?}",
                 out.estimate.observability

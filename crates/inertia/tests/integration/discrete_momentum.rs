@@ -666,7 +666,10 @@ fn each_stencil_is_exact_for_its_wheel_model_and_the_adaptive_one_for_all() {
         for s in &run.samples {
             p.push(s).expect("push");
         }
-        assert_eq!(p.row_model().expect("row model").stencil, Stencil::Adaptive);
+        assert_eq!(
+            p.diagnostics().row_model.expect("row model").stencil,
+            Stencil::Adaptive
+        );
         let e = p.last().expect("estimate");
         let pipeline_error =
             relative_frobenius_error(&e.inertia().expect("answer"), &run.inertia_kg_m2);

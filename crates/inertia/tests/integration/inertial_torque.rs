@@ -88,11 +88,17 @@ fn answer(run: &inertia::sim::SimOutput, mode: InertialTorque) -> [(f64, bool); 
     }
     let error = |j: &nalgebra::Matrix3<f64>| relative_frobenius_error(j, &run.inertia_kg_m2);
     let last = p.last().and_then(|e| e.inertia()).expect("answer");
-    let recursive = (error(&last), p.row_model().expect("rows").inertial_torque);
+    let recursive = (
+        error(&last),
+        p.diagnostics().row_model.expect("rows").inertial_torque,
+    );
     let config = settings.validate().expect("settings");
     let b = pipeline::batch(&run.samples, &config).expect("batch");
     let j = b.estimate.inertia().expect("batch answer");
-    let batch = (error(&j), b.row_model.expect("rows").inertial_torque);
+    let batch = (
+        error(&j),
+        b.diagnostics.row_model.expect("rows").inertial_torque,
+    );
     [recursive, batch]
 }
 

@@ -135,7 +135,7 @@ fn memory_decays_across_a_gap() {
     for s in &gapped {
         p.push(s).unwrap();
     }
-    assert_eq!(p.gaps(), 1);
+    assert_eq!(p.diagnostics().gaps, 1);
 }
 
 /// Every registered estimator runs through the same API and returns the same type, and
@@ -164,7 +164,7 @@ fn every_registered_estimator_runs_through_the_pipeline() {
             let jb = b.estimate.j().unwrap();
             let jr = last.j().unwrap();
             assert!((jb - jr).norm() < 1e-7 * jr.norm(), "{}", entry.name);
-            assert!(b.excitation.is_some());
+            assert!(b.diagnostics.excitation.is_some());
         }
     }
 }
@@ -852,10 +852,10 @@ fn batch_and_recursive_runs_report_the_same_torque_test() {
         for s in &out.samples {
             p.push(s).unwrap();
         }
-        let recursive = p.torque_test().expect("tested");
+        let recursive = p.diagnostics().torque_test.expect("tested");
         let config = settings.validate().unwrap();
         let b = pipeline::batch(&out.samples, &config).unwrap();
-        let batch = b.torque_test.expect("tested");
+        let batch = b.diagnostics.torque_test.expect("tested");
         assert_eq!(
             recursive.held_at_zero,
             torque == 0.0,
@@ -881,5 +881,5 @@ fn batch_and_recursive_runs_report_the_same_torque_test() {
     };
     let out = Scenario::slew().simulate(&Common::paper()).unwrap();
     let b = pipeline::batch(&out.samples, &paper.validate().unwrap()).unwrap();
-    assert!(b.torque_test.is_none());
+    assert!(b.diagnostics.torque_test.is_none());
 }

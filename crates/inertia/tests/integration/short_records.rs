@@ -130,7 +130,7 @@ fn a_spurious_torque_on_a_short_record_is_held_at_zero() {
         for s in samples {
             p.push(s).expect("push");
         }
-        (*p.last().expect("answer"), p.torque_test())
+        (*p.last().expect("answer"), p.diagnostics().torque_test)
     };
     let (mut covered, mut by_shift, mut held) = (0, 0, 0);
     let mut errors = Vec::new();

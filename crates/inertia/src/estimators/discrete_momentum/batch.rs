@@ -23,7 +23,7 @@ use crate::estimator::qr::RecursiveQr;
 use crate::estimator::uncertainty::noise_sigma;
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::pipeline::registry::{self, BatchOutput};
-use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::pipeline::{Diagnostics, PipelineConfig, PipelineError};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use crate::tensor::InertiaVector;
@@ -110,13 +110,16 @@ pub(super) fn run_batch(
         Finished::Reversed => None,
     };
     Ok(BatchOutput {
-        gyro_density_ratio,
         estimate,
-        excitation: Some(diagnose(&tested, &c.observability)),
-        gaps: batch.gaps,
-        row_model: Some(*rows),
-        torque_test,
-        attitude_is_gyro_integral,
+        diagnostics: Diagnostics {
+            gaps: batch.gaps,
+            excitation: Some(diagnose(&tested, &c.observability)),
+            row_model: Some(*rows),
+            torque_test,
+            gyro_density_ratio,
+            attitude_is_gyro_integral,
+            ..Diagnostics::default()
+        },
     })
 }
 

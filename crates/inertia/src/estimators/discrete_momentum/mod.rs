@@ -48,22 +48,19 @@ mod tests;
 pub(crate) mod twins;
 
 use crate::estimator::attitude_drift::AttitudeDrift;
-use crate::estimator::consistency::{self, ResidualSegments, Worst};
-use crate::estimator::discrete_momentum::{
-    DiscreteMomentumEstimator, MomentumEstimatorSettings, TorqueTest,
-};
-use crate::estimator::excitation::{diagnose, Excitation};
+use crate::estimator::consistency::{self, ResidualSegments};
+use crate::estimator::discrete_momentum::{DiscreteMomentumEstimator, MomentumEstimatorSettings};
+use crate::estimator::excitation::diagnose;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::registry::{self, Capabilities, Estimator, EstimatorEntry};
-use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::pipeline::{Diagnostics, PipelineConfig, PipelineError};
 use crate::sample::Sample;
 use crate::tensor::InertiaVector;
 use candidates::{candidates, chained_siblings, settings, shared_sources, Candidate, SharedSource};
 use cross_check::CrossCheck;
 use finish::{finish, Evidence, Finished};
-use nalgebra::Vector3;
 use select::{alternatives_from_s, in_running, pick, test_inertial_torque};
 use sigma::{candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer};
 use standing::{Standing, RULE_OUT_AFTER};
@@ -445,52 +442,29 @@ impl Estimator for DiscreteMomentum {
         Ok(self.weigh_for_drift(e, twin))
     }
 
-    fn gaps(&self) -> usize {
-        self.sources.first().map_or(0, |g| g.rows.gaps())
-    }
-
-    fn excitation(&self) -> Option<Excitation> {
+    fn diagnostics(&self) -> Diagnostics {
         let g = self.given();
-        let c = g.candidates.get(g.chosen)?;
-        (c.reduced().rows > 0).then(|| diagnose(c.reduced(), &g.config.observability))
-    }
-
-    fn row_model(&self) -> Option<MomentumRowSettings> {
-        let g = self.given();
-        g.candidates.get(g.chosen).map(|c| *c.row_settings())
-    }
-
-    fn torque_bias_nm(&self) -> Option<Vector3<f64>> {
-        let g = self.given();
-        g.candidates.get(g.chosen)?.torque_bias_nm()
-    }
-
-    fn torque_test(&self) -> Option<TorqueTest> {
-        let g = self.given();
-        g.candidates.get(g.chosen)?.torque_test()
-    }
-
-    fn residual_consistency(&self) -> Option<Worst> {
-        let g = self.given();
-        g.residuals.get(g.chosen)?.worst()
-    }
-
-    fn gyro_density_ratio(&self) -> Option<f64> {
-        self.given().density_ratio
-    }
-
-    fn attitude_is_gyro_integral(&self) -> Option<bool> {
-        match self.given().twins {
-            Twins::Undecided | Twins::NoPairs => None,
-            Twins::Same => Some(true),
-            Twins::Independent => Some(false),
+        let chosen = g.candidates.get(g.chosen);
+        Diagnostics {
+            gaps: self.sources.first().map_or(0, |g| g.rows.gaps()),
+            excitation: chosen
+                .filter(|c| c.reduced().rows > 0)
+                .map(|c| diagnose(c.reduced(), &g.config.observability)),
+            row_model: chosen.map(|c| *c.row_settings()),
+            torque_bias_nm: chosen.and_then(|c| c.torque_bias_nm()),
+            torque_test: chosen.and_then(|c| c.torque_test()),
+            residual_consistency: g.residuals.get(g.chosen).and_then(|r| r.worst()),
+            gyro_density_ratio: g.density_ratio,
+            drift_weighted: self
+                .config
+                .attitude_drift_deg_rth
+                .map(|_| matches!(self.unweighted, Some((_, false)))),
+            attitude_is_gyro_integral: match g.twins {
+                Twins::Undecided | Twins::NoPairs => None,
+                Twins::Same => Some(true),
+                Twins::Independent => Some(false),
+            },
         }
-    }
-
-    fn drift_weighted(&self) -> Option<bool> {
-        self.config
-            .attitude_drift_deg_rth
-            .map(|_| matches!(self.unweighted, Some((_, false))))
     }
 }
 

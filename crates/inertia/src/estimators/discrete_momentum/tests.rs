@@ -162,9 +162,9 @@ fn ruling_out_candidates_changes_no_answer() {
         // The star tracker's rotations are not the gyro's: both sources are kept
         // until the fit rules one out.
         assert_eq!(pruned.twins, Twins::Independent);
-        assert_eq!(pruned.attitude_is_gyro_integral(), Some(false));
+        assert_eq!(pruned.diagnostics().attitude_is_gyro_integral, Some(false));
         let batch = run_batch(&run.samples, &config).unwrap();
-        assert_eq!(batch.attitude_is_gyro_integral, Some(false));
+        assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(false));
     }
 }
 
@@ -211,25 +211,25 @@ fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
     assert!(worst <= twins::TWIN_Z, "{worst}");
     assert_eq!(pruned.twins, Twins::Same);
     assert_eq!(full.twins, Twins::Undecided);
-    assert_eq!(pruned.attitude_is_gyro_integral(), Some(true));
-    assert_eq!(full.attitude_is_gyro_integral(), None);
+    assert_eq!(pruned.diagnostics().attitude_is_gyro_integral, Some(true));
+    assert_eq!(full.diagnostics().attitude_is_gyro_integral, None);
     assert!([0, 2, 4, 6].iter().all(|&i| pruned.standing.live(i)));
     assert!([1, 3, 5, 7].iter().all(|&i| !pruned.standing.live(i)));
     assert_eq!(
-        pruned.row_model().map(|r| r.rotation),
+        pruned.diagnostics().row_model.map(|r| r.rotation),
         Some(RotationSource::Gyro)
     );
     // The batch run makes the same test once, on the whole record: the same
     // verdict, and the attitude's candidates left out of the choice. Over a record
     // shorter than the horizon, no test.
     let batch = run_batch(&run.samples, &config).unwrap();
-    assert_eq!(batch.attitude_is_gyro_integral, Some(true));
+    assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(true));
     assert_eq!(
-        batch.row_model.map(|r| r.rotation),
+        batch.diagnostics.row_model.map(|r| r.rotation),
         Some(RotationSource::Gyro)
     );
     let short = run_batch(&run.samples[..2000], &config).unwrap();
-    assert_eq!(short.attitude_is_gyro_integral, None);
+    assert_eq!(short.diagnostics.attitude_is_gyro_integral, None);
 }
 
 /// [`pick`] on made-up fits: the shortest chain fits best; a longer chain of the

@@ -41,7 +41,7 @@ use crate::estimator::momentum::gyro_sample;
 use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::registry::{Capabilities, Estimator, EstimatorEntry};
-use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::pipeline::{Diagnostics, PipelineConfig, PipelineError};
 use crate::sample::Sample;
 use crate::solver::{Residuals, Solution, SolveStatus};
 use crate::tensor::InertiaVector;
@@ -323,8 +323,11 @@ impl Estimator for Streaming {
         self.0.push(s)
     }
 
-    fn torque_bias_nm(&self) -> Option<Vector3<f64>> {
-        self.0.body_torque_nm()
+    fn diagnostics(&self) -> Diagnostics {
+        Diagnostics {
+            torque_bias_nm: self.0.body_torque_nm(),
+            ..Diagnostics::default()
+        }
     }
 }
 

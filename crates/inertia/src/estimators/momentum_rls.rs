@@ -1,10 +1,10 @@
 //! The momentum RLS baseline ([`crate::estimator::momentum`]) in the pipeline.
 
-use super::registry::{Capabilities, Estimator, EstimatorEntry};
-use super::settings::PipelineConfig;
-use super::PipelineError;
 use crate::estimator::momentum::{MomentumRls, MomentumSettings};
 use crate::estimator::{Estimate, EstimatorError};
+use crate::pipeline::registry::{Capabilities, Estimator, EstimatorEntry};
+use crate::pipeline::Diagnostics;
+use crate::pipeline::{PipelineConfig, PipelineError};
 use crate::sample::Sample;
 use std::boxed::Box;
 
@@ -45,5 +45,9 @@ impl Estimator for Momentum {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         let e = self.rls.push(s)?;
         Ok(e.filter(|_| self.rls.updates().is_multiple_of(self.every)))
+    }
+
+    fn diagnostics(&self) -> Diagnostics {
+        Diagnostics::default()
     }
 }

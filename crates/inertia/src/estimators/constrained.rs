@@ -2,16 +2,16 @@
 //! pipeline: one adapter for any row model, with the uncertainty model's half-rate
 //! shadow ([`crate::estimator::uncertainty`]) where the row model has one.
 
-use super::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
-use super::settings::PipelineConfig;
-use super::PipelineError;
 use crate::estimator::audit::audit;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
-use crate::estimator::excitation::{diagnose, Excitation};
+use crate::estimator::excitation::diagnose;
 use crate::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use crate::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
 use crate::estimator::uncertainty::combine;
 use crate::estimator::{batch, Estimate, EstimatorError};
+use crate::pipeline::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
+use crate::pipeline::Diagnostics;
+use crate::pipeline::{PipelineConfig, PipelineError};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use std::boxed::Box;
@@ -196,16 +196,14 @@ impl<S: RowSource + Send, B: Backend + Send> Estimator for Constrained<S, B> {
         Constrained::push(self, s)
     }
 
-    fn gaps(&self) -> usize {
-        self.main.gaps()
-    }
-
-    fn excitation(&self) -> Option<Excitation> {
-        (self.main.qr().rows > 0).then(|| diagnose(self.main.qr(), &self.observability))
-    }
-
-    fn residual_consistency(&self) -> Option<Worst> {
-        Constrained::residual_consistency(self)
+    fn diagnostics(&self) -> Diagnostics {
+        Diagnostics {
+            gaps: self.main.gaps(),
+            excitation: (self.main.qr().rows > 0)
+                .then(|| diagnose(self.main.qr(), &self.observability)),
+            residual_consistency: Constrained::residual_consistency(self),
+            ..Diagnostics::default()
+        }
     }
 }
 
@@ -240,12 +238,11 @@ fn run_batch<S: RowSource + Default>(
         c.stated_relative_sigma(),
     );
     Ok(BatchOutput {
-        gyro_density_ratio: None,
         estimate,
-        excitation: Some(diagnose(&qr, &c.observability)),
-        gaps: source.gaps(),
-        row_model: None,
-        torque_test: None,
-        attitude_is_gyro_integral: None,
+        diagnostics: Diagnostics {
+            gaps: source.gaps(),
+            excitation: Some(diagnose(&qr, &c.observability)),
+            ..Diagnostics::default()
+        },
     })
 }
