@@ -17,11 +17,12 @@
 //! ([`AugmentedQr::eliminate_anchors`]).
 
 use super::attitude_drift::{local_level_step, AttitudeDrift};
-use super::momentum_rows::{AugmentedRow, ANCHOR0, ANCHOR1, J, TORQUE};
+use super::momentum_rows::{AugmentedRow, ANCHOR0, ANCHOR1, J};
 use super::normal_equations::NormalEquations;
 use super::qr::RecursiveQr;
 use super::shared_qr::{SharedBlock, SharedQr, J_SHARED, SHARED};
 use super::trend_slot::{Trend, TrendStep};
+use super::unknowns::FIRST_SHARED;
 use crate::math::sqrt;
 use nalgebra::{Matrix3, SVector};
 
@@ -156,7 +157,7 @@ impl AugmentedQr {
         })));
         let y = row_y(row);
         let a: [SVector<f64, SHARED>; 3] =
-            core::array::from_fn(|m| row.a.fixed_view::<1, SHARED>(m, TORQUE).transpose());
+            core::array::from_fn(|m| row.a.fixed_view::<1, SHARED>(m, FIRST_SHARED).transpose());
         let slot = &mut self.slots[p];
         let w = slot.weight;
         let trend = self.inertial_torque;
@@ -336,7 +337,7 @@ impl AugmentedQr {
                 }
             }
         }
-        x.fixed_rows_mut::<J_SHARED>(TORQUE).copy_from(&lead);
+        x.fixed_rows_mut::<J_SHARED>(FIRST_SHARED).copy_from(&lead);
         x
     }
 }
@@ -372,7 +373,7 @@ mod tests {
             }
         }
         fn eliminate(&mut self) {
-            for i in ANCHOR0..TORQUE {
+            for i in 0..crate::estimator::unknowns::PER_CHAIN {
                 self.r.row_mut(i).fill(0.0);
                 self.z[i] = 0.0;
             }
@@ -388,10 +389,10 @@ mod tests {
     /// trailing block: the same Cholesky factor of the same Schur complement), `ρ²` within
     /// `100 tol` relative.
     fn assert_shared(s: &SharedQr, d: &Dense, what: &str, tol: f64) {
-        let r = d.r.fixed_view::<SHARED, SHARED>(TORQUE, TORQUE);
+        let r = d.r.fixed_view::<SHARED, SHARED>(FIRST_SHARED, FIRST_SHARED);
         let scale = d.r.amax();
         assert!((s.rt.transpose() - r).amax() <= tol * scale, "{what}: R");
-        let z = d.z.fixed_rows::<SHARED>(TORQUE);
+        let z = d.z.fixed_rows::<SHARED>(FIRST_SHARED);
         assert!((s.z - z).amax() <= tol * d.z.amax(), "{what}: z");
         assert!(
             (s.rss() - d.rss).abs() <= 100.0 * tol * d.rss,
@@ -405,7 +406,7 @@ mod tests {
     fn block(rnd: &mut impl FnMut() -> f64, p: usize) -> AugmentedRow {
         let mut a = SMatrix::<f64, 3, UNKNOWNS>::from_fn(|_, _| rnd());
         for m in 0..3 {
-            for k in ANCHOR0..TORQUE {
+            for k in 0..crate::estimator::unknowns::PER_CHAIN {
                 a[(m, k)] = if k == ANCHOR0 + 3 * p + m { -1.0 } else { 0.0 };
             }
         }
@@ -566,7 +567,9 @@ mod tests {
             let row = block(&mut rnd, k % 2);
             let mut zeroed = row;
             for m in 0..3 {
-                for t in TORQUE..TORQUE + 3 {
+                for t in crate::estimator::momentum_rows::TORQUE
+                    ..crate::estimator::momentum_rows::TORQUE + 3
+                {
                     zeroed.a[(m, t)] = 0.0;
                 }
             }

@@ -513,6 +513,7 @@ pub fn reduce_batch(
 ) -> Result<BatchReduction, EstimatorError> {
     use super::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
     use super::momentum_rows::{J, TORQUE};
+    use super::unknowns::FIRST_SHARED;
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
         return Err(EstimatorError::TooFewSamples {
@@ -557,7 +558,7 @@ pub fn reduce_batch(
     // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
     // initial momenta chain by chain (a short Richardson chain may use only X₀).
     let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
-    let shared_columns: Vec<usize> = (TORQUE..J)
+    let shared_columns: Vec<usize> = (FIRST_SHARED..J)
         .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
         .chain(J..J + 6)
         .collect();

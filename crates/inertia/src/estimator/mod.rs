@@ -39,6 +39,7 @@ pub mod shared_qr;
 pub mod svd_tracker;
 pub(crate) mod trend_slot;
 pub mod uncertainty;
+pub mod unknowns;
 #[cfg(feature = "std")]
 pub mod wheel_delay;
 

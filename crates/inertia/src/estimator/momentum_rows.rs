@@ -3,7 +3,8 @@
 //!
 //! # Unknowns
 //!
-//! `x = [X₀; X₁; τ_b; κ; j]` ([`UNKNOWNS`] = 16): two 3-vectors of initial momentum
+//! `x = [X₀; X₁; τ_b; κ; j]` ([`UNKNOWNS`] = 16; the blocks are named in
+//! [`super::unknowns`]): two 3-vectors of initial momentum
 //! (the plain rows use only `X₀ = L̄₀`), the constant body-frame disturbance torque `τ_b`
 //! (columns zero when [`MomentumRowSettings::torque_bias`] is off), the scalar `κ` of
 //! [`Stencil::Adaptive`] (zero column otherwise) and `j` last, so that the trailing 6×6
@@ -74,18 +75,18 @@ use crate::discrete_momentum::IntervalMomentum;
 use crate::sample::{is_gap, Sample};
 use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
 
-/// Number of unknowns: `[X₀ (3); X₁ (3); τ_b (3); κ (1); j (6)]`.
-pub const UNKNOWNS: usize = 16;
+use super::unknowns::Block;
+pub use super::unknowns::UNKNOWNS;
 /// Column of the first initial-momentum unknown.
-pub const ANCHOR0: usize = 0;
+pub const ANCHOR0: usize = Block::Anchor0.column();
 /// Column of the second initial-momentum unknown (Richardson rows, odd centres).
-pub const ANCHOR1: usize = 3;
+pub const ANCHOR1: usize = Block::Anchor1.column();
 /// Column of the disturbance torque `τ_b`.
-pub(crate) const TORQUE: usize = 6;
+pub(crate) const TORQUE: usize = Block::BodyTorque.column();
 /// Column of the wheel-momentum curvature coefficient `κ` ([`Stencil::Adaptive`]).
-pub(crate) const KAPPA: usize = 9;
+pub(crate) const KAPPA: usize = Block::Kappa.column();
 /// Column of `j`.
-pub const J: usize = 10;
+pub const J: usize = Block::J.column();
 
 /// Where the incremental rotation `φ_k` comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -10,18 +10,16 @@
 //! solvers and the observability test, which then see the same `(R, z, ρ²)` as for the
 //! paper's rows.
 
-use super::momentum_rows::{J, TORQUE, UNKNOWNS};
 use super::qr::RecursiveQr;
+use super::unknowns::Block;
+pub(crate) use super::unknowns::SHARED;
 use crate::givens::{rotate_transposed as rotate, wavefront};
 use crate::householder::reflect_transposed as reflect;
 use crate::math::sqrt;
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
-/// Number of shared unknowns: `[τ_b (3); κ (1); j (6)]`, the columns
-/// [`TORQUE`]`..`[`UNKNOWNS`] of a row.
-pub(crate) const SHARED: usize = UNKNOWNS - TORQUE;
 /// Position of `j` among the shared unknowns.
-pub(crate) const J_SHARED: usize = J - TORQUE;
+pub(crate) const J_SHARED: usize = Block::J.shared_column();
 
 /// A 3-row block in the shared unknowns with its right-hand sides.
 pub(crate) type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
@@ -278,6 +276,7 @@ impl SharedQr {
     /// only (the count of the torque unknowns is not weighted).
     #[must_use]
     pub fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
+        const _: () = assert!(Block::BodyTorque.shared_column() == 0, "τ_b leads");
         const REST: usize = SHARED - 3;
         // Rᵀ of the trailing factor, and the torque's rows of R without its columns.
         let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(i + 3, k + 3)]);
