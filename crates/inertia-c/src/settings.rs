@@ -326,6 +326,8 @@ impl Plan {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
+            // Air drag: a laboratory effect, not in the C API.
+            damping: false,
             rotor_scale_sigma: self.rotor_scale_sigma,
             // C has no estimator that filters (the equation-error baseline is not one of
             // `InertiaEstimatorKind`).

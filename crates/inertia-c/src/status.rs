@@ -116,6 +116,7 @@ fn c_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroDegrees => "multiply w_rad_s by pi/180 before pushing (the rates are in deg/s)",
         Fix::GyroRadians => "the rates are already rad/s: do not convert them",
         Fix::Conjugate => "conjugate q before pushing (inertial to body)",
+        Fix::InertialTorqueOn => "inertial_torque = 1 (on)",
         _ => return None,
     })
 }

@@ -69,7 +69,7 @@
 //!
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
 //! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto` its
-//! `--inertial-torque` (unset: `off`). `DIGITS=1` prints the medians with
+//! `--inertial-torque` (unset: `off`); `DAMPING=1` its `--damping`. `DIGITS=1` prints the medians with
 //! four significant digits. `WHEEL_DELAY=off|SECONDS|estimate` sets the lab cells' wheel
 //! speed time tag (every estimator; unset: off).
 
@@ -101,6 +101,11 @@ fn inertial_torque_from_env(estimator: &str) -> inertia::pipeline::InertialTorqu
         .filter(|_| estimator == "discrete-momentum")
         .and_then(|v| v.parse().ok())
         .unwrap_or_default()
+}
+
+/// The discrete momentum estimator's `--damping` from `DAMPING=1` (other estimators: off).
+fn damping_from_env(estimator: &str) -> bool {
+    estimator == "discrete-momentum" && std::env::var("DAMPING").is_ok_and(|v| v == "1")
 }
 
 /// The paper's gyro, deg/s/√Hz.
@@ -379,6 +384,7 @@ fn estimate(
             None => PipelineSettings::default().max_chain_s,
         },
         inertial_torque: inertial_torque_from_env(estimator),
+        damping: damping_from_env(estimator),
         ..PipelineSettings::default()
     })
     .ok()?;

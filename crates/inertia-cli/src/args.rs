@@ -483,6 +483,10 @@ pub struct EstimateArgs {
     #[arg(long, value_name = "MODE", default_value = "off",
           value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
     pub inertial_torque: String,
+    /// Estimate a linear damping torque −D·ω (air drag on a tumbling body; one more
+    /// unknown D, N m s, reported; discrete-momentum estimator).
+    #[arg(long)]
+    pub damping: bool,
     /// The wheel-speed telemetry's time tag: the speeds are read δ later than their time
     /// stamps. `off` (default), the delay in seconds (e.g. `0.05`; negative: early), or
     /// `estimate` (the residuals' minimum over ±min(0.25 s, a tenth of the record), with

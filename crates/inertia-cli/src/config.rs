@@ -299,6 +299,7 @@ pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError>
         },
         torque_bias: !a.no_torque_bias,
         inertial_torque: a.inertial_torque.parse().map_err(settings_error)?,
+        damping: a.damping,
         wheel_delay: inertia::pipeline::parse_wheel_delay(&a.wheel_delay)
             .map_err(settings_error)?,
         rotor_scale_sigma: a
@@ -328,6 +329,7 @@ fn option_of(field: &str) -> &str {
         "rho_model" => "--rho-model",
         "torque_bias" => "--no-torque-bias",
         "inertial_torque" => "--inertial-torque",
+        "damping" => "--damping",
         "wheel_delay" => "--wheel-delay",
         "rotor_scale_sigma" => "--rotor-scale-sigma",
         "filter_cutoff_hz" => "--filter-cutoff-hz",

@@ -39,6 +39,7 @@ pub fn option_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroDegrees => "--gyro-unit deg/s",
         Fix::GyroRadians => "--gyro-unit rad/s",
         Fix::Conjugate => "--conjugate",
+        Fix::InertialTorqueOn => "--inertial-torque on",
         _ => return None,
     })
 }

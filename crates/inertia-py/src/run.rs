@@ -134,6 +134,7 @@ pub fn keyword_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroDegrees => "gyro_unit=\"deg/s\"",
         Fix::GyroRadians => "gyro_unit=\"rad/s\"",
         Fix::Conjugate => "conjugate=True",
+        Fix::InertialTorqueOn => "inertial_torque=\"on\"",
         _ => return None,
     })
 }

@@ -52,6 +52,8 @@ pub enum Fix {
     GyroRadians,
     /// Read the quaternions conjugated: Hamilton, inertial → body.
     Conjugate,
+    /// Estimate a disturbance torque fixed in the inertial frame, per chain.
+    InertialTorqueOn,
 }
 
 impl Fix {
@@ -73,6 +75,7 @@ impl Fix {
             Fix::GyroDegrees => "gyro_unit = deg/s",
             Fix::GyroRadians => "gyro_unit = rad/s",
             Fix::Conjugate => "format = conjugate",
+            Fix::InertialTorqueOn => "inertial_torque = on",
         }
     }
 }

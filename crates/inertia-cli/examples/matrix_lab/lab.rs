@@ -88,6 +88,7 @@ fn estimate(samples: &[Sample], name: &str) -> Option<Estimate> {
         solve_every: 50,
         uncertainty: true,
         inertial_torque: super::inertial_torque_from_env(name),
+        damping: super::damping_from_env(name),
         filter_cutoff_hz: (name == "equation-error").then_some(LAB_CUTOFF_HZ),
         wheel_delay: wheel_delay_from_env(),
         ..PipelineSettings::default()
@@ -133,18 +134,27 @@ fn quantile(v: &[f64], q: f64) -> f64 {
     s[((s.len() - 1) as f64 * q).round() as usize]
 }
 
-/// Median and 95 % error, and the per-element 3σ coverage (None without a σ).
-fn summarise(runs: &[&LabRun], k: usize) -> (Vec<f64>, usize, Option<[f64; 6]>) {
+/// Median and 95 % error, the per-element 3σ coverage (None without a σ), and the
+/// determined answers with how many of them have an element beyond 3σ.
+fn summarise(runs: &[&LabRun], k: usize) -> (Vec<f64>, usize, Option<[f64; 6]>, (usize, usize)) {
     let mut errors = Vec::new();
     let mut within = [0usize; 6];
     let mut with_sigma = 0;
     let mut failed = 0;
+    let mut determined = (0, 0);
     for r in runs {
         let Some((e, j)) = r.estimates[k].and_then(|e| Some((e, e.inertia()?))) else {
             failed += 1;
             continue;
         };
         errors.push(relative_frobenius_error(&j, &r.truth));
+        if matches!(
+            e.observability,
+            inertia::estimator::observability::Observability::Determined { .. }
+        ) {
+            determined.0 += 1;
+            determined.1 += usize::from(e.within_3sigma(&r.truth) == Some(false));
+        }
         if let (Some(sig), Some(jv)) = (e.sigma_kg_m2(), e.j()) {
             with_sigma += 1;
             let t = j_from_matrix(&r.truth);
@@ -156,7 +166,7 @@ fn summarise(runs: &[&LabRun], k: usize) -> (Vec<f64>, usize, Option<[f64; 6]>) 
         }
     }
     let coverage = (with_sigma > 0).then(|| within.map(|w| w as f64 / with_sigma as f64));
-    (errors, failed, coverage)
+    (errors, failed, coverage, determined)
 }
 
 /// Run the lab cells whose label contains `filter` (lower case) over seeds 1..=seeds and
@@ -177,7 +187,9 @@ pub fn table(seeds: u64, filter: Option<&str>) {
     let mut header = String::from("| lab cell |");
     let mut rule = String::from("|---|");
     for (_, label) in ESTIMATORS {
-        header += &format!(" {label}: median / 95 % | its 3σ coverage J11 J22 J33 J12 J13 J23 |");
+        header += &format!(
+            " {label}: median / 95 % (determined, of which beyond 3σ) | its 3σ coverage J11 J22 J33 J12 J13 J23 |"
+        );
         rule += "---|---|";
     }
     header += " DM / best baseline |";
@@ -194,10 +206,13 @@ pub fn table(seeds: u64, filter: Option<&str>) {
         let mut line = format!("| {} |", cell.label);
         let mut medians = Vec::new();
         for k in 0..ESTIMATORS.len() {
-            let (errors, failed, coverage) = summarise(&mine, k);
+            let (errors, failed, coverage, (det, beyond)) = summarise(&mine, k);
             let median = quantile(&errors, 0.5);
             medians.push(median);
             let mut e = format!("{median:.2e} / {:.1e}", quantile(&errors, 0.95));
+            if coverage.is_some() {
+                e += &format!(" ({det}, {beyond})");
+            }
             if failed > 0 {
                 e += &format!(" ({failed} no answer)");
             }

@@ -11,7 +11,16 @@
 
 use super::augmented_qr::AugmentedQr;
 use super::jackknife::ChainGroups;
-use super::momentum_rows::{AugmentedRow, ChainClock, MomentumRowSettings, MomentumRows};
+use super::momentum_rows::{
+    AugmentedRow, ChainClock, MomentumRowSettings, MomentumRows, DAMPING, TORQUE,
+};
+
+use crate::tensor::InertiaVector;
+
+const _: () = assert!(
+    super::unknowns::Block::Damping.column() + 1 == super::unknowns::Block::J.column(),
+    "DampingRow: D is the last unknown before j"
+);
 use super::qr::RecursiveQr;
 use super::recursive::{estimate_from, RecursiveSettings};
 use super::svd_tracker::SvdTracker;
@@ -463,7 +472,37 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let held = self.torque_test.is_some_and(|t| t.held_at_zero);
         (self.settings.rows.torque_bias && !held).then(|| {
             let x = self.qr.nuisance_at(&j);
-            Vector3::new(x[6], x[7], x[8])
+            Vector3::new(x[TORQUE], x[TORQUE + 1], x[TORQUE + 2])
+        })
+    }
+
+    /// The estimated damping coefficient `D` of the torque `−D ω`, N m s, at the last
+    /// answer, with its least-squares σ where there is one (`None` before an answer, or
+    /// when it is not estimated). With the body torque held at zero it is still the
+    /// value that fits best with the torque free.
+    #[must_use]
+    pub fn damping_nms(&self) -> Option<(f64, Option<f64>)> {
+        self.damping_at(&self.last.and_then(|e| e.j())?)
+    }
+
+    /// The damping `D` (N m s) that fits best at `j`, where estimated, with its σ: the
+    /// larger of the least-squares σ (every unknown free) and the jackknife σ of the
+    /// delete-one-group answers' `D` ([`super::jackknife`]), as for `j`'s noise σ.
+    #[must_use]
+    pub fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+        self.settings.rows.damping.then(|| {
+            let column = super::unknowns::Block::Damping.shared_column();
+            let ls = self.qr.shared().marginal_sigma(column);
+            let jackknife = self
+                .groups
+                .as_ref()
+                .filter(|_| self.jackknife_in_sigma)
+                .and_then(|g| g.nuisance_sigma(&self.constraints, column));
+            let sigma = match (ls, jackknife) {
+                (Some(l), Some(k)) => Some(l.max(k)),
+                (l, k) => l.or(k),
+            };
+            (self.qr.nuisance_at(j)[DAMPING], sigma)
         })
     }
 
@@ -500,6 +539,36 @@ pub struct BatchReduction {
     /// The reduced state with the disturbance torque held at zero, and the growth of `ρ²`
     /// that costs ([`torque_tested`]); `None` when the torque is not estimated.
     pub without_torque: Option<(RecursiveQr, f64)>,
+    /// The damping's row of the shared factor, where the rows estimate one.
+    pub(crate) damping: Option<DampingRow>,
+}
+
+impl BatchReduction {
+    /// The damping `D` (N m s) that fits best at `j`, with its least-squares σ, where the
+    /// rows estimate one.
+    #[must_use]
+    pub fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+        self.damping.map(|d| d.at(j))
+    }
+}
+
+/// The damping's row of an upper-triangular factor over the shared unknowns, `j` last:
+/// `r_dd D + r_dj·j = z_d` once the unknowns after it are fixed, and its least-squares σ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct DampingRow {
+    r_dd: f64,
+    r_dj: nalgebra::Vector6<f64>,
+    z_d: f64,
+    sigma_nms: Option<f64>,
+}
+
+impl DampingRow {
+    /// `D` at `j` with its σ (the unknowns between `D` and `j` are none: `D` is the last
+    /// before `j`, [`super::unknowns::Block::ALL`]).
+    #[must_use]
+    pub(crate) fn at(&self, j: &InertiaVector) -> (f64, Option<f64>) {
+        ((self.z_d - self.r_dj.dot(j)) / self.r_dd, self.sigma_nms)
+    }
 }
 
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
@@ -512,7 +581,7 @@ pub fn reduce_batch(
     settings: &MomentumRowSettings,
 ) -> Result<BatchReduction, EstimatorError> {
     use super::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
-    use super::momentum_rows::{J, TORQUE};
+    use super::momentum_rows::J;
     use super::unknowns::FIRST_SHARED;
     use nalgebra::{DMatrix, DVector};
     if samples.len() < super::MIN_SAMPLES {
@@ -610,8 +679,11 @@ pub fn reduce_batch(
         (rss, y_energy, rows) = (rss + r, y_energy + e, rows + m);
         blocks.push(block);
     }
+    // Where the damping's column is among the shared ones.
+    let damping_at = shared_columns.iter().position(|&k| k == DAMPING);
     // The stacked shared rows of the chains' `blocks` that `keep` selects, without their
-    // first `drop` columns (the torque's, held at zero): (R, z, rss) in j.
+    // first `drop` columns (the torque's, held at zero): (R, z, rss) in j, and (all
+    // columns kept) the damping's row of the factor `(r_dd, r_dj, z_d)`.
     let solve_shared =
         |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop: usize| {
             let (mut a, mut y) = (Vec::new(), Vec::new());
@@ -635,9 +707,17 @@ pub fn reduce_batch(
                     z[i] = -z[i];
                 }
             }
-            (rr, z, (energy - qty.norm_squared()).max(0.0))
+            let damping = damping_at.filter(|_| drop == 0).map(|p| {
+                let r_dj = Vector6::from_fn(|i, _| r[(p, off + i)]);
+                (r[(p, p)], r_dj, qty[p], r)
+            });
+            (rr, z, (energy - qty.norm_squared()).max(0.0), damping)
         };
-    let (rr, z, shared_rss) = solve_shared(&blocks, &|_| true, 0);
+    let (rr, z, shared_rss, damping_factor) = solve_shared(&blocks, &|_| true, 0);
+    let damping_of = |row: &Option<(f64, Vector6<f64>, f64, DMatrix<f64>)>, j: &InertiaVector| {
+        row.as_ref()
+            .map(|(r_dd, r_dj, z_d, _)| (z_d - r_dj.dot(j)) / r_dd)
+    };
     // The torque's columns, when the rows use them: the same rows without them hold it
     // at zero ([`torque_tested`]), at the cost of the growth of ρ².
     let torque = if settings.torque_bias {
@@ -646,7 +726,7 @@ pub fn reduce_batch(
         0
     };
     let without_torque = (torque > 0).then(|| {
-        let (r, z, held_rss) = solve_shared(&blocks, &|_| true, torque);
+        let (r, z, held_rss, _) = solve_shared(&blocks, &|_| true, torque);
         let growth = (held_rss - shared_rss).max(0.0);
         let qr = RecursiveQr {
             r,
@@ -669,8 +749,9 @@ pub fn reduce_batch(
     let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
         (0..chains.len().min(GROUPS))
             .map(|g| {
-                let (r, z, _) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
-                crate::solver::unconstrained_minimiser(&r, &z)
+                let (r, z, _, d) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
+                let j = crate::solver::unconstrained_minimiser(&r, &z)?;
+                Some((j, damping_of(&d, &j)))
             })
             .collect()
     } else {
@@ -697,11 +778,21 @@ pub fn reduce_batch(
                         reduce_chain(&kept).0
                     })
                     .collect();
-                let (r, z, _) = solve_shared(&without, &|_| true, 0);
-                crate::solver::unconstrained_minimiser(&r, &z)
+                let (r, z, _, d) = solve_shared(&without, &|_| true, 0);
+                let j = crate::solver::unconstrained_minimiser(&r, &z)?;
+                Some((j, damping_of(&d, &j)))
             })
             .collect()
     };
+    let estimates: Option<Vec<(InertiaVector, Option<f64>)>> = estimates;
+    // The delete-one answers' D, as one more element of the jackknife.
+    let damping_jackknife = estimates.as_deref().and_then(|e| {
+        let d: Option<Vec<InertiaVector>> = e
+            .iter()
+            .map(|(_, d)| d.map(InertiaVector::from_element))
+            .collect();
+        Some(jackknife_sigma(&d?)?[0] * time_block_scale)
+    });
     Ok(BatchReduction {
         qr: RecursiveQr {
             r: rr,
@@ -715,9 +806,34 @@ pub fn reduce_batch(
         },
         gaps: source.gaps(),
         jackknife_sigma_kg_m2: estimates
+            .as_ref()
+            .map(|e| e.iter().map(|(j, _)| *j).collect::<Vec<_>>())
             .as_deref()
             .and_then(jackknife_sigma)
             .map(|s| s.map(|v| v * time_block_scale)),
         without_torque,
+        damping: damping_factor
+            .zip(damping_at)
+            .map(|((r_dd, r_dj, z_d, r), p)| {
+                let s2 = super::qr::residual_variance(rss, rows as f64 - 6.0 - nuisance);
+                // e_pᵀ (RᵀR)⁻¹ e_p = ‖R⁻ᵀ e_p‖².
+                let mut e = DVector::zeros(shared);
+                e[p] = 1.0;
+                let ls = r
+                    .transpose()
+                    .solve_lower_triangular(&e)
+                    .filter(|_| s2.is_finite() && r_dd != 0.0)
+                    .map(|u| crate::math::sqrt(s2 * u.norm_squared()));
+                let sigma_nms = match (ls, damping_jackknife) {
+                    (Some(l), Some(k)) => Some(l.max(k)),
+                    (l, k) => l.or(k),
+                };
+                DampingRow {
+                    r_dd,
+                    r_dj,
+                    z_d,
+                    sigma_nms,
+                }
+            }),
     })
 }

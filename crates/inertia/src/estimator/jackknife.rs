@@ -212,6 +212,26 @@ impl ChainGroups {
         self.chains >= MIN_GROUPS
     }
 
+    /// The jackknife σ of the shared unknown in `column` (the damping's, N m s): each
+    /// delete-one-group state's value at its own answer, scaled as [`Self::sigma`]'s; not
+    /// cached (asked for once per solve, with that unknown estimated).
+    #[must_use]
+    pub(crate) fn nuisance_sigma(&self, constraints: &Constraints, column: usize) -> Option<f64> {
+        let groups = if self.by_chain() {
+            &self.groups[..self.chains.min(GROUPS)]
+        } else {
+            &self.blocks[..self.closed]
+        };
+        let mut values = [0.0; 2 * GROUPS];
+        let used = delete_one(groups, constraints, |rest, j, g| {
+            values[g] = rest.leading_at(j)[column];
+        })?;
+        let one = |v: f64| InertiaVector::from_element(v);
+        let estimates: [InertiaVector; 2 * GROUPS] = core::array::from_fn(|g| one(values[g]));
+        let s = jackknife_sigma(&estimates[..used])?[0];
+        Some(self.scaled([s; 6])[0])
+    }
+
     fn scaled(&self, s: [f64; 6]) -> [f64; 6] {
         let pending = self.block.counts().weight();
         let (done, all) = if self.by_chain() {
@@ -245,6 +265,19 @@ impl ChainGroups {
 /// The jackknife σ of the delete-one-group answers of `groups` (module docs), each
 /// delete-one problem with the prior knowledge of `constraints`.
 fn delete_one_sigma(groups: &[SharedQr], constraints: &Constraints) -> Option<[f64; 6]> {
+    let mut estimates = [InertiaVector::zeros(); 2 * GROUPS];
+    let used = delete_one(groups, constraints, |_, j, g| estimates[g] = *j)?;
+    estimates.get(..used).and_then(jackknife_sigma)
+}
+
+/// Each delete-one-group problem of `groups` (with the prior knowledge of `constraints`)
+/// and its unconstrained answer, handed to `each` with the group's index; the number of
+/// groups, or `None` where a problem has no unique answer.
+fn delete_one(
+    groups: &[SharedQr],
+    constraints: &Constraints,
+    mut each: impl FnMut(&SharedQr, &InertiaVector, usize),
+) -> Option<usize> {
     let used = groups.len();
     // The groups before `g` and after it, merged once each way: each delete-one
     // state is then one merge, not `used − 2`.
@@ -258,14 +291,13 @@ fn delete_one_sigma(groups: &[SharedQr], constraints: &Constraints) -> Option<[f
         after[g] = after[g + 1];
         after[g].merge(&groups[g + 1]);
     }
-    let mut estimates = [InertiaVector::zeros(); 2 * GROUPS];
-    for (g, out) in estimates.iter_mut().enumerate().take(used) {
+    for g in 0..used {
         let mut rest = before[g];
         rest.merge(&after[g]);
         let reduced = super::prior::augment(&rest.reduced(), constraints).0;
-        *out = unconstrained_minimiser(&reduced.r, &reduced.z)?;
+        each(&rest, &unconstrained_minimiser(&reduced.r, &reduced.z)?, g);
     }
-    estimates.get(..used).and_then(jackknife_sigma)
+    Some(used)
 }
 
 /// The time block of each row block of chains of the given lengths (in row blocks), as

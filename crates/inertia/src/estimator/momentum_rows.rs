@@ -85,6 +85,8 @@ pub const ANCHOR1: usize = Block::Anchor1.column();
 pub(crate) const TORQUE: usize = Block::BodyTorque.column();
 /// Column of the wheel-momentum curvature coefficient `κ` ([`Stencil::Adaptive`]).
 pub(crate) const KAPPA: usize = Block::Kappa.column();
+/// Column of the damping coefficient `D` ([`MomentumRowSettings::damping`]).
+pub(crate) const DAMPING: usize = Block::Damping.column();
 /// Column of `j`.
 pub const J: usize = Block::J.column();
 
@@ -199,6 +201,9 @@ pub struct MomentumRowSettings {
     /// Richardson parity), beside its initial momentum (module docs, "Inertial torque";
     /// default `false`).
     pub inertial_torque: bool,
+    /// Estimate a linear damping torque `−D ω` (air drag; module docs, "Damping";
+    /// default `false`).
+    pub damping: bool,
     /// Longest chain, s (the first [`super::jackknife::MIN_GROUPS`] chains a quarter of
     /// it): a chain is split (its initial momentum becomes a new unknown) once it spans
     /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
@@ -215,6 +220,7 @@ impl Default for MomentumRowSettings {
             stencil: Stencil::Plain,
             torque_bias: true,
             inertial_torque: false,
+            damping: false,
             max_chain_s: None,
         }
     }
@@ -244,7 +250,12 @@ impl core::fmt::Display for MomentumRowSettings {
         } else {
             ""
         };
-        write!(f, "{rotation}, {stencil}{torque}{inertial}")?;
+        let damping = if self.damping {
+            ", unknown damping"
+        } else {
+            ""
+        };
+        write!(f, "{rotation}, {stencil}{torque}{inertial}{damping}")?;
         if let Some(max) = self.max_chain_s {
             write!(f, ", chains of {max} s")?;
         }
@@ -291,11 +302,11 @@ impl MomentumRowSettings {
         self.anchors_per_chain() * (1 + usize::from(self.inertial_torque))
     }
 
-    /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`).
+    /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`, `D`).
     #[must_use]
     pub fn shared_nuisance(&self) -> usize {
         let torque = if self.torque_bias { 3 } else { 0 };
-        torque + usize::from(self.stencil == Stencil::Adaptive)
+        torque + usize::from(self.stencil == Stencil::Adaptive) + usize::from(self.damping)
     }
 }
 
@@ -331,6 +342,8 @@ struct Plain {
     s: Matrix3<f64>,
     /// `Σ h̄` to the same node: the inertial torque's coefficient.
     si: f64,
+    /// `W_k = Σ h̄_m C_m ω̂_m` to the same node: the damping's coefficient.
+    w: Vector3<f64>,
 }
 
 /// A node as the rows need it.
@@ -342,6 +355,9 @@ struct Node {
     rho_nms: Vector3<f64>,
     tau_nm: Vector3<f64>,
     omega_rad_s: Option<Vector3<f64>>,
+    /// The body rate at the node from its two intervals' rotations, once it is interior
+    /// (with [`MomentumRowSettings::damping`] only).
+    omega_hat: Option<Vector3<f64>>,
 }
 
 /// Splits a row source's chains into chains no longer than
@@ -417,10 +433,13 @@ pub struct MomentumRows {
     t: Vector3<f64>,
     /// `Σ h̄` of the unit-step grid (the inertial torque's impulse per N m).
     si: f64,
+    /// `W` of the unit-step grid (the damping's impulse per N m s).
+    w: Vector3<f64>,
     /// The same per parity of the stride-2 subgrid.
     s2: [Matrix3<f64>; 2],
     t2: [Vector3<f64>; 2],
     si2: [f64; 2],
+    w2: [Vector3<f64>; 2],
     prev: Option<Plain>,
     /// The gyro's angle increment over the previous interval (coning term).
     alpha_prev: Option<Vector3<f64>>,
@@ -442,9 +461,11 @@ impl MomentumRows {
             s: Matrix3::zeros(),
             t: Vector3::zeros(),
             si: 0.0,
+            w: Vector3::zeros(),
             s2: [Matrix3::zeros(); 2],
             t2: [Vector3::zeros(); 2],
             si2: [0.0; 2],
+            w2: [Vector3::zeros(); 2],
             prev: None,
             alpha_prev: None,
             epoch: 0,
@@ -514,6 +535,7 @@ impl MomentumRows {
             rho_nms: s.rho_nms,
             tau_nm: s.tau_nm,
             omega_rad_s: s.omega_rad_s,
+            omega_hat: None,
         };
         let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
         if !finite(&node.rho_nms) {
@@ -572,6 +594,16 @@ impl MomentumRows {
             self.s += b.c * hbar;
             self.t += b.c * b.tau_nm * hbar;
             self.si += hbar;
+            if self.settings.damping {
+                // The rate at b interpolated between its two intervals' mean rates; a
+                // rotation vector is the same in both ends' body axes.
+                let (h0, w0, w1) = (b.t_s - a.t_s, self.f_last.log(), f.log());
+                let omega = (w0 * (h / h0) + w1 * (h0 / h)) / (h0 + h);
+                self.w += b.c * omega * hbar;
+                if let Some(n) = self.nodes[2].as_mut() {
+                    n.omega_hat = Some(omega);
+                }
+            }
         }
         let m = IntervalMomentum::new(&b.c, &f.v, &(0.5 * (b.rho_nms + node.rho_nms)), h);
         let plain = Plain {
@@ -579,6 +611,7 @@ impl MomentumRows {
             rhs: m.b + self.t,
             s: self.s,
             si: self.si,
+            w: self.w,
         };
         let f_prev = self.f_last;
         self.t_older_s = [self.t_older_s[1], self.nodes[0].map(|n| n.t_s)];
@@ -590,7 +623,7 @@ impl MomentumRows {
             return Ok(Some(self.assemble(
                 &plain.m.a,
                 &plain.rhs,
-                (&plain.s, plain.si),
+                (&plain.s, plain.si, &plain.w),
                 ANCHOR0,
                 1.0 / h,
             )));
@@ -610,6 +643,9 @@ impl MomentumRows {
                 self.s2[parity] += cm1.c * hbar2;
                 self.t2[parity] += cm1.c * cm1.tau_nm * hbar2;
                 self.si2[parity] += hbar2;
+                if let Some(omega) = cm1.omega_hat {
+                    self.w2[parity] += cm1.c * omega * hbar2;
+                }
             }
         }
         let h2 = node.t_s - cm1.t_s;
@@ -627,12 +663,13 @@ impl MomentumRows {
         let rhs = (prev.rhs + plain.rhs) * w - (m2.b + self.t2[parity]) * v;
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
         let si = (prev.si + plain.si) * w - self.si2[parity] * v;
+        let wd = (prev.w + plain.w) * w - self.w2[parity] * v;
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
         let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
         let c0 = 4.0 / (3.0 * h0) - 2.0 / (3.0 * h2);
         let c1 = 4.0 / (3.0 * h1) - 2.0 / (3.0 * h2);
         let noise_s = 0.25 * (c0 * c0 * h0 + c1 * c1 * h1);
-        let mut row = self.assemble(&a, &rhs, (&s, si), anchor, noise_s);
+        let mut row = self.assemble(&a, &rhs, (&s, si, &wd), anchor, noise_s);
         if self.settings.stencil == Stencil::Adaptive {
             // Every ρ̄ of the stencil moves by κ Δ²ρ_c (h̄² times the second divided
             // difference at c): the κ column is minus the stencil's b for ρ̄ := Δ²ρ_c.
@@ -652,7 +689,7 @@ impl MomentumRows {
         &self,
         a: &Matrix3x6<f64>,
         rhs: &Vector3<f64>,
-        (s, si): (&Matrix3<f64>, f64),
+        (s, si, wd): (&Matrix3<f64>, f64, &Vector3<f64>),
         anchor: usize,
         noise_s: f64,
     ) -> AugmentedRow {
@@ -662,6 +699,9 @@ impl MomentumRows {
         }
         if self.settings.torque_bias {
             out.fixed_view_mut::<3, 3>(0, TORQUE).copy_from(&(-s));
+        }
+        if self.settings.damping {
+            out.fixed_view_mut::<3, 1>(0, DAMPING).copy_from(wd);
         }
         out.fixed_view_mut::<3, 6>(0, J).copy_from(a);
         AugmentedRow {

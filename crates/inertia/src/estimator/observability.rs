@@ -36,6 +36,10 @@ pub const DEFAULT_MAX_RELATIVE_SIGMA: f64 = 0.1;
 /// `s²` (and so every σ) is itself too uncertain to gate on.
 pub(crate) const MIN_RESIDUAL_DOF: usize = 6;
 
+/// How many least-squares σ below zero an estimated damping may lie before the model
+/// check fails ([`Unobservable::NegativeDamping`]).
+pub const NEGATIVE_DAMPING_Z: f64 = 3.0;
+
 /// Thresholds of the observability test.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ObservabilitySettings {
@@ -155,6 +159,16 @@ pub enum Unobservable {
         /// The larger of the two violations in units of its σ.
         z: f64,
     },
+    /// The estimated damping `D` of a torque `−D ω` is negative by more than
+    /// [`NEGATIVE_DAMPING_Z`] of its least-squares σ: a drag cannot feed energy in, so the
+    /// damping stands in for another effect and the row model does not hold
+    /// ([`Observability::ModelCheckFailed`]; the answer and its σ stay visible).
+    NegativeDamping {
+        /// `D`, N m s.
+        damping_nms: f64,
+        /// Its least-squares σ, N m s.
+        sigma_nms: f64,
+    },
     /// The weakest direction of `j` is too poorly determined.
     IllConditioned {
         /// `σ_1/σ_6`.
@@ -176,6 +190,7 @@ impl Unobservable {
             Unobservable::Inconsistent { .. } => &[Fix::Memory],
             Unobservable::DensityOverstated { .. } => &[Fix::GyroNoise],
             Unobservable::PriorConflict { .. } => &[Fix::PriorSigma, Fix::Products],
+            Unobservable::NegativeDamping { .. } => &[Fix::InertialTorqueOn],
             _ => &[],
         }
     }
@@ -278,6 +293,15 @@ impl core::fmt::Display for Unobservable {
             } => write!(
                 f,
                 "not a physical inertia (J1 + J2 − J3 = {triangle_kg_m2:.2e} ± {triangle_sigma_kg_m2:.1e} kg m², J1 = {min_moment_kg_m2:.4e} kg m²; {z:.1} σ outside J1 > 0, J1 + J2 ≥ J3): a real body's J is physical, so the row model or the data's conventions do not hold here; the answer and its σ are shown, not promised (the physical constraint set keeps the answer physical)"
+            ),
+            Unobservable::NegativeDamping {
+                damping_nms,
+                sigma_nms,
+            } => write!(
+                f,
+                "the damping came out negative (D = {} ± {} N m s, beyond {NEGATIVE_DAMPING_Z} σ): a drag cannot feed energy in, so the damping stands in for another effect (a torque fixed in the inertial frame?) and the answer may be biased; it and its σ are shown, not promised",
+                crate::text::Num(*damping_nms),
+                crate::text::Num(*sigma_nms)
             ),
             Unobservable::IllConditioned {
                 condition,

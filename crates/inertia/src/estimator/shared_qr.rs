@@ -1,5 +1,5 @@
 //! The least-squares state in the unknowns every chain of discrete momentum rows shares,
-//! `y = [τ_b; κ; j]` (`SHARED` = 10, [`super::momentum_rows`]), the chains' initial
+//! `y = [τ_b; κ; D; j]` (`SHARED` = 11, [`super::momentum_rows`]), the chains' initial
 //! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
 //! folded by Householder reflections, one per pivot for each 3-row block
 //! (the crate's `householder` module; the factor of paper eqs. 60–61 up to rounding).
@@ -114,13 +114,13 @@ impl SharedQr {
         let (mut a, mut beta) = block;
         // Unrolled: each reflection's loops get fixed lengths (4 % faster on the
         // 1M-sample run than the loop over pivots).
-        const _: () = assert!(SHARED == 10, "one literal per pivot below");
+        const _: () = assert!(SHARED == 11, "one literal per pivot below");
         macro_rules! one {
             ($($i:literal)*) => {$(
                 reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, $i);
             )*};
         }
-        one!(0 1 2 3 4 5 6 7 8 9);
+        one!(0 1 2 3 4 5 6 7 8 9 10);
         self.count(y, &beta, noise_s);
     }
 
@@ -134,14 +134,14 @@ impl SharedQr {
         y: &[f64; 3],
         noise_s: f64,
     ) {
-        const _: () = assert!(SHARED == 10, "one literal per pivot below");
+        const _: () = assert!(SHARED == 11, "one literal per pivot below");
         macro_rules! both {
             ($($i:literal)*) => {$(
                 reflect(&mut s.rt, &mut s.z, &mut a, &mut beta, $i);
                 reflect(&mut o.rt, &mut o.z, &mut a2, &mut beta2, $i);
             )*};
         }
-        both!(0 1 2 3 4 5 6 7 8 9);
+        both!(0 1 2 3 4 5 6 7 8 9 10);
         s.count(y, &beta, noise_s);
         o.count(y, &beta2, noise_s);
     }
@@ -264,6 +264,34 @@ impl SharedQr {
             noise_s: self.counts.noise_s,
             nuisance: self.nuisance,
         }
+    }
+
+    /// The least-squares standard deviation of the shared unknown in column `column`
+    /// with every other unknown free: `s √(e_cᵀ (RᵀR)⁻¹ e_c)`, `s²` the residual variance
+    /// per degree of freedom. Unknowns the rows do not use (a zero pivot) are not in the
+    /// problem. `None` where the column is unused or there is no residual degree of
+    /// freedom. White-noise σ: it knows nothing of correlated residuals.
+    #[must_use]
+    pub(crate) fn marginal_sigma(&self, column: usize) -> Option<f64> {
+        let s2 = self.residual_variance();
+        if !s2.is_finite() || self.rt[(column, column)] == 0.0 {
+            return None;
+        }
+        // Rᵀ u = e_c, forward substitution (Rᵀ is lower triangular); then e_cᵀ(RᵀR)⁻¹e_c
+        // = ‖u‖².
+        let mut u = SVector::<f64, SHARED>::zeros();
+        for i in column..SHARED {
+            let d = self.rt[(i, i)];
+            if d == 0.0 {
+                continue;
+            }
+            let mut v = if i == column { 1.0 } else { 0.0 };
+            for k in column..i {
+                v -= self.rt[(i, k)] * u[k];
+            }
+            u[i] = v / d;
+        }
+        Some(sqrt(s2 * u.norm_squared()))
     }
 
     /// The reduced problem in `j` with the disturbance torque `τ_b` held at zero instead of

@@ -2,8 +2,8 @@
 //! blocks: the layout of `x` is this list, and every column index follows from it.
 //!
 //! ```text
-//! x = [ X₀ (3) │ X₁ (3) │ τ_b (3) │ κ (1) │ j (6) ]
-//!       ╰── per chain ──╯ ╰─── shared by every chain ───╯
+//! x = [ X₀ (3) │ X₁ (3) │ τ_b (3) │ κ (1) │ D (1) │ j (6) ]
+//!       ╰── per chain ──╯ ╰─────── shared by every chain ───────╯
 //! ```
 //!
 //! * **Per chain** ([`Scope::Chain`]): unknowns of one chain of rows, minimised out as the
@@ -41,17 +41,20 @@ pub enum Block {
     BodyTorque,
     /// `κ`: the wheel-momentum curvature coefficient of the adaptive stencil.
     Kappa,
+    /// `D`: the coefficient of a linear damping torque `−D ω` (air drag), N m s.
+    Damping,
     /// `j = [J11, J22, J33, J12, J13, J23]`, kg m².
     J,
 }
 
 impl Block {
     /// Every block, in column order: per-chain blocks first, `j` last.
-    pub const ALL: [Block; 5] = [
+    pub const ALL: [Block; 6] = [
         Block::Anchor0,
         Block::Anchor1,
         Block::BodyTorque,
         Block::Kappa,
+        Block::Damping,
         Block::J,
     ];
 
@@ -60,7 +63,7 @@ impl Block {
     pub const fn width(self) -> usize {
         match self {
             Block::Anchor0 | Block::Anchor1 | Block::BodyTorque => 3,
-            Block::Kappa => 1,
+            Block::Kappa | Block::Damping => 1,
             Block::J => 6,
         }
     }
@@ -70,7 +73,7 @@ impl Block {
     pub const fn scope(self) -> Scope {
         match self {
             Block::Anchor0 | Block::Anchor1 => Scope::Chain,
-            Block::BodyTorque | Block::Kappa | Block::J => Scope::Shared,
+            Block::BodyTorque | Block::Kappa | Block::Damping | Block::J => Scope::Shared,
         }
     }
 
@@ -82,6 +85,7 @@ impl Block {
             Block::Anchor1 => "initial momentum (odd subgrid)",
             Block::BodyTorque => "body-frame torque",
             Block::Kappa => "wheel-momentum curvature",
+            Block::Damping => "damping",
             Block::J => "inertia",
         }
     }

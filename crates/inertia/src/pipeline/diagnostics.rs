@@ -24,6 +24,9 @@ pub struct Diagnostics {
     pub row_model: Option<MomentumRowSettings>,
     /// The estimated constant body-frame disturbance torque, N m, where estimated.
     pub torque_bias_nm: Option<Vector3<f64>>,
+    /// The estimated damping coefficient `D` of a torque `−D ω`, N m s, and its
+    /// least-squares σ, where estimated ([`super::PipelineSettings::damping`]).
+    pub damping_nms: Option<(f64, Option<f64>)>,
     /// The test for a constant disturbance torque at the last solve, where made: whether
     /// the torque was held at zero for want of evidence
     /// ([`crate::estimator::discrete_momentum::torque_tested`]).

@@ -136,6 +136,13 @@ pub struct Report {
     pub row_model: Option<MomentumRowSettings>,
     /// The estimated constant body-frame disturbance torque, N m.
     pub torque_bias_nm: Option<[f64; 3]>,
+    /// The estimated damping coefficient `D` of a torque `−D ω`, N m s (only with
+    /// `damping` on).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_nms: Option<f64>,
+    /// Its least-squares σ, N m s (white-noise σ; only with `damping` on).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub damping_sigma_nms: Option<f64>,
     /// The test for that torque: `chi2`, and whether it was held at zero for want of
     /// evidence (`held_at_zero`; then `torque_bias_nm` is `null`).
     pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
@@ -374,6 +381,8 @@ impl Report {
             excitation: None,
             row_model: None,
             torque_bias_nm: None,
+            damping_nms: None,
+            damping_sigma_nms: None,
             torque_test: None,
             active_bounds: estimate
                 .j()
@@ -567,6 +576,8 @@ impl Report {
         self.excitation = d.excitation;
         self.row_model = d.row_model;
         self.torque_bias_nm = d.torque_bias_nm.map(|t| [t.x, t.y, t.z]);
+        self.damping_nms = d.damping_nms.map(|d| d.0);
+        self.damping_sigma_nms = d.damping_nms.and_then(|d| d.1);
         self.torque_test = d.torque_test;
         self.attitude_is_gyro_integral = d.attitude_is_gyro_integral;
         self.drift_weighted = d.drift_weighted;

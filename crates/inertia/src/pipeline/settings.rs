@@ -61,6 +61,10 @@ pub struct PipelineSettings {
     /// Whether to estimate a disturbance torque constant in the inertial frame, per chain
     /// (discrete momentum estimator; default [`InertialTorque::Off`]).
     pub inertial_torque: InertialTorque,
+    /// Estimate a linear damping torque `−D ω` (air drag on a tumbling body; discrete
+    /// momentum estimator; default `false`): one more shared unknown `D`, N m s
+    /// ([`crate::estimator::momentum_rows`], "Damping").
+    pub damping: bool,
     /// Short momentum chain, s (discrete momentum estimator): bounds how far a
     /// drifting attitude error can rotate the conserved momentum
     /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
@@ -114,6 +118,7 @@ impl Default for PipelineSettings {
             rho_model: RhoModel::Auto,
             torque_bias: true,
             inertial_torque: InertialTorque::Off,
+            damping: false,
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
             glitches: GlitchPolicy::Stop,
@@ -140,6 +145,7 @@ pub struct PipelineConfig {
     pub(crate) rho_model: RhoModel,
     pub(crate) torque_bias: bool,
     pub(crate) inertial_torque: InertialTorque,
+    pub(crate) damping: bool,
     pub(crate) max_chain_s: Option<f64>,
     pub(crate) attitude_drift_deg_rth: Option<f64>,
     pub(crate) glitches: GlitchPolicy,
@@ -268,6 +274,7 @@ impl PipelineSettings {
                     "inertial_torque",
                     self.inertial_torque != defaults.inertial_torque,
                 ),
+                ("damping", self.damping != defaults.damping),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
                 (
                     "attitude_drift_deg_rth",
@@ -333,6 +340,7 @@ impl PipelineSettings {
             rho_model: self.rho_model,
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
+            damping: self.damping,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift_deg_rth,
             glitches: self.glitches,
@@ -409,6 +417,7 @@ impl PipelineConfig {
         } else {
             InertialTorque::Off
         };
+        self.damping = r.damping;
         self.pinned_chain_s = Some(r.max_chain_s);
         self
     }

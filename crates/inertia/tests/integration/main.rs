@@ -12,6 +12,7 @@ mod changing_inertia;
 mod consistency;
 mod constraints;
 mod csv_robustness;
+mod damping;
 mod discrete_convergence;
 mod discrete_momentum;
 mod dynamics;

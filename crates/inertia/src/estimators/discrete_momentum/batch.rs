@@ -105,9 +105,12 @@ pub(super) fn run_batch(
     let (mut estimate, noise) = run.own(chosen)?;
     // (The span test needs the recursive residuals, which a batch reduction does not
     // form.)
-    let gyro_density_ratio = match finish(&mut estimate, noise, &mut run)? {
-        Finished::Checked { density_ratio } => density_ratio,
-        Finished::Reversed => None,
+    let (gyro_density_ratio, damping_nms) = match finish(&mut estimate, noise, &mut run)? {
+        Finished::Checked {
+            density_ratio,
+            damping,
+        } => (density_ratio, damping),
+        Finished::Reversed => (None, None),
     };
     Ok(BatchOutput {
         estimate,
@@ -117,6 +120,7 @@ pub(super) fn run_batch(
             row_model: Some(*rows),
             torque_test,
             gyro_density_ratio,
+            damping_nms,
             attitude_is_gyro_integral,
             ..Diagnostics::default()
         },
@@ -281,6 +285,10 @@ impl Evidence for BatchRun<'_> {
 
     fn residuals(&mut self, _: &Estimate) -> Option<&ResidualSegments> {
         None
+    }
+
+    fn damping(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+        Some(self.reduced.get(self.chosen)?.1.damping?.at(j))
     }
 }
 

@@ -58,6 +58,7 @@ pub(super) fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowS
                         stencil,
                         torque_bias: c.torque_bias,
                         inertial_torque,
+                        damping: c.damping,
                         max_chain_s,
                     });
                 }

@@ -18,7 +18,7 @@ use super::sigma::{quadrature, scale_from_prior, NO_EIGEN};
 use crate::eigen3::symmetric_eigen3;
 use crate::estimator::audit::{audit_at, reversed_at_floor};
 use crate::estimator::consistency::{self, ResidualSegments};
-use crate::estimator::observability::Observability;
+use crate::estimator::observability::{Observability, Unobservable, NEGATIVE_DAMPING_Z};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::uncertainty::with_bias_at;
 use crate::estimator::Estimate;
@@ -51,6 +51,9 @@ pub(super) trait Evidence {
     /// The chosen candidate's residual record to test `e` against, once `e` has been noted
     /// as the reference of the spans that start after it (`None`: no record).
     fn residuals(&mut self, e: &Estimate) -> Option<&ResidualSegments>;
+    /// The damping `D` (N m s) that fits best at `j`, with its σ (the larger of the
+    /// least-squares and the jackknife σ), where the chosen rows estimate one.
+    fn damping(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)>;
 }
 
 /// How [`finish`] ended.
@@ -59,10 +62,12 @@ pub(super) enum Finished {
     /// The answer was told as a reversed ρ ([`reversed_at_floor`]): nothing after it ran.
     Reversed,
     /// Every step ran; the residuals' ratio to the stated gyro density
-    /// ([`Evidence::density_ratio`]).
+    /// ([`Evidence::density_ratio`]) and the damping with its σ ([`damping`]).
     Checked {
         /// `None`: no test.
         density_ratio: Option<f64>,
+        /// `(D, σ_D)`, N m s; `None` where not estimated.
+        damping: Option<(f64, Option<f64>)>,
     },
 }
 
@@ -126,5 +131,26 @@ pub(super) fn finish<V: Evidence>(
         _ => None,
     };
     consistency::check(e, evidence.residuals(e), density_ratio, stated);
-    Ok(Finished::Checked { density_ratio })
+    let damping = damping(e, evidence);
+    Ok(Finished::Checked {
+        density_ratio,
+        damping,
+    })
+}
+
+/// The damping `D` at the answer with its σ ([`Evidence::damping`]: the larger of the
+/// least-squares and the jackknife σ, as `j`'s noise σ), and the model check on its sign:
+/// a `D` negative beyond [`NEGATIVE_DAMPING_Z`] of its σ fails it, since a drag cannot
+/// feed energy in, so the damping's column stands in for another effect.
+fn damping<V: Evidence>(e: &mut Estimate, evidence: &V) -> Option<(f64, Option<f64>)> {
+    let (d, sigma) = evidence.damping(&e.j()?)?;
+    if let (Some(s), Observability::Determined { .. }) = (sigma, e.observability) {
+        if d < -NEGATIVE_DAMPING_Z * s {
+            e.observability = Observability::ModelCheckFailed(Unobservable::NegativeDamping {
+                damping_nms: d,
+                sigma_nms: s,
+            });
+        }
+    }
+    Some((d, sigma))
 }

@@ -113,6 +113,8 @@ struct DiscreteMomentum {
     residuals: Vec<ResidualSegments>,
     /// The residuals' ratio to the stated gyro density at the last solve.
     density_ratio: Option<f64>,
+    /// The damping at the last answer with its widened σ ([`finish`]).
+    damping: Option<(f64, Option<f64>)>,
     /// Input samples so far.
     samples: usize,
     /// Samples that completed a row block (the cross-check's clock).
@@ -170,6 +172,7 @@ impl DiscreteMomentum {
             shadow: None,
             residuals: Vec::new(),
             density_ratio: None,
+            damping: None,
             samples: 0,
             blocks: 0,
             held: None,
@@ -361,8 +364,13 @@ impl DiscreteMomentum {
             t_s,
             record,
         };
-        if let Finished::Checked { density_ratio } = finish(&mut e, noise, &mut evidence)? {
+        if let Finished::Checked {
+            density_ratio,
+            damping,
+        } = finish(&mut e, noise, &mut evidence)?
+        {
             self.density_ratio = density_ratio;
+            self.damping = damping;
         }
         Ok(Some(e))
     }
@@ -452,6 +460,7 @@ impl Estimator for DiscreteMomentum {
                 .map(|c| diagnose(c.reduced(), &g.config.observability)),
             row_model: chosen.map(|c| *c.row_settings()),
             torque_bias_nm: chosen.and_then(|c| c.torque_bias_nm()),
+            damping_nms: g.damping,
             torque_test: chosen.and_then(|c| c.torque_test()),
             residual_consistency: g.residuals.get(g.chosen).and_then(|r| r.worst()),
             gyro_density_ratio: g.density_ratio,
@@ -558,6 +567,10 @@ impl Evidence for Streaming<'_> {
             Some(d) if self.record => consistency::gyro_density_ratio(&d.qr().reduced(), j, g),
             _ => None,
         }
+    }
+
+    fn damping(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+        self.chosen().damping_at(j)
     }
 
     fn residuals(&mut self, e: &Estimate) -> Option<&ResidualSegments> {

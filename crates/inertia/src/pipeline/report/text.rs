@@ -239,6 +239,12 @@ impl fmt::Display for ReportText<'_> {
                 )?,
             }
         }
+        if let Some(d) = r.damping_nms {
+            match r.damping_sigma_nms {
+                Some(sd) => writeln!(s, "unknown damping −D ω: D = {d:.3e} ± {sd:.1e} N m s")?,
+                None => writeln!(s, "unknown damping −D ω: D = {d:.3e} N m s")?,
+            }
+        }
         match r.drift_weighted {
             Some(true) => writeln!(
                 s,
