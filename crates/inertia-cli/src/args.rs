@@ -481,7 +481,7 @@ pub struct EstimateArgs {
     /// taken where a nested chi-squared test at 1e-3 and the BIC both say the data need
     /// it, and the report's `rows:` line says so).
     #[arg(long, value_name = "MODE", default_value = "off",
-          value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
+          value_parser = clap::builder::PossibleValuesParser::new(<inertia::pipeline::InertialTorque as inertia::choice::Choice>::NAMES))]
     pub inertial_torque: String,
     /// The wheel-speed telemetry's time tag: the speeds are read δ later than their time
     /// stamps. `off` (default), the delay in seconds (e.g. `0.05`; negative: early), or

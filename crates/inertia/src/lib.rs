@@ -85,6 +85,8 @@
 
 pub mod attitude;
 mod barrier;
+#[cfg(feature = "std")]
+pub mod choice;
 pub mod constraints;
 pub mod discrete;
 pub mod discrete_momentum;
