@@ -551,7 +551,7 @@ pub fn pipeline(kw: &Kwargs<'_>) -> PyResult<PipelineSettings> {
         torque_bias: kw.bool("torque_bias", true)?,
         rotor_scale_sigma: kw.f64("rotor_scale_sigma")?,
         filter_cutoff_hz: kw.f64("filter_cutoff_hz")?,
-        inertial_torque: match kw.choice("inertial_torque", &InertialTorque::NAMES)? {
+        inertial_torque: match kw.choice("inertial_torque", <InertialTorque as inertia::choice::Choice>::NAMES)? {
             Some(name) => name
                 .parse()
                 .map_err(|e: PipelineError| value_error(e.to_string()))?,
