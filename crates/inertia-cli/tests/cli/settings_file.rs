@@ -136,12 +136,12 @@ fn a_bad_run_file_names_the_file_line_and_key() {
         (
             "unknown.toml",
             "every = 2\n\nmemroy = 30\n",
-            &["unknown.toml:3: `memroy`: unknown field `memroy`"][..],
+            &["unknown.toml:3: `memroy`: unknown key `memroy`"][..],
         ),
         (
             "type.toml",
             "memory = \"long\"\n",
-            &["type.toml:1: `memory`: invalid type: string \"long\""][..],
+            &["type.toml:1: `memory`: invalid type: string \"long\", expected a number"][..],
         ),
         (
             "choice.toml",
@@ -151,7 +151,7 @@ fn a_bad_run_file_names_the_file_line_and_key() {
         (
             "unknown.json",
             "{\n  \"every\": 2,\n  \"chian\": 3\n}\n",
-            &["unknown.json:3: `chian`: unknown field `chian`"][..],
+            &["unknown.json:3: `chian`: unknown key `chian`"][..],
         ),
         // Validation is the settings' own, in the options' words.
         (

@@ -59,6 +59,7 @@ impl RunDescription {
     pub fn parse(text: &str, file: &str, json: bool) -> Result<Self, RunFileError> {
         let line_of = |offset: usize| 1 + text[..offset.min(text.len())].matches('\n').count();
         let err = |line: Option<usize>, message: &str| {
+            let message = plain(message);
             // The key of the line the error points at (`key = …` or `"key": …`).
             let key = line.and_then(|l| {
                 let (k, _) = text
@@ -75,7 +76,7 @@ impl RunDescription {
                 file: file.to_string(),
                 line,
                 key,
-                message: format!(" {}", Clipped::with_limit(message, 300)),
+                message: format!(" {}", Clipped::with_limit(&message, 300)),
             }
         };
         if json {
@@ -110,4 +111,19 @@ impl RunDescription {
             }
         }
     }
+}
+
+/// A deserialiser's message in a user's words: an unknown key without the list of every
+/// key, serde's type names as what they are.
+fn plain(message: &str) -> String {
+    let m = match message.split_once(", expected one of `") {
+        Some((head, _)) if head.starts_with("unknown field") => {
+            format!("{head} (the keys are `inertia estimate`'s long options in snake case)")
+        }
+        _ => message.to_string(),
+    };
+    m.replace("unknown field", "unknown key")
+        .replace("expected f64", "expected a number")
+        .replace("expected usize", "expected an integer >= 0")
+        .replace("expected a boolean", "expected true or false")
 }
