@@ -312,7 +312,15 @@ impl Plan {
             // 0: chosen from the data; k ≥ 1: the library's value k − 1.
             rotation_source: match s.rotation_source {
                 0 => None,
-                k => Some(library_choice::<RotationSource>("rotation_source", k - 1)?),
+                k => Some(*RotationSource::ALL.get(k as usize - 1).ok_or_else(|| {
+                    fail(
+                        InertiaStatus::InvalidSetting,
+                        format_args!(
+                            "setting `rotation_source` = {k} is invalid: expected 0 to {}",
+                            RotationSource::ALL.len()
+                        ),
+                    )
+                })?),
             },
             rho_model: library_choice("rho_model", s.rho_model)?,
             inertial_torque: library_choice("inertial_torque", s.inertial_torque)?,

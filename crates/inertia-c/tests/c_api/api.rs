@@ -132,6 +132,22 @@ fn bad_settings_name_the_setting() {
         ),
         (
             InertiaSettings {
+                rotation_source: 3,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "`rotation_source` = 3 is invalid: expected 0 to 2",
+        ),
+        (
+            InertiaSettings {
+                solver: 3,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "`solver` = 3 is invalid: expected 0 (default) to 2",
+        ),
+        (
+            InertiaSettings {
                 solve_every: 0,
                 ..variational()
             },
