@@ -73,12 +73,16 @@ static int column(char names[][64], int n, const char *name) {
     return -1;
 }
 
-static const char *estimator_kind_name(uint32_t kind) {
-    switch (kind) {
-    case INERTIA_ESTIMATOR_KIND_DISCRETE_MOMENTUM: return "discrete-momentum";
-    case INERTIA_ESTIMATOR_KIND_VARIATIONAL: return "variational";
-    case INERTIA_ESTIMATOR_KIND_FINITE_DIFFERENCE: return "finite-difference";
-    default: return "momentum";
+/* The name of an estimator id (INERTIA_ESTIMATOR_*, generated from the library's
+   registry), or NULL past the last. */
+static const char *estimator_name(uint32_t id) {
+    switch (id) {
+    case INERTIA_ESTIMATOR_VARIATIONAL: return "variational";
+    case INERTIA_ESTIMATOR_DISCRETE_MOMENTUM: return "discrete-momentum";
+    case INERTIA_ESTIMATOR_FINITE_DIFFERENCE: return "finite-difference";
+    case INERTIA_ESTIMATOR_MOMENTUM: return "momentum";
+    case INERTIA_ESTIMATOR_EQUATION_ERROR: return "equation-error";
+    default: return NULL;
     }
 }
 
@@ -103,12 +107,12 @@ int main(int argc, char **argv) {
         } else if (strcmp(argv[i], "--estimator") == 0 && i + 1 < argc) {
             const char *name = argv[++i];
             uint32_t k;
-            for (k = 0; k <= INERTIA_ESTIMATOR_KIND_MOMENTUM; k++) {
-                if (strcmp(name, estimator_kind_name(k)) == 0) {
+            for (k = 1; estimator_name(k) != NULL; k++) {
+                if (strcmp(name, estimator_name(k)) == 0) {
                     break;
                 }
             }
-            if (k > INERTIA_ESTIMATOR_KIND_MOMENTUM) {
+            if (estimator_name(k) == NULL) {
                 fprintf(stderr, "unknown estimator `%s`\n", name);
                 return 2;
             }
@@ -249,7 +253,9 @@ int main(int argc, char **argv) {
         char reason[512];
         inertia_estimator_reason(est, reason, sizeof reason);
         push_allocations += ALLOCATIONS() - before;
-        printf("estimator: %s (%s)\n", estimator_kind_name(settings.estimator),
+        printf("estimator: %s (%s)\n",
+               settings.estimator == INERTIA_ESTIMATOR_DEFAULT ? "discrete-momentum (default)"
+                                                                : estimator_name(settings.estimator),
                use_storage ? "caller storage" : "heap");
         printf("samples: %llu, t = %.17g s\n", (unsigned long long)e.samples, e.t_s);
         printf("status: %s%s%s\n", status_word(e.status), reason[0] ? ": " : "", reason);

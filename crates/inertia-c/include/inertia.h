@@ -8,6 +8,33 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// Ids of `InertiaSettings::estimator`, in the order of the library's registry
+// (`inertia::pipeline::registry`); 0 is the library's default (discrete-momentum).
+enum {
+  INERTIA_ESTIMATOR_DEFAULT = 0,
+  // `variational`: discrete variational rows (paper eqs. 53-54), constrained least squares (the paper's Algorithm 1).
+  INERTIA_ESTIMATOR_VARIATIONAL = 1,
+  // `discrete-momentum`: discrete conservation of angular momentum (telescoped paper rows), unknown constant torque, Richardson O(h^4) rows, constrained (default).
+  INERTIA_ESTIMATOR_DISCRETE_MOMENTUM = 2,
+  // `finite-difference`: the paper's finite-difference SDP baseline (eq. 26, differenced gyro rates).
+  INERTIA_ESTIMATOR_FINITE_DIFFERENCE = 3,
+  // `momentum`: momentum-based RLS baseline (Norman, Peck & O'Shaughnessy 2011), unconstrained, needs gyro rates.
+  INERTIA_ESTIMATOR_MOMENTUM = 4,
+  // `equation-error`: filtered equation-error least squares (Savitzky-Golay ω̇, ρ̇; Euler's equation), unconstrained, needs gyro rates.
+  INERTIA_ESTIMATOR_EQUATION_ERROR = 5,
+};
+
+// Ids of `InertiaSettings::solver`, in the order of the library's registry
+// (`inertia::pipeline::registry`); 0 is the library's default (native).
+enum {
+  INERTIA_SOLVER_DEFAULT = 0,
+  // `native`: pure-Rust active-set, LMI-face Newton and barrier paths (default).
+  INERTIA_SOLVER_NATIVE = 1,
+  // `clarabel`: Clarabel interior-point conic solver (builds with the `clarabel` feature).
+  INERTIA_SOLVER_CLARABEL = 2,
+};
+
+
 // What a function did: `INERTIA_STATUS_OK`, or why not.
 typedef enum InertiaStatus {
   // Success.
@@ -128,24 +155,14 @@ typedef enum InertiaErrorKind {
   INERTIA_ERROR_KIND_OTHER = 15,
 } InertiaErrorKind;
 
-// The estimators (`InertiaSettings::estimator`).
-typedef enum InertiaEstimatorKind {
-  // The discrete momentum estimator (the CLI's default; heap only).
-  INERTIA_ESTIMATOR_KIND_DISCRETE_MOMENTUM = 0,
-  // The paper's discrete variational estimator (heap or caller storage).
-  INERTIA_ESTIMATOR_KIND_VARIATIONAL = 1,
-  // The paper's finite-difference baseline; needs gyro rates (heap or caller storage).
-  INERTIA_ESTIMATOR_KIND_FINITE_DIFFERENCE = 2,
-  // The momentum recursive least-squares baseline, unconstrained (heap only).
-  INERTIA_ESTIMATOR_KIND_MOMENTUM = 3,
-} InertiaEstimatorKind;
-
 // The feasible set of J (`InertiaSettings::constraints`).
 typedef enum InertiaConstraintKind {
   // J ⪰ εI and Σ = ½tr(J)I − J ⪰ 0 (default).
   INERTIA_CONSTRAINT_KIND_PHYSICAL = 0,
   // The paper's set: J ⪰ εI and the diagonal triangle inequalities.
   INERTIA_CONSTRAINT_KIND_PAPER = 1,
+  // J ⪰ εI only.
+  INERTIA_CONSTRAINT_KIND_POSITIVE_DEFINITE = 2,
 } InertiaConstraintKind;
 
 // Where the discrete momentum estimator takes the rotation from
@@ -172,6 +189,17 @@ typedef enum InertiaRhoModel {
   INERTIA_RHO_MODEL_PLAIN = 3,
 } InertiaRhoModel;
 
+// Whether to estimate a torque constant in the inertial frame, per chain
+// (`InertiaSettings::inertial_torque`, discrete momentum; the CLI's `--inertial-torque`).
+typedef enum InertiaInertialTorque {
+  // Not estimated (default).
+  INERTIA_INERTIAL_TORQUE_OFF = 0,
+  // Always estimated.
+  INERTIA_INERTIAL_TORQUE_ON = 1,
+  // Estimated where a nested χ² test says the data need it.
+  INERTIA_INERTIAL_TORQUE_AUTO = 2,
+} InertiaInertialTorque;
+
 // What to do when the attitude jumps against the gyro (`InertiaSettings::glitches`).
 typedef enum InertiaGlitchPolicy {
   // Stop with `INERTIA_STATUS_DATA` (default).
@@ -188,7 +216,8 @@ typedef struct InertiaEstimator InertiaEstimator;
 // unknown value is `INERTIA_STATUS_INVALID_SETTING`, never undefined behaviour); flags
 // are 0 or non-zero. Units SI.
 typedef struct InertiaSettings {
-  // One of `InertiaEstimatorKind`. Default discrete momentum.
+  // An `INERTIA_ESTIMATOR_*` id (the library's registry, in order, from 1); 0
+  // (default): the library's default, discrete momentum.
   uint32_t estimator;
   // One of `InertiaConstraintKind`. Default physical.
   uint32_t constraints;
@@ -235,6 +264,9 @@ typedef struct InertiaSettings {
   // Relative σ of the wheel momentum's scale (their spin inertia known to ±this), a
   // consider parameter that widens σ; 0 (default) for none. Heap only.
   double rotor_scale_sigma;
+  // An `INERTIA_SOLVER_*` id (the library's registry, in order, from 1); 0 (default):
+  // the library's default, native. Caller storage runs the native solver only.
+  uint32_t solver;
 } InertiaSettings;
 
 // One telemetry sample at time `t_s` (README "Estimating your own telemetry").
@@ -293,7 +325,7 @@ extern "C" {
 // The default settings: the discrete momentum estimator, the physical constraint set,
 // no bounds, no memory, no resampling, no gyro-noise compensation, σ on, torque bias on,
 // chains of 30 s, glitches stop the run (the CLI's `estimate` defaults). For caller
-// storage set `estimator = INERTIA_ESTIMATOR_KIND_VARIATIONAL`.
+// storage set `estimator = INERTIA_ESTIMATOR_VARIATIONAL`.
 struct InertiaSettings inertia_settings_default(void);
 
 // Create an estimator on the heap (any estimator). On success `*out` holds it; free it

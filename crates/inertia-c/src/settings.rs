@@ -1,30 +1,26 @@
 //! Settings from C: plain integers and numbers (no heap, no strings) validated into a
 //! [`Plan`], from which the heap engine's library settings or the fixed-size engine are
 //! built.
+//!
+//! The estimator and the solver backend are selected by id: `k ≥ 1` is entry `k − 1` of
+//! the library's registry ([`ESTIMATORS`], [`BACKENDS`]), 0 the library's default. The
+//! header's `INERTIA_ESTIMATOR_*` and `INERTIA_SOLVER_*` constants are generated from the
+//! same registry (`tests/header.rs`): this crate keeps no list of its own. The other
+//! choices index the library's [`Choice::ALL`] (`tests/c_api/api.rs` checks that each
+//! named constant is the value of the same name).
 
 use crate::engine::{self, Engine, FixedConfig};
 use crate::status::{fail, pipeline_fail, InertiaStatus};
+use inertia::choice::Choice;
+use inertia::constraints::Consistency;
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
 use inertia::estimator::observability::ObservabilitySettings;
 use inertia::estimator::recursive::RecursiveSettings;
+use inertia::pipeline::registry::{BackendEntry, EstimatorEntry, BACKENDS, ESTIMATORS};
 use inertia::pipeline::{InertialTorque, PipelineError, PipelineSettings};
 use inertia::telemetry::glitch::GlitchPolicy;
 use inertia::tensor::Component;
-
-/// The estimators (`InertiaSettings::estimator`).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum InertiaEstimatorKind {
-    /// The discrete momentum estimator (the CLI's default; heap only).
-    DiscreteMomentum = 0,
-    /// The paper's discrete variational estimator (heap or caller storage).
-    Variational = 1,
-    /// The paper's finite-difference baseline; needs gyro rates (heap or caller storage).
-    FiniteDifference = 2,
-    /// The momentum recursive least-squares baseline, unconstrained (heap only).
-    Momentum = 3,
-}
 
 /// The feasible set of J (`InertiaSettings::constraints`).
 #[repr(C)]
@@ -34,6 +30,8 @@ pub enum InertiaConstraintKind {
     Physical = 0,
     /// The paper's set: J ⪰ εI and the diagonal triangle inequalities.
     Paper = 1,
+    /// J ⪰ εI only.
+    PositiveDefinite = 2,
 }
 
 /// Where the discrete momentum estimator takes the rotation from
@@ -94,7 +92,8 @@ pub enum InertiaGlitchPolicy {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InertiaSettings {
-    /// One of `InertiaEstimatorKind`. Default discrete momentum.
+    /// An `INERTIA_ESTIMATOR_*` id (the library's registry, in order, from 1); 0
+    /// (default): the library's default, discrete momentum.
     pub estimator: u32,
     /// One of `InertiaConstraintKind`. Default physical.
     pub constraints: u32,
@@ -141,11 +140,15 @@ pub struct InertiaSettings {
     /// Relative σ of the wheel momentum's scale (their spin inertia known to ±this), a
     /// consider parameter that widens σ; 0 (default) for none. Heap only.
     pub rotor_scale_sigma: f64,
+    /// An `INERTIA_SOLVER_*` id (the library's registry, in order, from 1); 0 (default):
+    /// the library's default, native. Caller storage runs the native solver only.
+    pub solver: u32,
 }
 
 /// What the C settings ask for, without the heap (no estimator name string).
 pub(crate) struct Plan {
-    kind: InertiaEstimatorKind,
+    estimator: &'static EstimatorEntry,
+    backend: &'static BackendEntry,
     constraints: ConstraintSet,
     solve_every: usize,
     pub(crate) memory_s: Option<f64>,
@@ -200,24 +203,61 @@ fn choice<T: Copy>(name: &str, v: u32, options: &[T]) -> Result<T, InertiaStatus
     })
 }
 
+/// Id `v` of a registry (`entries`): 0 is the entry called `default`, `k ≥ 1` entry
+/// `k − 1`.
+fn registered<T>(
+    name: &str,
+    v: u32,
+    entries: &'static [T],
+    entry_name: fn(&T) -> &'static str,
+    default: &str,
+) -> Result<&'static T, InertiaStatus> {
+    let found = match v {
+        0 => entries.iter().find(|e| entry_name(e) == default),
+        k => entries.get(k as usize - 1),
+    };
+    found.ok_or_else(|| {
+        fail(
+            InertiaStatus::InvalidSetting,
+            format_args!(
+                "setting `{name}` = {v} is invalid: expected 0 (default) to {}",
+                entries.len()
+            ),
+        )
+    })
+}
+
+/// A value of the library's choice `T` by its index in [`Choice::ALL`].
+fn library_choice<T: Choice>(name: &str, v: u32) -> Result<T, InertiaStatus> {
+    choice(name, v, T::ALL)
+}
+
 impl Plan {
     pub(crate) fn from_c(s: &InertiaSettings) -> Result<Self, InertiaStatus> {
-        use InertiaEstimatorKind as K;
-        let kind = choice(
+        let estimator = registered(
             "estimator",
             s.estimator,
-            &[
-                K::DiscreteMomentum,
-                K::Variational,
-                K::FiniteDifference,
-                K::Momentum,
-            ],
+            ESTIMATORS,
+            |e| e.name,
+            PipelineSettings::DEFAULT_ESTIMATOR,
         )?;
-        let mut constraints = choice(
-            "constraints",
-            s.constraints,
-            &[ConstraintSet::physical(), ConstraintSet::paper()],
+        let backend = registered(
+            "solver",
+            s.solver,
+            BACKENDS,
+            |e| e.name,
+            PipelineSettings::DEFAULT_SOLVER,
         )?;
+        if let Some(why) = backend.unavailable {
+            return Err(pipeline_fail(&PipelineError::SolverUnavailable {
+                name: backend.name,
+                why,
+            }));
+        }
+        let mut constraints = ConstraintSet {
+            consistency: library_choice::<Consistency>("constraints", s.constraints)?,
+            ..ConstraintSet::physical()
+        };
         for (k, c) in Component::ALL.iter().enumerate() {
             let (l, u) = (s.bound_lower_kg_m2[k], s.bound_upper_kg_m2[k]);
             if l.is_nan() || u.is_nan() || l == f64::INFINITY || u == f64::NEG_INFINITY {
@@ -259,7 +299,8 @@ impl Plan {
             (g > 0.0).then_some(g)
         };
         Ok(Plan {
-            kind,
+            estimator,
+            backend,
             constraints,
             solve_every: s.solve_every as usize,
             memory_s: optional_positive("memory_s", s.memory_s)?,
@@ -268,53 +309,39 @@ impl Plan {
             gyro_noise,
             uncertainty: s.uncertainty != 0,
             torque_bias: s.torque_bias != 0,
-            rotation_source: choice(
-                "rotation_source",
-                s.rotation_source,
-                &[
-                    None,
-                    Some(RotationSource::Attitude),
-                    Some(RotationSource::Gyro),
-                ],
-            )?,
-            rho_model: choice(
-                "rho_model",
-                s.rho_model,
-                &[
-                    RhoModel::Auto,
-                    RhoModel::Smooth,
-                    RhoModel::Held,
-                    RhoModel::Plain,
-                ],
-            )?,
-            inertial_torque: choice("inertial_torque", s.inertial_torque, &InertialTorque::ALL)?,
+            // 0: chosen from the data; k ≥ 1: the library's value k − 1.
+            rotation_source: match s.rotation_source {
+                0 => None,
+                k => Some(*RotationSource::ALL.get(k as usize - 1).ok_or_else(|| {
+                    fail(
+                        InertiaStatus::InvalidSetting,
+                        format_args!(
+                            "setting `rotation_source` = {k} is invalid: expected 0 to {}",
+                            RotationSource::ALL.len()
+                        ),
+                    )
+                })?),
+            },
+            rho_model: library_choice("rho_model", s.rho_model)?,
+            inertial_torque: library_choice("inertial_torque", s.inertial_torque)?,
             rotor_scale_sigma: {
                 finite("rotor_scale_sigma", s.rotor_scale_sigma)?;
                 (s.rotor_scale_sigma != 0.0).then_some(s.rotor_scale_sigma)
             },
             max_chain_s: optional_positive("max_chain_s", s.max_chain_s)?,
-            glitches: choice(
-                "glitches",
-                s.glitches,
-                &[GlitchPolicy::Stop, GlitchPolicy::Keep],
-            )?,
+            glitches: library_choice("glitches", s.glitches)?,
         })
     }
 
     fn name(&self) -> &'static str {
-        match self.kind {
-            InertiaEstimatorKind::DiscreteMomentum => "discrete-momentum",
-            InertiaEstimatorKind::Variational => "variational",
-            InertiaEstimatorKind::FiniteDifference => "finite-difference",
-            InertiaEstimatorKind::Momentum => "momentum",
-        }
+        self.estimator.name
     }
 
     /// The library's settings (allocates: the estimator's name is a `String`).
     pub(crate) fn pipeline_settings(&self) -> PipelineSettings {
         PipelineSettings {
-            estimator: self.name().into(),
-            solver: "native".into(),
+            estimator: self.estimator.name.into(),
+            solver: self.backend.name.into(),
             constraints: self.constraints,
             solve_every: self.solve_every,
             memory_s: self.memory_s,
@@ -329,8 +356,8 @@ impl Plan {
             // Air drag: a laboratory effect, not in the C API.
             damping: false,
             rotor_scale_sigma: self.rotor_scale_sigma,
-            // C has no estimator that filters (the equation-error baseline is not one of
-            // `InertiaEstimatorKind`).
+            // The filter's cutoff is the estimator's own default (`InertiaSettings` has
+            // none to give).
             filter_cutoff_hz: None,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift,
@@ -344,9 +371,10 @@ impl Plan {
     /// The fixed-size engine, validated as `PipelineSettings::validate` would, without
     /// the heap.
     pub(crate) fn fixed_engine(&self) -> Result<Engine, InertiaStatus> {
-        let fd = match self.kind {
-            InertiaEstimatorKind::Variational => false,
-            InertiaEstimatorKind::FiniteDifference => true,
+        // The two estimators this crate implements in fixed-size state.
+        let fd = match self.estimator.name {
+            "variational" => false,
+            "finite-difference" => true,
             _ => {
                 return Err(fail(
                     InertiaStatus::NeedsHeap,
@@ -357,6 +385,16 @@ impl Plan {
                 ))
             }
         };
+        if self.backend.name != PipelineSettings::DEFAULT_SOLVER {
+            return Err(fail(
+                InertiaStatus::NeedsHeap,
+                format_args!(
+                    "the {} solver cannot run in caller storage (only {} can): use inertia_estimator_new",
+                    self.backend.name,
+                    PipelineSettings::DEFAULT_SOLVER
+                ),
+            ));
+        }
         if self.resample_s.is_some() {
             return Err(fail(
                 InertiaStatus::NeedsHeap,
@@ -427,11 +465,11 @@ impl Plan {
 /// The default settings: the discrete momentum estimator, the physical constraint set,
 /// no bounds, no memory, no resampling, no gyro-noise compensation, σ on, torque bias on,
 /// chains of 30 s, glitches stop the run (the CLI's `estimate` defaults). For caller
-/// storage set `estimator = INERTIA_ESTIMATOR_KIND_VARIATIONAL`.
+/// storage set `estimator = INERTIA_ESTIMATOR_VARIATIONAL`.
 #[no_mangle]
 pub extern "C" fn inertia_settings_default() -> InertiaSettings {
     InertiaSettings {
-        estimator: InertiaEstimatorKind::DiscreteMomentum as u32,
+        estimator: 0,
         constraints: InertiaConstraintKind::Physical as u32,
         bound_lower_kg_m2: [f64::NEG_INFINITY; 6],
         bound_upper_kg_m2: [f64::INFINITY; 6],
@@ -450,5 +488,6 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         attitude_drift_deg_rth: 0.0,
         inertial_torque: InertiaInertialTorque::Off as u32,
         rotor_scale_sigma: 0.0,
+        solver: 0,
     }
 }

@@ -1,12 +1,58 @@
-//! `include/inertia.h` is what cbindgen makes of the crate now. On a difference the
-//! test fails and shows how to refresh it: `INERTIA_BLESS=1 cargo test -p inertia-c --test header`.
+//! `include/inertia.h` is what cbindgen makes of the crate now, with the estimator and
+//! solver ids generated from the library's registry. On a difference the test fails and
+//! shows how to refresh it: `INERTIA_BLESS=1 cargo test -p inertia-c --test header`.
 
+use inertia::pipeline::registry::{BACKENDS, ESTIMATORS};
+use inertia::pipeline::PipelineSettings;
+use std::fmt::Write;
 use std::path::Path;
+
+/// `INERTIA_<KIND>_<NAME>` constants for a registry's entries: 0 the default, entry
+/// `k − 1` is `k` (the mapping `crates/inertia-c/src/settings.rs` applies).
+fn ids(kind: &str, field: &str, names: &[(&str, &str)], default: &str) -> String {
+    let constant = |name: &str| format!("INERTIA_{kind}_{}", name.replace('-', "_").to_uppercase());
+    let mut out = format!(
+        "// Ids of `InertiaSettings::{field}`, in the order of the library's registry\n// (`inertia::pipeline::registry`); 0 is the library's default ({default}).\nenum {{\n  {} = 0,\n",
+        constant("default")
+    );
+    for (k, (name, summary)) in names.iter().enumerate() {
+        writeln!(
+            out,
+            "  // `{name}`: {summary}.\n  {} = {},",
+            constant(name),
+            k + 1
+        )
+        .unwrap();
+    }
+    out + "};\n"
+}
+
+/// The registry's ids as C constants (the header's `after_includes`).
+fn registry_ids() -> String {
+    let estimators: Vec<_> = ESTIMATORS.iter().map(|e| (e.name, e.summary)).collect();
+    let backends: Vec<_> = BACKENDS.iter().map(|e| (e.name, e.summary)).collect();
+    format!(
+        "\n{}\n{}",
+        ids(
+            "ESTIMATOR",
+            "estimator",
+            &estimators,
+            PipelineSettings::DEFAULT_ESTIMATOR
+        ),
+        ids(
+            "SOLVER",
+            "solver",
+            &backends,
+            PipelineSettings::DEFAULT_SOLVER
+        )
+    )
+}
 
 #[test]
 fn the_checked_in_header_is_current() {
     let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).unwrap();
+    let mut config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).unwrap();
+    config.after_includes = Some(registry_ids());
     let mut generated = Vec::new();
     cbindgen::Builder::new()
         .with_crate(crate_dir)
@@ -29,6 +75,15 @@ fn the_checked_in_header_is_current() {
             .zip(generated.lines())
             .find(|(a, b)| a != b)
     );
+    // Every registered estimator and backend has its id.
+    for (k, name) in ESTIMATORS.iter().map(|e| e.name).enumerate() {
+        let line = format!(
+            "INERTIA_ESTIMATOR_{} = {},",
+            name.replace('-', "_").to_uppercase(),
+            k + 1
+        );
+        assert!(generated.contains(&line), "{line} missing from the header");
+    }
     // Every exported function is declared.
     for f in [
         "inertia_settings_default",

@@ -1,6 +1,13 @@
 //! Command-line arguments (parsed first; validated into a config by `config`).
 
+use clap::builder::TypedValueParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use inertia::choice::Choice;
+use inertia::constraints::{Consistency, ProductConvention};
+use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
+use inertia::pipeline::InertialTorque;
+use inertia::telemetry::gate::GyroUnit;
+use inertia::telemetry::glitch::GlitchPolicy;
 use std::path::PathBuf;
 
 /// Estimate a spacecraft's inertia tensor from attitude telemetry.
@@ -277,61 +284,11 @@ fn registered(
     )
 }
 
-/// Constraint sets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
-pub enum ConstraintArg {
-    /// J ⪰ εI and Σ = ½ tr(J) I − J ⪰ 0 (exact physical consistency; default).
-    #[default]
-    Physical,
-    /// J ⪰ εI and the paper's diagonal triangle inequalities (eq. 9).
-    Paper,
-    /// J ⪰ εI only.
-    PositiveDefinite,
-}
-
-/// Conventions for products of inertia.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ProductsArg {
-    /// Tensor entries: J12 = −Σ m x y (this tool's convention).
-    Tensor,
-    /// CAD products of inertia: I_xy = +Σ m x y = −J12.
-    Cad,
-}
-
-/// Sources of the incremental rotations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum RotationArg {
-    /// `vec(q_k† q_{k+1})` of the attitude quaternions.
-    Attitude,
-    /// The gyro's angle increment `w h` over each step (needs `w_*` columns).
-    Gyro,
-}
-
-/// What to do with an attitude glitch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
-pub enum GlitchArg {
-    /// Stop with an error naming the line.
-    #[default]
-    Stop,
-    /// Estimate anyway; the report counts and lists the steps.
-    Keep,
-}
-
-/// Models of the wheel momentum between samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
-pub enum RhoModelArg {
-    /// Estimated from the data: Richardson rows, O(h^4), with the wheel momentum's mean
-    /// over each step corrected by a curvature coefficient estimated with J (smooth
-    /// wheel laws, commands held over each step, or commands that change between samples).
-    #[default]
-    Auto,
-    /// Smooth across two steps (a continuous law): Richardson rows, O(h^4).
-    Smooth,
-    /// Linear within each step (torque commands held over each telemetry step, changing
-    /// at the samples): Richardson rows with the double step's mean momentum, O(h^4).
-    Held,
-    /// Plain one-step rows, O(h^2), whatever the wheels do.
-    Plain,
+/// A choice-valued option: the library's names ([`Choice::NAMES`]) as clap's possible
+/// values, parsed into the library's value.
+fn choice<T: Choice + Clone + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
+    clap::builder::PossibleValuesParser::new(T::NAMES.iter().copied())
+        .map(|s| T::parse(&s).expect("clap passes one of the possible values"))
 }
 
 /// Input-format options shared by commands that read telemetry.
@@ -348,8 +305,8 @@ pub struct InputArgs {
     #[arg(long)]
     pub conjugate: bool,
     /// The unit of the gyro rate columns w_*: `rad/s` (default) or `deg/s`.
-    #[arg(long, value_name = "UNIT", value_parser = ["rad/s", "deg/s"], default_value = "rad/s")]
-    pub gyro_unit: String,
+    #[arg(long, value_name = "UNIT", value_parser = choice::<GyroUnit>())]
+    pub gyro_unit: Option<GyroUnit>,
     /// The rho columns hold the rotor momentum with the opposite sign (e.g. the wheels'
     /// reaction on the body): negate them as they are read.
     #[arg(long)]
@@ -362,9 +319,9 @@ pub struct InputArgs {
     /// Rename a column, e.g. `--column t=time --column rho_x=h_wheel_x`.
     #[arg(long = "column", value_name = "DEFAULT=NAME")]
     pub columns: Vec<String>,
-    /// Largest | |q| − 1 | that is renormalised (beyond it, an error).
-    #[arg(long, value_name = "TOL", default_value_t = inertia::telemetry::csv::DEFAULT_UNIT_TOLERANCE)]
-    pub unit_tolerance: f64,
+    /// Largest | |q| − 1 | that is renormalised (beyond it, an error) [default: 0.001].
+    #[arg(long, value_name = "TOL")]
+    pub unit_tolerance: Option<f64>,
     /// Strict mode: reject any step that differs from the first by more than TOL
     /// (relative). By default irregular sampling is accepted and gaps are counted.
     #[arg(long, value_name = "TOL")]
@@ -376,16 +333,25 @@ pub struct InputArgs {
 pub struct EstimateArgs {
     /// Telemetry CSV file (see README: t, q_x..q_w, rho_x..rho_z, optional tau_*, w_*).
     pub file: PathBuf,
+    /// A run file (TOML, or JSON for a name ending in `.json`) that gives any of the
+    /// options below (and the input options) by their long names in snake case
+    /// (`memory = 120`, `rho_model = "held"`, `bounds = ["J33=2.7:3.3"]`,
+    /// `torque_bias = false`, `columns = { t = "time" }`); the options given on the command
+    /// line override it. Relative file names in it are relative to its folder.
+    #[arg(long, value_name = "RUN.toml")]
+    pub settings: Option<PathBuf>,
     /// Estimator (default: the discrete momentum estimator, the most accurate in the
     /// README's Monte Carlo matrix; `variational` is the paper's).
-    #[arg(long, default_value = "discrete-momentum", value_parser = registered(inertia::pipeline::registry::ESTIMATORS.iter().map(|e| (e.name, e.summary))))]
-    pub estimator: String,
+    #[arg(long, value_parser = registered(inertia::pipeline::registry::ESTIMATORS.iter().map(|e| (e.name, e.summary))))]
+    pub estimator: Option<String>,
     /// One batch solve over all samples instead of the recursive estimator.
     #[arg(long)]
     pub batch: bool,
-    /// Constraint set.
-    #[arg(long, value_enum, default_value = "physical")]
-    pub constraints: ConstraintArg,
+    /// Constraint set: `physical` (J ⪰ εI and Σ = ½ tr(J) I − J ⪰ 0, exact physical
+    /// consistency; default), `paper` (J ⪰ εI and the paper's diagonal triangle
+    /// inequalities, eq. 9) or `positive-definite` (J ⪰ εI only).
+    #[arg(long, value_parser = choice::<Consistency>())]
+    pub constraints: Option<Consistency>,
     /// Bound an element, kg m²: `J33=2.7:3.3`, `J12=:0.05`, `J11=0.9:` (repeatable).
     #[arg(long = "bound", value_name = "Jij=LO:HI")]
     pub bounds: Vec<String>,
@@ -425,11 +391,11 @@ pub struct EstimateArgs {
     /// (i ≠ j): `tensor` (J12 = −Σ m x y, this tool's convention) or `cad` (I_xy = +Σ m x y,
     /// what CAD tools report). Default tensor; a `--prior`/`--nominal` file's own
     /// `products_of_inertia` applies to that file (and must agree with this option).
-    #[arg(long, value_enum, value_name = "CONVENTION")]
-    pub products: Option<ProductsArg>,
-    /// Solve every N samples (recursive estimators).
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub every: usize,
+    #[arg(long, value_name = "CONVENTION", value_parser = choice::<ProductConvention>())]
+    pub products: Option<ProductConvention>,
+    /// Solve every N samples (recursive estimators) [default: 1].
+    #[arg(long, value_name = "N")]
+    pub every: Option<usize>,
     /// Forget old data with this time constant, s (exponential weighting, for an inertia
     /// that changes). Shorter memory tracks faster and is noisier (README).
     #[arg(long, value_name = "S")]
@@ -457,20 +423,20 @@ pub struct EstimateArgs {
     /// attitude quaternions or the gyro's angle increments. Default: both are tried when
     /// the telemetry has gyro rates, and the rows that fit better are used (the report
     /// says which).
-    #[arg(long, value_enum, value_name = "SOURCE")]
-    pub rotation_source: Option<RotationArg>,
+    #[arg(long, value_name = "SOURCE", value_parser = choice::<RotationSource>())]
+    pub rotation_source: Option<RotationSource>,
     /// What the wheel momentum does between samples (discrete-momentum estimator):
     /// `auto` (estimated with J: smooth laws, commands held over each step, or commands
     /// that change between samples), `smooth`, `held` (torque commands held over each
     /// telemetry step, changing at the samples), or `plain` (O(h²) one-step rows).
-    #[arg(long, value_enum, default_value = "auto")]
-    pub rho_model: RhoModelArg,
+    #[arg(long, value_parser = choice::<RhoModel>())]
+    pub rho_model: Option<RhoModel>,
     /// A step where the attitude jumps against the gyro (a glitch in the quaternions or
     /// the rates; telemetry with `w_*` columns): `stop` with an error naming the line
     /// (default), or `keep` it and estimate anyway, the steps counted and listed in the
     /// report.
-    #[arg(long, value_enum, default_value = "stop")]
-    pub glitches: GlitchArg,
+    #[arg(long, value_parser = choice::<GlitchPolicy>())]
+    pub glitches: Option<GlitchPolicy>,
     /// Do not estimate an unknown constant disturbance torque (discrete-momentum
     /// estimator; by default it is estimated, at no cost when it is absent).
     #[arg(long)]
@@ -480,9 +446,8 @@ pub struct EstimateArgs {
     /// record), one per chain: `off` (default), `on`, or `auto` (both models folded; it is
     /// taken where a nested chi-squared test at 1e-3 and the BIC both say the data need
     /// it, and the report's `rows:` line says so).
-    #[arg(long, value_name = "MODE", default_value = "off",
-          value_parser = clap::builder::PossibleValuesParser::new(inertia::pipeline::InertialTorque::NAMES))]
-    pub inertial_torque: String,
+    #[arg(long, value_name = "MODE", value_parser = choice::<InertialTorque>())]
+    pub inertial_torque: Option<InertialTorque>,
     /// Estimate a linear damping torque −D·ω (air drag on a tumbling body; one more
     /// unknown D, N m s, reported; discrete-momentum estimator).
     #[arg(long)]
@@ -493,20 +458,15 @@ pub struct EstimateArgs {
     /// σ; its σ widens each element's). Any estimator; the run then keeps every sample
     /// and gives its estimates (and the history) at the end of the input. Speeds held
     /// between updates lag by about half the update period.
-    #[arg(
-        long,
-        value_name = "S|estimate",
-        default_value = "off",
-        allow_hyphen_values = true
-    )]
-    pub wheel_delay: String,
+    #[arg(long, value_name = "S|estimate", allow_hyphen_values = true)]
+    pub wheel_delay: Option<String>,
     /// Short momentum chain, s (discrete-momentum estimator): the conserved momentum is
     /// re-anchored after this long, which bounds the effect of a drifting attitude
     /// (gyro-propagated attitude); chains a quarter and 4x as long and one chain over the
     /// whole record are folded too, and the data choose (the report's `rows:` line says
-    /// which). `0` for chains that end only at gaps.
-    #[arg(long, value_name = "S", default_value_t = inertia::pipeline::DEFAULT_MAX_CHAIN_S)]
-    pub chain: f64,
+    /// which). `0` for chains that end only at gaps [default: 30].
+    #[arg(long, value_name = "S")]
+    pub chain: Option<f64>,
     /// True inertia (JSON) to report the relative Frobenius error against.
     #[arg(long, value_name = "J.json")]
     pub truth: Option<PathBuf>,
@@ -516,9 +476,9 @@ pub struct EstimateArgs {
     /// Print one JSON object instead of the readable report.
     #[arg(long)]
     pub json: bool,
-    /// Solver backend.
-    #[arg(long, default_value = "native", value_parser = registered(inertia::pipeline::registry::BACKENDS.iter().map(|e| (e.name, e.summary))))]
-    pub solver: String,
+    /// Solver backend [default: native].
+    #[arg(long, value_parser = registered(inertia::pipeline::registry::BACKENDS.iter().map(|e| (e.name, e.summary))))]
+    pub solver: Option<String>,
     /// Input format.
     #[command(flatten)]
     pub input: InputArgs,

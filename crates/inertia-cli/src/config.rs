@@ -1,15 +1,14 @@
-//! Arguments validated into configurations.
+//! Arguments into the library's run description ([`RunDescription`]: a run file's, the
+//! options given over it), and from it the library's settings, the options' names in
+//! messages.
 
-use crate::args::{
-    ConstraintArg, EstimateArgs, GlitchArg, InputArgs, ProductsArg, RhoModelArg, RotationArg,
-};
+use crate::args::EstimateArgs;
 use crate::error::{input, read_failed, CliError};
-use inertia::constraints::{ConstraintSet, ProductConvention};
-use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
+use inertia::constraints::ProductConvention;
 use inertia::pipeline::{PipelineError, PipelineSettings};
-use inertia::telemetry::csv::{ColumnNames, CsvOptions, QuaternionFormat};
-use inertia::telemetry::glitch::GlitchPolicy;
-use inertia::tensor::{j_from_matrix, Component};
+use inertia::run_description::{Bounds, ElementBound, InertiaInput, RunDescription};
+use inertia::telemetry::csv::CsvOptions;
+use inertia::tensor::j_from_matrix;
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -56,7 +55,7 @@ impl InertiaFile {
     /// Read and check a file of J in tensor entries (a `products_of_inertia` other than
     /// `"tensor"` is an error: simulation truth and `--truth` are always tensors).
     pub fn read(path: &Path) -> Result<Matrix3<f64>, CliError> {
-        Ok(Self::read_known(path, Some(ProductsArg::Tensor), "--truth")?.inertia_kg_m2)
+        Ok(Self::read_known(path, Some(ProductConvention::Tensor), "--truth")?.inertia_kg_m2)
     }
 
     /// Read and check a prior-knowledge file, converting its products to tensor entries:
@@ -64,14 +63,14 @@ impl InertiaFile {
     /// file's `products_of_inertia` when both are given).
     pub fn read_known(
         path: &Path,
-        option: Option<ProductsArg>,
+        option: Option<ProductConvention>,
         what: &str,
     ) -> Result<KnownInertia, CliError> {
         let f = Self::parse(path)?;
         let from_file = match f.products_of_inertia.as_deref() {
             None => None,
-            Some("tensor") => Some(ProductsArg::Tensor),
-            Some("cad") => Some(ProductsArg::Cad),
+            Some("tensor") => Some(ProductConvention::Tensor),
+            Some("cad") => Some(ProductConvention::Cad),
             Some(other) => {
                 return Err(input(format!(
                     "{}: products_of_inertia {other:?}: expected \"tensor\" (J12 = −Σ m x y) or \"cad\" (+Σ m x y)",
@@ -85,18 +84,14 @@ impl InertiaFile {
                     "{}: products_of_inertia is {:?} but {what} asks for {}",
                     path.display(),
                     f.products_of_inertia.as_deref().unwrap_or_default(),
-                    match b {
-                        ProductsArg::Tensor => "tensor",
-                        ProductsArg::Cad => "cad",
-                    }
+                    inertia::choice::Choice::choice_name(b)
                 )))
             }
             (Some(a), _) => a,
             (None, Some(b)) => b,
-            (None, None) => ProductsArg::Tensor,
+            (None, None) => ProductConvention::Tensor,
         };
-        let m = product_convention(Some(convention))
-            .matrix_to_tensor(&Matrix3::from_fn(|r, k| f.inertia_kg_m2[r][k]));
+        let m = convention.matrix_to_tensor(&Matrix3::from_fn(|r, k| f.inertia_kg_m2[r][k]));
         check_matrix(path, "inertia_kg_m2", &m)?;
         let sigma_kg_m2 = match f.sigma_kg_m2 {
             Some(s) => {
@@ -155,16 +150,8 @@ fn check_matrix(path: &Path, field: &str, m: &Matrix3<f64>) -> Result<(), CliErr
     Ok(())
 }
 
-/// The library's convention of a `--products` option (`None`: tensor entries).
-pub fn product_convention(a: Option<ProductsArg>) -> ProductConvention {
-    match a {
-        Some(ProductsArg::Cad) => ProductConvention::Cad,
-        Some(ProductsArg::Tensor) | None => ProductConvention::Tensor,
-    }
-}
-
-/// Parse `Jij=LO:HI` into `(component, lower, upper)` ([`inertia::constraints::parse_bound`]).
-pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), CliError> {
+/// `Jij=LO:HI` given to `--bound` ([`inertia::constraints::parse_bound`]).
+fn parse_bound(s: &str) -> Result<ElementBound, CliError> {
     inertia::constraints::parse_bound(s).map_err(|why| {
         input(format!(
             "--bound {s:?}: {why} (expected e.g. J33=2.7:3.3, J12=:0.05)"
@@ -172,175 +159,118 @@ pub fn parse_bound(s: &str) -> Result<(Component, Option<f64>, Option<f64>), Cli
     })
 }
 
-/// Parse `10%` or `0.1` given to `option`.
-pub fn parse_fraction(option: &str, s: &str) -> Result<f64, CliError> {
-    let t = s.trim();
-    let v = match t.strip_suffix('%') {
-        Some(p) => p.trim().parse::<f64>().map(|v| v / 100.0),
-        None => t.parse::<f64>(),
-    }
-    .map_err(|_| input(format!("{option} {s:?}: expected e.g. 10% or 0.1")))?;
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(input(format!("{option} {s:?}: must be finite and >= 0")))
-    }
-}
-
-/// The constraint set of the arguments (validated with the rest of the settings).
-pub fn constraint_set(
-    kind: ConstraintArg,
-    bounds: &[String],
-    nominal: Option<(&Matrix3<f64>, f64)>,
-    products: ProductConvention,
-) -> Result<ConstraintSet, CliError> {
-    let mut set = match kind {
-        ConstraintArg::Physical => ConstraintSet::physical(),
-        ConstraintArg::Paper => ConstraintSet::paper(),
-        ConstraintArg::PositiveDefinite => ConstraintSet::positive_definite(),
-    };
-    if let Some((n, p)) = nominal {
-        set = set.with_nominal_inertia(n, p);
-    }
-    for b in bounds {
-        let (k, l, h) = parse_bound(b)?;
-        let (l, h) = products.bound_to_tensor(k, l, h);
-        set = set.with_bounds(k, l, h);
-    }
-    Ok(set)
-}
-
-/// Parse `--prior-sigma`: `5%` (relative) or `0.02` (kg m², every element).
-pub fn parse_prior_sigma(s: &str) -> Result<PriorSigma, CliError> {
-    let t = s.trim();
-    let bad = || {
-        input(format!(
-            "--prior-sigma {s:?}: expected a relative σ such as 5% or an absolute one in kg m² such as 0.02, finite and > 0"
-        ))
-    };
-    let out = match t.strip_suffix('%') {
-        Some(p) => PriorSigma::Relative(p.trim().parse::<f64>().map_err(|_| bad())? / 100.0),
-        None => PriorSigma::Absolute(t.parse::<f64>().map_err(|_| bad())?),
-    };
-    match out {
-        PriorSigma::Relative(v) | PriorSigma::Absolute(v) if v.is_finite() && v > 0.0 => Ok(out),
-        _ => Err(bad()),
-    }
-}
-
-/// A `--prior-sigma`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PriorSigma {
-    /// A fraction (moments of |J_ii|, products of √(J_ii J_jj)).
-    Relative(f64),
-    /// kg m², every element.
-    Absolute(f64),
-}
-
-/// The pipeline settings of `inertia estimate`.
-pub fn pipeline_settings(a: &EstimateArgs) -> Result<PipelineSettings, CliError> {
-    let nominal = match (&a.nominal, &a.tolerance) {
-        (Some(p), Some(t)) => Some((
-            InertiaFile::read_known(p, a.products, "--products")?.inertia_kg_m2,
-            parse_fraction("--tolerance", t)?,
-        )),
-        _ => None,
-    };
-    let mut constraints = constraint_set(
-        a.constraints,
-        &a.bounds,
-        nominal.as_ref().map(|(m, p)| (m, *p)),
-        product_convention(a.products),
-    )?;
-    if a.diagonal {
-        constraints = constraints.diagonal();
-    }
-    if let Some(path) = &a.prior {
-        let known = InertiaFile::read_known(path, a.products, "--products")?;
-        let sigma = a
-            .prior_sigma
-            .as_deref()
-            .map(parse_prior_sigma)
-            .transpose()?;
-        constraints = match (sigma, known.sigma_kg_m2) {
-            (Some(PriorSigma::Relative(f)), _) => {
-                constraints.with_relative_prior(&known.inertia_kg_m2, f)
-            }
-            (Some(PriorSigma::Absolute(v)), _) => {
-                constraints.with_prior(&known.inertia_kg_m2, [v; 6])
-            }
-            (None, Some(s)) => constraints.with_prior(&known.inertia_kg_m2, s),
-            (None, None) => {
-                return Err(input(format!(
-                    "{}: the prior needs a standard deviation: --prior-sigma (e.g. 5%) or sigma_kg_m2 in the file",
-                    path.display()
-                )))
-            }
-        };
-    }
-    Ok(PipelineSettings {
-        estimator: a.estimator.clone(),
-        solver: a.solver.clone(),
-        constraints,
-        solve_every: a.every,
-        memory_s: a.memory,
-        resample_s: a.resample,
-        gyro_noise_deg_s_rthz: a.gyro_noise,
-        attitude_drift_deg_rth: a.attitude_drift,
-        rotation_source: a.rotation_source.map(|r| match r {
-            RotationArg::Attitude => RotationSource::Attitude,
-            RotationArg::Gyro => RotationSource::Gyro,
-        }),
-        rho_model: match a.rho_model {
-            RhoModelArg::Auto => RhoModel::Auto,
-            RhoModelArg::Smooth => RhoModel::Smooth,
-            RhoModelArg::Held => RhoModel::Held,
-            RhoModelArg::Plain => RhoModel::Plain,
-        },
-        torque_bias: !a.no_torque_bias,
-        inertial_torque: a.inertial_torque.parse().map_err(settings_error)?,
-        damping: a.damping,
-        wheel_delay: inertia::pipeline::parse_wheel_delay(&a.wheel_delay)
-            .map_err(settings_error)?,
-        rotor_scale_sigma: a
-            .rotor_scale_sigma
-            .as_deref()
-            .map(|s| parse_fraction("--rotor-scale-sigma", s))
-            .transpose()?,
-        filter_cutoff_hz: a.filter_cutoff_hz,
-        max_chain_s: (a.chain != 0.0).then_some(a.chain),
-        glitches: match a.glitches {
-            GlitchArg::Stop => GlitchPolicy::Stop,
-            GlitchArg::Keep => GlitchPolicy::Keep,
-        },
-        ..PipelineSettings::default()
+/// An option's text parsed as the library's value (`10%`, `5%`).
+fn parsed<T: std::str::FromStr<Err = &'static str>>(
+    option: &str,
+    s: Option<&str>,
+) -> Result<Option<T>, CliError> {
+    s.map(|s| {
+        s.parse()
+            .map_err(|why| input(format!("{option} {s:?}: {why}")))
     })
+    .transpose()
 }
 
-/// The command-line option behind a pipeline setting.
-fn option_of(field: &str) -> &str {
-    match field {
-        "solve_every" => "--every",
-        "memory_s" => "--memory",
-        "resample_s" => "--resample",
-        "gyro_noise_deg_s_rthz" => "--gyro-noise",
-        "constraints" => "--constraints/--bound/--nominal/--diagonal/--prior",
-        "rotation_source" => "--rotation-source",
-        "rho_model" => "--rho-model",
-        "torque_bias" => "--no-torque-bias",
-        "inertial_torque" => "--inertial-torque",
-        "damping" => "--damping",
-        "wheel_delay" => "--wheel-delay",
-        "rotor_scale_sigma" => "--rotor-scale-sigma",
-        "filter_cutoff_hz" => "--filter-cutoff-hz",
-        "max_chain_s" => "--chain",
-        "attitude_drift_deg_rth" => "--attitude-drift",
-        other => other,
+/// The run described: the `--settings` file's, the options given on the command line
+/// over it.
+pub fn description(a: &EstimateArgs) -> Result<RunDescription, CliError> {
+    let file = a
+        .settings
+        .as_deref()
+        .map(|p| RunDescription::load(p).map_err(|e| input(e.to_string())))
+        .transpose()?
+        .unwrap_or_default();
+    let i = &a.input;
+    let mut options = RunDescription::default();
+    options.estimator = a.estimator.clone();
+    options.solver = a.solver.clone();
+    options.batch = a.batch.then_some(true);
+    options.constraints = a.constraints;
+    options.bounds = (!a.bounds.is_empty())
+        .then(|| a.bounds.iter().map(|b| parse_bound(b)).collect())
+        .transpose()?
+        .map(Bounds);
+    options.nominal = a.nominal.clone().map(InertiaInput::File);
+    options.tolerance = parsed("--tolerance", a.tolerance.as_deref())?;
+    options.diagonal = a.diagonal.then_some(true);
+    options.prior = a.prior.clone().map(InertiaInput::File);
+    options.prior_sigma = parsed("--prior-sigma", a.prior_sigma.as_deref())?;
+    options.products = a.products;
+    options.rotor_scale_sigma = parsed("--rotor-scale-sigma", a.rotor_scale_sigma.as_deref())?;
+    options.filter_cutoff_hz = a.filter_cutoff_hz;
+    options.every = a.every;
+    options.memory = a.memory;
+    options.resample = a.resample;
+    options.gyro_noise = a.gyro_noise;
+    options.attitude_drift = a.attitude_drift;
+    options.rotation_source = a.rotation_source;
+    options.rho_model = a.rho_model;
+    options.glitches = a.glitches;
+    options.torque_bias = a.no_torque_bias.then_some(false);
+    options.inertial_torque = a.inertial_torque;
+    options.damping = a.damping.then_some(true);
+    options.wheel_delay = a
+        .wheel_delay
+        .as_deref()
+        .map(inertia::pipeline::parse_wheel_delay)
+        .transpose()
+        .map_err(settings_error)?;
+    options.chain = a.chain;
+    options.scalar_first = i.scalar_first.then_some(true);
+    options.jpl = i.jpl.then_some(true);
+    options.conjugate = i.conjugate.then_some(true);
+    options.gyro_unit = i.gyro_unit;
+    options.negate_rho = i.negate_rho.then_some(true);
+    options.unit_tolerance = i.unit_tolerance;
+    options.period_tolerance = i.period_tolerance;
+    options.spacecraft = i.spacecraft.clone();
+    options.columns = (!i.columns.is_empty())
+        .then(|| {
+            i.columns
+                .iter()
+                .map(|c| {
+                    c.split_once('=')
+                        .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
+                        .ok_or_else(|| {
+                            input(format!(
+                                "--column {c:?}: expected DEFAULT=NAME, e.g. t=time"
+                            ))
+                        })
+                })
+                .collect()
+        })
+        .transpose()?;
+    Ok(file.overridden_by(options))
+}
+
+/// A run description's key as the command line names it: its option.
+pub fn option(key: &str) -> String {
+    match key {
+        "bounds" => "--bound".into(),
+        "columns" => "--column".into(),
+        "torque_bias" => "--no-torque-bias".into(),
+        "constraints" => "--constraints/--bound/--nominal/--diagonal/--prior".into(),
+        // A run file's key without an option of its own.
+        "uncertainty" => "uncertainty".into(),
+        k => format!("--{}", k.replace('_', "-")),
     }
+}
+
+/// The pipeline settings of the run described (the `--nominal`/`--prior` files read
+/// here, in the `--products` convention).
+pub fn pipeline_settings(d: &RunDescription) -> Result<PipelineSettings, CliError> {
+    let mut read = |path: &Path, products: Option<ProductConvention>| {
+        InertiaFile::read_known(path, products, "--products")
+            .map(|k| (k.inertia_kg_m2, k.sigma_kg_m2))
+            .map_err(|e| e.to_string())
+    };
+    d.pipeline_settings(&option, &mut read)
+        .map_err(|e| input(e.message))
 }
 
 /// A settings error in the command line's words.
 pub fn settings_error(e: PipelineError) -> CliError {
+    let name = |field: &str| option(RunDescription::key_of(field));
     match e {
         PipelineError::InvalidSetting {
             field,
@@ -348,12 +278,12 @@ pub fn settings_error(e: PipelineError) -> CliError {
             expected,
         } => input(format!(
             "{} {}: expected {expected}",
-            option_of(field),
+            name(field),
             inertia::text::Num(value)
         )),
         PipelineError::NotApplicable { setting, estimator } => input(format!(
             "{} does not apply to the {estimator} estimator",
-            option_of(setting)
+            name(setting)
         )),
         PipelineError::NeedsSetting {
             setting,
@@ -362,70 +292,27 @@ pub fn settings_error(e: PipelineError) -> CliError {
             why,
         } => input(format!(
             "{} needs {} {requirement}: {why}",
-            option_of(setting),
-            option_of(needs)
+            name(setting),
+            name(needs)
         )),
         other => input(other),
     }
 }
 
-/// The spacecraft file of the input arguments, if any.
-pub fn spacecraft(a: &InputArgs) -> Result<Option<inertia::spacecraft::Spacecraft>, CliError> {
-    a.spacecraft
+/// The spacecraft file of the run described, if any.
+pub fn spacecraft(d: &RunDescription) -> Result<Option<inertia::spacecraft::Spacecraft>, CliError> {
+    d.spacecraft
         .as_deref()
         .map(|p| inertia::spacecraft::Spacecraft::load(p).map_err(|e| input(e.to_string())))
         .transpose()
 }
 
-/// CSV options from the input arguments (and the speed columns of their spacecraft
-/// file).
+/// CSV options of the run described (and the speed columns of its spacecraft file).
 pub fn csv_options(
-    a: &InputArgs,
+    d: &RunDescription,
     spacecraft: Option<&inertia::spacecraft::Spacecraft>,
 ) -> Result<CsvOptions, CliError> {
-    let mut columns = ColumnNames::default();
-    for c in &a.columns {
-        let (k, v) = c.split_once('=').ok_or_else(|| {
-            input(format!(
-                "--column {c:?}: expected DEFAULT=NAME, e.g. t=time"
-            ))
-        })?;
-        if !columns.rename(k.trim(), v.trim()) {
-            return Err(input(format!(
-                "--column {c:?}: unknown column {k:?} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
-            )));
-        }
-    }
-    for (name, v) in [
-        ("--unit-tolerance", Some(a.unit_tolerance)),
-        ("--period-tolerance", a.period_tolerance),
-    ] {
-        if let Some(v) = v {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(input(format!("{name} {v}: must be finite and > 0")));
-            }
-        }
-    }
-    Ok(CsvOptions {
-        quaternion: if a.scalar_first {
-            QuaternionFormat::HamiltonScalarFirst
-        } else if a.jpl {
-            QuaternionFormat::Jpl
-        } else if a.conjugate {
-            QuaternionFormat::Conjugate
-        } else {
-            QuaternionFormat::HamiltonScalarLast
-        },
-        columns,
-        unit_tolerance: a.unit_tolerance,
-        period_tolerance: a.period_tolerance,
-        delimiter: b',',
-        negate_rho: a.negate_rho,
-        gyro_unit: if a.gyro_unit == "deg/s" {
-            inertia::telemetry::csv::GyroUnit::DegPerS
-        } else {
-            inertia::telemetry::csv::GyroUnit::RadPerS
-        },
-        speed_columns: spacecraft.map_or_else(Vec::new, |s| s.speed_columns()),
-    })
+    let mut o = d.csv_options(&option).map_err(|e| input(e.message))?;
+    o.speed_columns = spacecraft.map_or_else(Vec::new, |s| s.speed_columns());
+    Ok(o)
 }

@@ -73,9 +73,11 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             "-o -: the report goes to standard output; give the history a file name (e.g. -o history.csv)",
         ));
     }
-    let spacecraft = config::spacecraft(&a.input)?;
-    let options = config::csv_options(&a.input, spacecraft.as_ref())?;
-    let settings = config::pipeline_settings(a)?;
+    let described = config::description(a)?;
+    let spacecraft = config::spacecraft(&described)?;
+    let options = config::csv_options(&described, spacecraft.as_ref())?;
+    let settings = config::pipeline_settings(&described)?;
+    let batch = described.batch.unwrap_or(false);
     let config = settings.validate().map_err(settings_error)?;
     let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
     let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
@@ -83,7 +85,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
     let file = reader.file().to_string();
     let q_columns = reader.quaternion_columns();
-    let mut run = Run::new(config, a.batch).map_err(settings_error)?;
+    let mut run = Run::new(config, batch).map_err(settings_error)?;
     if let Some(s) = spacecraft {
         run = run.with_spacecraft(s);
     }
@@ -108,7 +110,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     // the run keeps the samples for the wheel speeds' time tag (the estimate at the end
     // names any sample), the last `RECENT` streaming.
     let mut lines = VecDeque::new();
-    let keep = if a.batch || run.holds_samples() {
+    let keep = if batch || run.holds_samples() {
         usize::MAX
     } else {
         RECENT

@@ -2,6 +2,8 @@
 
 #[path = "cli/bad_inputs.rs"]
 mod bad_inputs;
+#[path = "cli/settings_file.rs"]
+mod settings_file;
 #[path = "cli/simulate_options.rs"]
 mod simulate_options;
 #[path = "cli/spacecraft.rs"]

@@ -8,6 +8,7 @@
 //! its JSON text (the `--json` schema), which the Python half turns into an `Estimate`.
 
 mod errors;
+mod kwargs;
 mod run;
 mod samples;
 mod settings;
@@ -18,15 +19,17 @@ use errors::{type_error, value_error, DataError, Failure};
 use inertia::estimator::Estimate;
 use inertia::pipeline::history::HEADER;
 use inertia::pipeline::report::Report;
+use inertia::run_description::RunDescription;
 use inertia::sample::Sample;
-use inertia::telemetry::csv::{ColumnNames, CsvOptions, TelemetryError, TelemetryReader};
+use inertia::telemetry::csv::{CsvOptions, TelemetryError, TelemetryReader};
+use kwargs::Kwargs;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use run::Origin;
 use samples::{Checker, Naming, Row, Stats};
-use settings::{Convention, Kwargs};
+use settings::Convention;
 
 /// Telemetry held in memory: what `read_csv` read or `simulate` made, checked and in
 /// this library's convention (Hamilton, body → inertial, scalar last).
@@ -177,24 +180,16 @@ impl Telemetry {
         kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let kw = Kwargs::new(kwargs, py, "estimate")?;
-        for name in [
-            "scalar_first",
-            "jpl",
-            "conjugate",
-            "gyro_unit",
-            "negate_rho",
-            "unit_tolerance",
-            "period_tolerance",
-            "columns",
-        ] {
-            if kw.take(name)?.is_some() {
-                return Err(value_error(format!(
-                    "{name}: these samples were already read and checked; give it to read_csv"
-                )));
-            }
+        let (s, d) = settings::run(&kw, "estimate")?;
+        if let Some(name) = d
+            .given()
+            .into_iter()
+            .find(|k| RunDescription::INPUT_KEYS.contains(k))
+        {
+            return Err(value_error(format!(
+                "{name}: these samples were already read and checked; give it to read_csv"
+            )));
         }
-        let s = settings::run(&kw)?;
-        kw.finish()?;
         let config = s.pipeline.validate().map_err(settings::settings_error)?;
         let origin = match (&self.file, &self.lines) {
             (Some(name), Some(lines)) => Origin::File {
@@ -299,26 +294,14 @@ fn read_csv(
     kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Telemetry> {
     let kw = Kwargs::new(kwargs, py, "read_csv")?;
-    let conv = settings::convention(&kw)?;
-    let mut columns = ColumnNames::default();
-    if let Some(c) = kw.take("columns")? {
-        let map: std::collections::BTreeMap<String, String> = c.extract().map_err(|_| {
-            type_error(
-                "columns: expected a dict {default name: name in the file}, e.g. {\"t\": \"time\"}",
-            )
-        })?;
-        for (k, v) in map {
-            if !columns.rename(k.trim(), v.trim()) {
-                return Err(value_error(format!(
-                    "columns: unknown column {k:?} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
-                )));
-            }
-        }
-    }
-    let spacecraft = kw
-        .string("spacecraft")?
+    let d = settings::describe(&kw, "read_csv")?;
+    only_input(&d, "read_csv")?;
+    let spacecraft = d
+        .spacecraft
+        .as_deref()
         .map(
             |p| -> PyResult<(inertia::spacecraft::Spacecraft, (String, String))> {
+                let p = p.display().to_string();
                 let text = std::fs::read_to_string(&p).map_err(|e| {
                     pyo3::exceptions::PyOSError::new_err(format!("cannot read {p}: {e}"))
                 })?;
@@ -328,21 +311,29 @@ fn read_csv(
             },
         )
         .transpose()?;
-    kw.finish()?;
-    let options = CsvOptions {
-        quaternion: conv.format,
-        columns,
-        unit_tolerance: conv.unit_tolerance,
-        period_tolerance: conv.period_tolerance,
-        delimiter: b',',
-        negate_rho: conv.negate_rho,
-        gyro_unit: conv.gyro_unit,
-        speed_columns: spacecraft
-            .as_ref()
-            .map_or_else(Vec::new, |s| s.0.speed_columns()),
-    };
+    let mut options = d
+        .csv_options(&|k| k.to_string())
+        .map_err(|e| value_error(e.message))?;
+    options.speed_columns = spacecraft
+        .as_ref()
+        .map_or_else(Vec::new, |s| s.0.speed_columns());
     py.allow_threads(|| read(&path, options, spacecraft))
         .map_err(|f| f.into_py(py))
+}
+
+/// Only input conventions: a run setting given to `function` (which reads) is an
+/// unexpected keyword.
+fn only_input(d: &RunDescription, function: &str) -> PyResult<()> {
+    match d
+        .given()
+        .into_iter()
+        .find(|k| RunDescription::SETTINGS_KEYS.contains(k))
+    {
+        Some(k) => Err(type_error(format!(
+            "{function}() got an unexpected keyword argument '{k}'"
+        ))),
+        None => Ok(()),
+    }
 }
 
 fn telemetry_failure(e: TelemetryError) -> Failure {
@@ -480,12 +471,11 @@ fn estimate_arrays<'py>(
     label: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let kw = Kwargs::new(kwargs, py, "estimate")?;
-    let mut conv = settings::convention(&kw)?;
+    let (s, d) = settings::run(&kw, "estimate")?;
+    let mut conv = settings::convention(&d)?;
     if q.is_none() {
         conv = conv.without_quaternions()?;
     }
-    let s = settings::run(&kw)?;
-    kw.finish()?;
     let config = s.pipeline.validate().map_err(settings::settings_error)?;
     let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
     let naming = match frame_columns {
@@ -519,11 +509,12 @@ fn samples_from_arrays<'py>(
     kwargs: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Telemetry> {
     let kw = Kwargs::new(kwargs, py, "Telemetry")?;
-    let mut conv = settings::convention(&kw)?;
+    let d = settings::describe(&kw, "Telemetry")?;
+    only_input(&d, "Telemetry")?;
+    let mut conv = settings::convention(&d)?;
     if q.is_none() {
         conv = conv.without_quaternions()?;
     }
-    kw.finish()?;
     let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
     let (samples, stats) = py
         .allow_threads(|| check_rows(&rows, &conv, &Naming::Arrays))
@@ -618,7 +609,12 @@ fn estimators() -> Vec<(&'static str, &'static str)> {
 #[pymodule]
 fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DataError", m.py().get_type::<DataError>())?;
-    m.add("DEFAULT_ESTIMATOR", settings::DEFAULT_ESTIMATOR)?;
+    m.add(
+        "DEFAULT_ESTIMATOR",
+        inertia::pipeline::PipelineSettings::DEFAULT_ESTIMATOR,
+    )?;
+    m.add("SETTINGS_KEYS", RunDescription::SETTINGS_KEYS.to_vec())?;
+    m.add("INPUT_KEYS", RunDescription::INPUT_KEYS.to_vec())?;
     m.add_class::<Telemetry>()?;
     m.add_class::<stream::Stream>()?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;

@@ -4,8 +4,9 @@
 //! maps them.
 
 use crate::errors::{value_error, Failure};
+use crate::kwargs::Kwargs;
 use crate::samples::{Checker, Naming, Row};
-use crate::settings::{Convention, Kwargs};
+use crate::settings::Convention;
 use crate::Telemetry;
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;

@@ -2,9 +2,10 @@
 //! `inertia::pipeline::Pipeline`, checked as the CSV reader checks rows.
 
 use crate::errors::Failure;
+use crate::kwargs::Kwargs;
 use crate::run::Origin;
 use crate::samples::{Checker, Naming, Row};
-use crate::settings::{self, Kwargs};
+use crate::settings;
 use inertia::pipeline::report::Report;
 use inertia::pipeline::Run;
 use numpy::PyReadonlyArrayDyn;
@@ -54,9 +55,14 @@ impl Stream {
     #[pyo3(signature = (kwargs=None))]
     fn new(py: Python<'_>, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let kw = Kwargs::new(kwargs, py, "Estimator")?;
-        let conv = settings::convention(&kw)?;
-        let pipeline_settings = settings::pipeline(&kw)?;
-        kw.finish()?;
+        let d = settings::describe(&kw, "Estimator")?;
+        if d.batch.is_some() {
+            return Err(crate::errors::type_error(
+                "Estimator() got an unexpected keyword argument 'batch'",
+            ));
+        }
+        let conv = settings::convention(&d)?;
+        let pipeline_settings = settings::pipeline(&d)?;
         if pipeline_settings.wheel_delay != Default::default() {
             return Err(crate::errors::value_error(
                 "wheel_delay: the wheel speeds' time tag needs the whole record; give it to estimate()",

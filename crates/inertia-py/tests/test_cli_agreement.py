@@ -258,3 +258,18 @@ def test_prior_matches_cli(cli, files, tmp_path, products):
     for sigma in (0.02, "0.02"):
         got = inertia.estimate(str(path), prior=prior, prior_sigma=sigma, products=products)
         assert differences(absolute, got.to_dict()) <= TOL
+
+
+def test_the_keywords_are_a_run_files_keys(cli, files, tmp_path):
+    """Python's keywords and ``inertia estimate --settings`` read the same description:
+    the keywords written as a JSON run file give the CLI the report Python gives."""
+    import json
+
+    kwargs = dict(memory=60.0, rho_model="plain", torque_bias=False, every=2,
+                  bounds=["J33=2.7:3.3"], inertial_torque="on", chain=20.0)
+    run = tmp_path / "run.json"
+    run.write_text(json.dumps(kwargs))
+    expected = cli_estimate(cli, files["slew"], "--settings", str(run))
+    got = inertia.estimate(str(files["slew"]), **kwargs).to_dict()
+    assert differences(expected, got) <= TOL
+    assert expected["j"] != cli_estimate(cli, files["slew"])["j"]

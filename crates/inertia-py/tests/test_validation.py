@@ -143,3 +143,24 @@ def test_simulate_arguments():
         inertia.simulate("slew", telemetry_dt=0.15)
     with pytest.raises(ValueError, match="constant_torque_nm: expected 3 numbers, got 2"):
         inertia.simulate("slew", constant_torque_nm=(1e-5, 0))
+
+
+def test_the_native_mapping_is_the_librarys_description(tel):
+    """The keywords are the library's run description's keys (every one is a keyword of
+    :func:`inertia.estimate`), and the native side maps a dict onto it generically: an
+    unknown keyword is a TypeError naming it, a value of the wrong type a TypeError, a bad
+    value a ValueError, each naming the keyword."""
+    import inspect
+
+    names = set(inspect.signature(inertia.estimate).parameters)
+    assert set(inertia._inertia.SETTINGS_KEYS) | set(inertia._inertia.INPUT_KEYS) <= names
+    with pytest.raises(TypeError, match=r"^Estimator\(\) got an unexpected keyword argument 'memroy'$"):
+        inertia._inertia.Stream(kwargs={"memroy": 30.0})
+    with pytest.raises(TypeError, match=r"^read_csv\(\) got an unexpected keyword argument 'memory'$"):
+        inertia._inertia.read_csv("x.csv", kwargs={"memory": 30.0})
+    with pytest.raises(TypeError, match=r"^chain: expected a number, got str$"):
+        inertia._inertia.Stream(kwargs={"chain": "long"})
+    with pytest.raises(ValueError, match=r'^glitches="ignore": expected one of stop, keep$'):
+        inertia._inertia.Stream(kwargs={"glitches": "ignore"})
+    # None is the default, as for a keyword not given.
+    assert inertia._inertia.Stream(kwargs={"memory": None, "rho_model": None}) is not None

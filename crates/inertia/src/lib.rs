@@ -85,6 +85,8 @@
 
 pub mod attitude;
 mod barrier;
+#[cfg(feature = "std")]
+pub mod choice;
 pub mod constraints;
 pub mod discrete;
 pub mod discrete_momentum;
@@ -100,6 +102,8 @@ mod householder;
 mod math;
 #[cfg(feature = "std")]
 pub mod pipeline;
+#[cfg(feature = "serde")]
+pub mod run_description;
 pub mod sample;
 #[cfg(feature = "sim")]
 pub mod sim;

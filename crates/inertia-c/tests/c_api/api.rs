@@ -10,7 +10,7 @@ use inertia_c::*;
 
 fn variational() -> InertiaSettings {
     InertiaSettings {
-        estimator: InertiaEstimatorKind::Variational as u32,
+        estimator: estimator_id("variational"),
         ..inertia_settings_default()
     }
 }
@@ -129,6 +129,22 @@ fn bad_settings_name_the_setting() {
             },
             InertiaStatus::InvalidSetting,
             "glitches",
+        ),
+        (
+            InertiaSettings {
+                rotation_source: 3,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "`rotation_source` = 3 is invalid: expected 0 to 2",
+        ),
+        (
+            InertiaSettings {
+                solver: 3,
+                ..inertia_settings_default()
+            },
+            InertiaStatus::InvalidSetting,
+            "`solver` = 3 is invalid: expected 0 (default) to 2",
         ),
         (
             InertiaSettings {
@@ -425,7 +441,7 @@ fn the_default_settings_are_the_pipelines() {
     let d = inertia::pipeline::PipelineSettings::default();
     let c = inertia_settings_default();
     assert_eq!(d.estimator, "discrete-momentum");
-    assert_eq!(c.estimator, InertiaEstimatorKind::DiscreteMomentum as u32);
+    assert_eq!(c.estimator, 0); // the library's default, `d.estimator`
     assert_eq!(d.max_chain_s, Some(c.max_chain_s));
     assert_eq!(
         (d.torque_bias, d.uncertainty),
@@ -449,4 +465,56 @@ fn the_default_settings_are_the_pipelines() {
         d.constraints,
         inertia::constraints::ConstraintSet::physical()
     );
+}
+
+/// The header's named constants of the other choices select the library's value of the
+/// same name (`Choice::ALL` by index; a rotation source's 0 is "from the data").
+#[test]
+fn the_choice_constants_are_the_librarys_values() {
+    use inertia::choice::Choice;
+    use inertia::constraints::Consistency;
+    use inertia::estimator::momentum_rows::{RhoModel, RotationSource};
+    use inertia::pipeline::InertialTorque;
+    use inertia::telemetry::glitch::GlitchPolicy;
+    fn name<T: Choice>(id: u32) -> &'static str {
+        T::ALL[id as usize].choice_name()
+    }
+    for (id, n) in [
+        (InertiaConstraintKind::Physical as u32, "physical"),
+        (InertiaConstraintKind::Paper as u32, "paper"),
+        (
+            InertiaConstraintKind::PositiveDefinite as u32,
+            "positive-definite",
+        ),
+    ] {
+        assert_eq!(name::<Consistency>(id), n);
+    }
+    for (id, n) in [
+        (InertiaRhoModel::Auto as u32, "auto"),
+        (InertiaRhoModel::Smooth as u32, "smooth"),
+        (InertiaRhoModel::Held as u32, "held"),
+        (InertiaRhoModel::Plain as u32, "plain"),
+    ] {
+        assert_eq!(name::<RhoModel>(id), n);
+    }
+    for (id, n) in [
+        (InertiaInertialTorque::Off as u32, "off"),
+        (InertiaInertialTorque::On as u32, "on"),
+        (InertiaInertialTorque::Auto as u32, "auto"),
+    ] {
+        assert_eq!(name::<InertialTorque>(id), n);
+    }
+    for (id, n) in [
+        (InertiaGlitchPolicy::Stop as u32, "stop"),
+        (InertiaGlitchPolicy::Keep as u32, "keep"),
+    ] {
+        assert_eq!(name::<GlitchPolicy>(id), n);
+    }
+    assert_eq!(InertiaRotationSource::Auto as u32, 0);
+    for (id, n) in [
+        (InertiaRotationSource::Attitude as u32, "attitude"),
+        (InertiaRotationSource::Gyro as u32, "gyro"),
+    ] {
+        assert_eq!(name::<RotationSource>(id - 1), n);
+    }
 }

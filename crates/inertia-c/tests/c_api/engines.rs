@@ -41,7 +41,7 @@ fn compare(scenario: Scenario, settings: InertiaSettings, label: &str) -> usize 
 
 fn variational() -> InertiaSettings {
     InertiaSettings {
-        estimator: InertiaEstimatorKind::Variational as u32,
+        estimator: estimator_id("variational"),
         ..inertia_settings_default()
     }
 }
@@ -99,7 +99,7 @@ fn variational_with_compensation_memory_and_every() {
 #[test]
 fn finite_difference_slew() {
     let s = InertiaSettings {
-        estimator: InertiaEstimatorKind::FiniteDifference as u32,
+        estimator: estimator_id("finite-difference"),
         ..inertia_settings_default()
     };
     assert!(compare(Scenario::slew(), s, "slew, finite difference") > 2000);
@@ -179,7 +179,7 @@ fn a_reversed_wheel_momentum_stops_both_engines_alike() {
     for settings in [
         variational(),
         InertiaSettings {
-            estimator: InertiaEstimatorKind::FiniteDifference as u32,
+            estimator: estimator_id("finite-difference"),
             ..inertia_settings_default()
         },
     ] {
@@ -281,5 +281,89 @@ fn the_inertial_torque_reaches_the_discrete_momentum_estimator() {
     assert!(
         gap(&off) > 1e-9 * library.norm(),
         "off gives on's answer: {off:?}"
+    );
+}
+
+/// Every estimator of the library's registry, selected by its C id (its index from 1;
+/// 0 the default), gives the library pipeline's estimate of the same name after every
+/// sample of the paper's slew, bit for bit (J and σ); an id past the registry is refused.
+#[test]
+fn every_registered_estimator_by_id_is_the_pipelines() {
+    use inertia::pipeline::registry::ESTIMATORS;
+    use inertia::pipeline::{Pipeline, PipelineSettings};
+    let run = Scenario::slew().simulate(&Common::paper()).unwrap();
+    let ids = (0..=ESTIMATORS.len()).map(|k| u32::try_from(k).unwrap());
+    for id in ids {
+        let name = match id {
+            0 => PipelineSettings::DEFAULT_ESTIMATOR,
+            k => ESTIMATORS[k as usize - 1].name,
+        };
+        assert!(id == 0 || estimator_id(name) == id);
+        let est = new(&InertiaSettings {
+            estimator: id,
+            ..inertia_settings_default()
+        });
+        let mut p = Pipeline::new(&PipelineSettings {
+            estimator: name.into(),
+            ..PipelineSettings::default()
+        })
+        .unwrap();
+        // The pipeline takes each sample as C's gate passes it (renormalised), and its
+        // estimate is, as C keeps it, the one the last push returned.
+        let mut gate = inertia::telemetry::gate::Gate::default();
+        let (mut answers, mut last) = (0, None);
+        for (k, x) in run.samples.iter().enumerate() {
+            let c = c_sample(x);
+            assert_eq!(
+                push(est, &c),
+                InertiaStatus::Ok,
+                "{name} {k}: {}",
+                last_error()
+            );
+            let gated = gate
+                .check(&inertia::telemetry::gate::RawSample {
+                    t_s: c.t_s,
+                    q: c.q,
+                    rho_nms: c.rho_nms,
+                    tau_nm: Some(c.tau_nm),
+                    w_rad_s: (c.has_w == 1).then_some(c.w_rad_s),
+                })
+                .unwrap();
+            if let Some(e) = p.push(&gated).unwrap() {
+                last = Some(e);
+            }
+            let c = get(est);
+            match last.and_then(|e: inertia::estimator::Estimate| e.j()) {
+                Some(j) => {
+                    answers += 1;
+                    assert_eq!(c.has_answer, 1, "{name} {k}");
+                    let bits = |a: &[f64]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&c.j), bits(j.as_slice()), "{name} {k}: J");
+                    match last.and_then(|e| e.sigma_kg_m2()) {
+                        Some(s) => {
+                            assert_eq!(c.has_sigma, 1, "{name} {k}");
+                            assert_eq!(bits(&c.sigma), bits(&s), "{name} {k}: σ");
+                        }
+                        None => assert_eq!(c.has_sigma, 0, "{name} {k}"),
+                    }
+                }
+                None => assert_eq!(c.has_answer, 0, "{name} {k}"),
+            }
+        }
+        free(est);
+        assert!(answers > 0, "{name}: no answer");
+    }
+    let mut est = core::ptr::null_mut();
+    let past = InertiaSettings {
+        estimator: u32::try_from(ESTIMATORS.len() + 1).unwrap(),
+        ..inertia_settings_default()
+    };
+    // SAFETY: valid pointers.
+    let status = unsafe { inertia_estimator_new(&past, &mut est) };
+    assert_eq!(status, InertiaStatus::InvalidSetting);
+    assert!(
+        last_error().contains("setting `estimator`"),
+        "{}",
+        last_error()
     );
 }

@@ -434,28 +434,19 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
     return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
 
 
-#: The estimation settings, as :func:`estimate` and :class:`Estimator` name them (the
-#: command line's options).
-_SETTINGS = (
-    "estimator", "constraints", "bounds", "nominal", "tolerance", "diagonal", "prior",
-    "prior_sigma", "products", "gyro_noise", "attitude_drift", "memory",
-    "resample", "every", "rotation_source", "rho_model", "torque_bias", "inertial_torque",
-    "rotor_scale_sigma", "filter_cutoff_hz", "chain", "wheel_delay",
-    "glitches",
-    "solver", "uncertainty",
-)
-#: What :class:`Estimator` takes: the time tag of the wheel speeds needs the whole record.
-_STREAM_SETTINGS = tuple(n for n in _SETTINGS if n != "wheel_delay")
-#: How the data are read.
-_CONVENTIONS = (
-    "scalar_first", "jpl", "conjugate", "gyro_unit", "negate_rho", "unit_tolerance",
-    "period_tolerance",
-)
+#: The estimation settings and the input conventions, as :func:`estimate` and
+#: :class:`Estimator` name them: the library's run description's keys (the command line's
+#: options, in snake case; ``inertia estimate --settings`` reads the same keys from a
+#: file). The native side maps them onto the description generically.
+_SETTINGS = tuple(_inertia.SETTINGS_KEYS)
+#: How the data are read (``columns`` and ``spacecraft`` go to :func:`read_csv` apart).
+_CONVENTIONS = tuple(k for k in _inertia.INPUT_KEYS if k not in ("columns", "spacecraft"))
 
 
 def _settings(arguments: Mapping[str, Any], names: Sequence[str] = _SETTINGS) -> Dict[str, Any]:
-    """The named arguments, with matrices as nested lists for the native side."""
-    kw = {k: arguments[k] for k in names}
+    """The named arguments a function has, with matrices as nested lists for the native
+    side."""
+    kw = {k: arguments[k] for k in names if k in arguments}
     for key in ("nominal", "truth", "prior"):
         if kw.get(key) is not None:
             kw[key] = _float_array(key, kw[key], "(3, 3)").tolist()
@@ -490,6 +481,7 @@ def estimate(
     rho_model: str = "auto",
     torque_bias: bool = True,
     inertial_torque: str = "off",
+    damping: bool = False,
     rotor_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
     chain: float = 30.0,
@@ -557,6 +549,7 @@ def estimate(
             ``"held"``, ``"plain"``. torque_bias: estimate an unknown constant torque.
             inertial_torque: a torque constant in the inertial frame, per chain: ``"off"``,
             ``"on"`` or ``"auto"`` (a nested χ² test decides; ``report["row_model"]``).
+            damping: estimate a linear damping torque −D ω (air drag; ``report["damping_nms"]``).
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
             filter_cutoff_hz: the equation-error baseline's low-pass cutoff, Hz.
@@ -581,7 +574,7 @@ def estimate(
         ValueError, TypeError: an invalid argument, named.
     """
     arguments = locals()
-    settings = _settings(arguments, (*_SETTINGS, "batch", "history", "truth"))
+    settings = _settings(arguments, (*_SETTINGS, "history", "truth"))
     conventions = _settings(arguments, _CONVENTIONS)
     single = q is None and rho is None and tau is None and w is None
     if isinstance(t, Telemetry) or isinstance(t, (str, os.PathLike)) or _is_frame(t):
@@ -665,6 +658,7 @@ class Estimator:
         rho_model: str = "auto",
         torque_bias: bool = True,
         inertial_torque: str = "off",
+        damping: bool = False,
         rotor_scale_sigma: Optional[float] = None,
         filter_cutoff_hz: Optional[float] = None,
         chain: float = 30.0,
@@ -679,7 +673,7 @@ class Estimator:
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> None:
-        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_STREAM_SETTINGS, *_CONVENTIONS)))
+        self._native = _inertia.Stream(kwargs=_settings(locals(), (*_SETTINGS, *_CONVENTIONS)))
 
     def push(self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
         """Push one sample: ``t`` s, ``q`` (4,), ``rho`` (3,) N m s, ``tau`` (3,) N m,

@@ -5,6 +5,8 @@ from typing import Any, Dict, List, Optional, Tuple
 import numpy as np
 
 DEFAULT_ESTIMATOR: str
+SETTINGS_KEYS: List[str]
+INPUT_KEYS: List[str]
 
 class DataError(ValueError):
     line: Optional[int]

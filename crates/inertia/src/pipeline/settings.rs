@@ -103,8 +103,8 @@ pub const DEFAULT_MAX_CHAIN_S: f64 = 30.0;
 impl Default for PipelineSettings {
     fn default() -> Self {
         Self {
-            estimator: "discrete-momentum".into(),
-            solver: "native".into(),
+            estimator: Self::DEFAULT_ESTIMATOR.into(),
+            solver: Self::DEFAULT_SOLVER.into(),
             constraints: ConstraintSet::physical(),
             solve_every: 1,
             memory_s: None,
@@ -176,6 +176,11 @@ fn positive(field: &'static str, v: Option<f64>, unit: &'static str) -> Result<(
 }
 
 impl PipelineSettings {
+    /// The estimator of [`Self::default`]: the discrete momentum estimator.
+    pub const DEFAULT_ESTIMATOR: &'static str = "discrete-momentum";
+    /// The solver backend of [`Self::default`].
+    pub const DEFAULT_SOLVER: &'static str = "native";
+
     /// Check every setting and the combination, and validate the constraint set (a
     /// phase-I search for a strictly feasible J).
     pub fn validate(&self) -> Result<PipelineConfig, PipelineError> {
@@ -539,27 +544,6 @@ pub enum InertialTorque {
     Auto,
 }
 
-impl InertialTorque {
-    /// Every value, in the order of [`Self::NAMES`].
-    pub const ALL: [InertialTorque; 3] = [
-        InertialTorque::Off,
-        InertialTorque::On,
-        InertialTorque::Auto,
-    ];
-    /// The names options and keywords use (`off`, `on`, `auto`).
-    pub const NAMES: [&'static str; 3] = ["off", "on", "auto"];
-
-    /// The name for reports and options.
-    #[must_use]
-    pub(crate) fn name(&self) -> &'static str {
-        match self {
-            InertialTorque::Off => "off",
-            InertialTorque::On => "on",
-            InertialTorque::Auto => "auto",
-        }
-    }
-}
-
 /// The wheel-speed time tag setting from its text: `off`, `estimate`, or the delay in
 /// seconds ([`WheelDelay`]).
 pub fn parse_wheel_delay(s: &str) -> Result<WheelDelay, PipelineError> {
@@ -568,19 +552,4 @@ pub fn parse_wheel_delay(s: &str) -> Result<WheelDelay, PipelineError> {
         value: s.into(),
         expected: "off, estimate, or the delay in seconds",
     })
-}
-
-impl core::str::FromStr for InertialTorque {
-    type Err = PipelineError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .into_iter()
-            .find(|v| v.name() == s)
-            .ok_or_else(|| PipelineError::UnknownChoice {
-                setting: "inertial_torque",
-                value: s.into(),
-                expected: "off, on, auto",
-            })
-    }
 }

@@ -92,3 +92,13 @@ pub fn same(a: &InertiaEstimate, b: &InertiaEstimate) -> bool {
         && a.has_sigma == b.has_sigma
         && bits(a) == bits(b)
 }
+
+/// The C id of an estimator of the library's registry (`INERTIA_ESTIMATOR_*`: its index
+/// from 1).
+pub fn estimator_id(name: &str) -> u32 {
+    let k = inertia::pipeline::registry::ESTIMATORS
+        .iter()
+        .position(|e| e.name == name)
+        .unwrap_or_else(|| panic!("no estimator {name}"));
+    u32::try_from(k + 1).unwrap()
+}
