@@ -4,6 +4,10 @@
 #
 #   scripts/compare_outputs.sh OLD_INERTIA NEW_INERTIA [WORKDIR]
 #
+# NEW_SED: a sed script applied to the new build's printed output before the comparison,
+# for a deliberate additive change (e.g. NEW_SED='s/"damping":false,//g' for a JSON key
+# the old build did not print).
+#
 # Exit 0 and "IDENTICAL" when every output matches. Wall-clock lines are not printed by
 # `estimate`, so nothing is filtered. Takes a few minutes with release builds.
 set -euo pipefail
@@ -85,6 +89,7 @@ for f in slew spin sat micro throw gyro_only wheels; do
 done
 # Stdout and stderr name the run's own files; both builds wrote under $work/{old,new}.
 for b in old new; do sed -i "s#$work/$b#WORK#g" "$work/$b/"*.err "$work/$b/"*.out; done
+if [ -n "${NEW_SED:-}" ]; then sed -i "$NEW_SED" "$work/new/"*.out; fi
 diff -r "$work/old" "$work/new" >"$work/diff.txt" || rc=1
 echo "cases: $n, files compared: $(find "$work/old" -type f | wc -l)"
 if [ $rc = 0 ]; then echo IDENTICAL; else echo "DIFFERENT (see $work/diff.txt)"; head -40 "$work/diff.txt"; fi

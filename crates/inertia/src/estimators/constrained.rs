@@ -9,9 +9,11 @@ use crate::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
 use crate::estimator::rows::{FiniteDifferenceRows, RowSource, VariationalRows};
 use crate::estimator::uncertainty::combine;
 use crate::estimator::{batch, Estimate, EstimatorError};
-use crate::pipeline::registry::{self, BatchOutput, Capabilities, Estimator, EstimatorEntry};
-use crate::pipeline::Diagnostics;
-use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::pipeline::config::EstimatorEntry;
+use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::diagnostics::Diagnostics;
+use crate::pipeline::error::PipelineError;
+use crate::pipeline::interface::{BatchOutput, Capabilities, Estimator};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use std::boxed::Box;
@@ -181,7 +183,7 @@ fn build<S: RowSource + Default + Send + 'static>(
         settings(c),
         c.uncertainty,
         c.memory_s.is_none(),
-        || registry::build_backend(c.backend),
+        || c.backend.build(),
     )
     .map_err(|source| PipelineError::Estimator {
         sample: None,
@@ -220,7 +222,7 @@ fn run_batch<S: RowSource + Default>(
         source,
     };
     let qr = batch::reduce(samples, &mut source).map_err(wrap)?;
-    let mut backend = registry::build_backend(c.backend);
+    let mut backend = c.backend.build();
     let mut estimate = batch::solve_reduced(
         &qr,
         samples.last().map_or(0.0, |s| s.t_s),

@@ -2,9 +2,11 @@
 
 use crate::estimator::momentum::{MomentumRls, MomentumSettings};
 use crate::estimator::{Estimate, EstimatorError};
-use crate::pipeline::registry::{Capabilities, Estimator, EstimatorEntry};
-use crate::pipeline::Diagnostics;
-use crate::pipeline::{PipelineConfig, PipelineError};
+use crate::pipeline::config::EstimatorEntry;
+use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::diagnostics::Diagnostics;
+use crate::pipeline::error::PipelineError;
+use crate::pipeline::interface::{Capabilities, Estimator};
 use crate::sample::Sample;
 use std::boxed::Box;
 

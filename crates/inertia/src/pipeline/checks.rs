@@ -107,27 +107,3 @@ pub(crate) fn reversed_momentum(
         _ => Ok(()),
     }
 }
-
-/// The message of [`PipelineError::ReversedMomentum`].
-pub(crate) struct ReversedMessage<'a> {
-    pub(crate) sample: &'a Option<usize>,
-    pub(crate) tau_given: &'a bool,
-    pub(crate) quaternions: &'a Verdict,
-}
-
-impl core::fmt::Display for ReversedMessage<'_> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        if let Some(s) = self.sample {
-            write!(f, "input sample {s}: ")?;
-        }
-        f.write_str("the data fit a negative-definite J whose negation would be determined: the wheel momentum rho has the opposite sign of this library's convention (the rotors' own momentum in body axes, docs/conventions.md §1; negate it)")?;
-        if *self.tau_given {
-            f.write_str(", or the known torque tau has")?;
-        }
-        match self.quaternions {
-            Verdict::Consistent(_) => Ok(()),
-            Verdict::Undecided => f.write_str(", or the quaternions are conjugated (read them conjugated): gyro rates have not confirmed the quaternion convention (there are none, or too few turning steps yet)"),
-            _ => f.write_str(", or the quaternions are conjugated (read them conjugated): the attitude disagrees with the gyro rates too"),
-        }
-    }
-}

@@ -18,8 +18,8 @@
 
 mod text;
 
+use super::config::PipelineConfig;
 use super::diagnostics::Diagnostics;
-use super::settings::PipelineConfig;
 use super::status::{PhysicalMargin, PHYSICAL_Z};
 use crate::constraints::ActiveBound;
 use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTENT_RATIO, SHIFT_Z};

@@ -34,7 +34,7 @@
 //!   term, per rotor ([`crate::estimator::rotor_inertia`]); so is the wheel-speed time
 //!   tag's σ ([`crate::estimator::wheel_delay`]).
 
-use super::PipelineConfig;
+use super::config::PipelineConfig;
 use crate::constraints::Consistency;
 use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::uncertainty::Uncertainty;

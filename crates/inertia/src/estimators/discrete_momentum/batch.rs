@@ -22,8 +22,10 @@ use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::uncertainty::noise_sigma;
 use crate::estimator::{batch, Estimate, EstimatorError};
-use crate::pipeline::registry::{self, BatchOutput};
-use crate::pipeline::{Diagnostics, PipelineConfig, PipelineError};
+use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::diagnostics::Diagnostics;
+use crate::pipeline::error::PipelineError;
+use crate::pipeline::interface::BatchOutput;
 use crate::sample::Sample;
 use crate::solver::Backend;
 use crate::tensor::InertiaVector;
@@ -98,7 +100,7 @@ pub(super) fn run_batch(
         tested,
         // The chosen rows with the prior's: what the audit judges.
         augmented: prior::augment(&tested, &c.constraints).0,
-        backend: registry::build_backend(c.backend),
+        backend: c.backend.build(),
         t_s: samples.last().map_or(0.0, |s| s.t_s),
         others: Vec::new(),
     };

@@ -8,7 +8,7 @@ use crate::estimator::momentum_rows::{
     MomentumRowSettings, MomentumRows, RhoModel, RotationSource, Stencil,
 };
 use crate::estimator::recursive::RecursiveSettings;
-use crate::pipeline::{InertialTorque, PipelineConfig};
+use crate::pipeline::config::{InertialTorque, PipelineConfig};
 use crate::solver::Backend;
 use std::boxed::Box;
 use std::vec::Vec;

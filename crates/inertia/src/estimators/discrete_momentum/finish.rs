@@ -22,7 +22,7 @@ use crate::estimator::observability::{Observability, Unobservable, NEGATIVE_DAMP
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::uncertainty::with_bias_at;
 use crate::estimator::Estimate;
-use crate::pipeline::PipelineConfig;
+use crate::pipeline::config::PipelineConfig;
 use crate::tensor::{matrix_from_j, InertiaVector};
 
 /// What the σ and the status of an answer need from the candidates behind it.

@@ -54,8 +54,11 @@ use crate::estimator::excitation::diagnose;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::{Estimate, EstimatorError};
-use crate::pipeline::registry::{self, Capabilities, Estimator, EstimatorEntry};
-use crate::pipeline::{Diagnostics, PipelineConfig, PipelineError};
+use crate::pipeline::config::EstimatorEntry;
+use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::diagnostics::Diagnostics;
+use crate::pipeline::error::PipelineError;
+use crate::pipeline::interface::{Capabilities, Estimator};
 use crate::sample::Sample;
 use crate::tensor::InertiaVector;
 use candidates::{candidates, chained_siblings, settings, shared_sources, Candidate, SharedSource};
@@ -185,7 +188,7 @@ impl DiscreteMomentum {
 
     fn start(&mut self, first: &Sample) -> Result<(), EstimatorError> {
         for rows in candidates(&self.config, first.omega_rad_s.is_some()) {
-            let backend = registry::build_backend(self.config.backend);
+            let backend = self.config.backend.build();
             self.candidates.push(DiscreteMomentumEstimator::new(
                 settings(&self.config, rows),
                 self.config.constraints,
@@ -209,7 +212,7 @@ impl DiscreteMomentum {
                 let mut shadow = DiscreteMomentumEstimator::new(
                     settings(&self.config, *first.row_settings()),
                     self.config.constraints,
-                    registry::build_backend(self.config.backend),
+                    self.config.backend.build(),
                 )?;
                 // Only its least-squares state is used ([`discretisation_bias`]).
                 shadow.stop_jackknife();

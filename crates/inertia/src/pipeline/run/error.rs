@@ -106,7 +106,7 @@ impl core::fmt::Display for RunError {
             }) => write!(
                 f,
                 "{}",
-                super::super::checks::ReversedMessage {
+                super::super::error::ReversedMessage {
                     sample: &None,
                     tau_given,
                     quaternions,

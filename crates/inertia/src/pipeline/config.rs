@@ -1,0 +1,283 @@
+//! What a pipeline runs with once its settings are validated ([`PipelineConfig`], made
+//! by [`super::PipelineSettings::validate`]): the registry entries, the validated
+//! constraint set and the estimators' settings. The estimators read this, never the
+//! settings, so that they do not depend on the registry that lists them.
+
+use super::error::PipelineError;
+use super::interface::{BatchOutput, Capabilities, Estimator};
+use crate::constraints::Constraints;
+use crate::estimator::momentum_rows::{RhoModel, RotationSource};
+use crate::estimator::observability::ObservabilitySettings;
+use crate::estimator::wheel_delay::WheelDelay;
+use crate::sample::Sample;
+use crate::solver::Backend;
+use crate::telemetry::glitch::GlitchPolicy;
+use std::boxed::Box;
+
+/// Validated settings: what a [`super::Pipeline`] runs with.
+#[derive(Debug, Clone, Copy)]
+pub struct PipelineConfig {
+    pub(crate) estimator: &'static EstimatorEntry,
+    pub(crate) backend: &'static BackendEntry,
+    pub(crate) constraints: Constraints,
+    pub(crate) solve_every: usize,
+    pub(crate) memory_s: Option<f64>,
+    pub(crate) resample_s: Option<f64>,
+    pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
+    pub(crate) uncertainty: bool,
+    pub(crate) rotor_scale_sigma: Option<f64>,
+    pub(crate) filter_cutoff_hz: Option<f64>,
+    pub(crate) observability: ObservabilitySettings,
+    pub(crate) rotation_source: Option<RotationSource>,
+    pub(crate) rho_model: RhoModel,
+    pub(crate) torque_bias: bool,
+    pub(crate) inertial_torque: InertialTorque,
+    pub(crate) damping: bool,
+    pub(crate) max_chain_s: Option<f64>,
+    pub(crate) attitude_drift_deg_rth: Option<f64>,
+    pub(crate) glitches: GlitchPolicy,
+    pub(crate) wheel_delay: WheelDelay,
+    /// The time tag's consider term per element, kg m², once a run has applied it.
+    pub(crate) wheel_delay_consider: Option<[f64; 6]>,
+    /// The rotors' spin-inertia consider term per element, kg m², once a run with a
+    /// spacecraft file has computed it ([`crate::estimator::rotor_inertia`]).
+    pub(crate) rotor_inertia_consider: Option<[f64; 6]>,
+    /// `√Σ_i s_i²` of a spacecraft file's rotors' relative spin-inertia σ (0 without).
+    pub(crate) rotor_inertia_relative_sigma: f64,
+    /// One chain length for the discrete momentum estimator's candidates (`Some(None)`:
+    /// the whole record), in place of the choice among [`Self::max_chain_s`]'s: a run that
+    /// re-estimates perturbed data in the row model its answer used
+    /// ([`Self::pinned_to`]).
+    pub(crate) pinned_chain_s: Option<Option<f64>>,
+}
+
+impl PipelineConfig {
+    /// A wheel-speed time tag is applied by a [`super::Run`] alone, which holds the record
+    /// ([`crate::estimator::wheel_delay`]); a [`super::Pipeline`] or a batch call given
+    /// one refuses it rather than ignore it.
+    pub(crate) fn check_no_wheel_delay(&self) -> Result<(), PipelineError> {
+        if self.wheel_delay == WheelDelay::Off {
+            return Ok(());
+        }
+        Err(PipelineError::NeedsSetting {
+            setting: "wheel_delay",
+            needs: "Run",
+            requirement: "to apply it",
+            why: "the speeds are read later over the whole record, which only a run holds",
+        })
+    }
+
+    /// This configuration with its wheel-speed time tag applied by the run: the time tag
+    /// off for the pipeline or batch call, its consider term kept.
+    pub(crate) fn with_delay_applied(mut self) -> Self {
+        self.wheel_delay = WheelDelay::Off;
+        self
+    }
+
+    /// The relative σ of the rotor momentum the user stated: the common scale's
+    /// ([`PipelineSettings::rotor_scale_sigma`]) and a spacecraft file's rotors'
+    /// (`√Σ_i (σ_i/J_i)²`), in quadrature; 0 without either. The residual-span test widens
+    /// its reference σ by it ([`crate::estimator::consistency`]).
+    #[must_use]
+    pub(crate) fn stated_relative_sigma(&self) -> f64 {
+        let r = self.rotor_scale_sigma.unwrap_or(0.0);
+        crate::math::sqrt(
+            r * r + self.rotor_inertia_relative_sigma * self.rotor_inertia_relative_sigma,
+        )
+    }
+
+    /// This configuration with the row model an answer used (`rows`, and whether its
+    /// constant torque was held at zero, `torque`) fixed instead of chosen from the data:
+    /// its rotation source, stencil, chain length, inertial torque, and the body torque
+    /// estimated or not. For re-running the estimator on slightly changed data (the
+    /// rotors' consider term, [`crate::estimator::rotor_inertia`]) so that the change
+    /// measures the answer's sensitivity, not a switch of the model.
+    #[must_use]
+    pub(crate) fn pinned_to(
+        mut self,
+        rows: Option<crate::estimator::momentum_rows::MomentumRowSettings>,
+        torque: Option<crate::estimator::discrete_momentum::TorqueTest>,
+    ) -> Self {
+        use crate::estimator::momentum_rows::Stencil;
+        let Some(r) = rows else {
+            return self;
+        };
+        self.rotation_source = Some(r.rotation);
+        self.rho_model = match r.stencil {
+            Stencil::Plain => RhoModel::Plain,
+            Stencil::Smooth => RhoModel::Smooth,
+            Stencil::Held => RhoModel::Held,
+            Stencil::Adaptive => RhoModel::Auto,
+        };
+        self.torque_bias = r.torque_bias && !torque.is_some_and(|t| t.held_at_zero);
+        self.inertial_torque = if r.inertial_torque {
+            InertialTorque::On
+        } else {
+            InertialTorque::Off
+        };
+        self.damping = r.damping;
+        self.pinned_chain_s = Some(r.max_chain_s);
+        self
+    }
+
+    /// The estimator's registry entry.
+    #[must_use]
+    pub fn estimator(&self) -> &'static EstimatorEntry {
+        self.estimator
+    }
+
+    /// The backend's registry entry.
+    #[must_use]
+    pub fn backend(&self) -> &'static BackendEntry {
+        self.backend
+    }
+
+    /// The validated constraints.
+    #[must_use]
+    pub fn constraints(&self) -> &Constraints {
+        &self.constraints
+    }
+
+    /// Solve every this many row blocks.
+    #[must_use]
+    pub fn solve_every(&self) -> usize {
+        self.solve_every
+    }
+
+    /// Memory time constant, s.
+    #[must_use]
+    pub fn memory_s(&self) -> Option<f64> {
+        self.memory_s
+    }
+
+    /// Resampling period, s.
+    #[must_use]
+    pub fn resample_s(&self) -> Option<f64> {
+        self.resample_s
+    }
+
+    /// Gyro rate-noise density, rad/s/√Hz (converted once, here, from the settings'
+    /// deg/s/√Hz).
+    #[must_use]
+    pub fn gyro_noise_rad_s_rthz(&self) -> Option<f64> {
+        self.gyro_noise_rad_s_rthz
+    }
+
+    /// Whether estimates carry a standard deviation.
+    #[must_use]
+    pub fn uncertainty(&self) -> bool {
+        self.uncertainty
+    }
+
+    /// Source of the incremental rotations (`None`: chosen from the data).
+    #[must_use]
+    pub fn rotation_source(&self) -> Option<RotationSource> {
+        self.rotation_source
+    }
+
+    /// Model of the rotor momentum between samples.
+    #[must_use]
+    pub fn rho_model(&self) -> RhoModel {
+        self.rho_model
+    }
+
+    /// Whether an unknown constant torque is estimated.
+    #[must_use]
+    pub fn torque_bias(&self) -> bool {
+        self.torque_bias
+    }
+
+    /// Relative σ of the rotor momentum's scale (a consider parameter), if any.
+    #[must_use]
+    pub fn rotor_scale_sigma(&self) -> Option<f64> {
+        self.rotor_scale_sigma
+    }
+
+    /// Whether an unknown constant inertial-frame torque is estimated.
+    #[must_use]
+    pub fn inertial_torque(&self) -> InertialTorque {
+        self.inertial_torque
+    }
+
+    /// Longest momentum chain, s.
+    #[must_use]
+    pub fn max_chain_s(&self) -> Option<f64> {
+        self.max_chain_s
+    }
+
+    /// Angle random walk of the attitude solution, deg/√h (the drift weighting).
+    #[must_use]
+    pub fn attitude_drift_deg_rth(&self) -> Option<f64> {
+        self.attitude_drift_deg_rth
+    }
+
+    /// Observability thresholds.
+    #[must_use]
+    pub fn observability(&self) -> &ObservabilitySettings {
+        &self.observability
+    }
+}
+
+/// Whether the discrete momentum estimator estimates a disturbance torque constant in the
+/// inertial frame, per chain ([`crate::estimator::momentum_rows`], "Inertial torque"):
+/// an aerodynamic or solar force whose direction is fixed in space, the momentum's drift
+/// over a short record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum InertialTorque {
+    /// Not estimated (default).
+    #[default]
+    Off,
+    /// Always estimated.
+    On,
+    /// Estimated where a nested χ² test at 10⁻³ and the Bayesian information criterion
+    /// both say the data need it (`estimators/discrete_momentum/select.rs`): both models
+    /// are folded, and the report says which answered.
+    Auto,
+}
+
+/// Build a streaming estimator from a validated configuration.
+pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
+/// Estimate from all samples at once.
+pub(crate) type BatchFn = fn(&[Sample], &PipelineConfig) -> Result<BatchOutput, PipelineError>;
+
+/// A registered estimator.
+#[derive(Debug)]
+pub struct EstimatorEntry {
+    /// Name, as given in settings and on the command line.
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// What it uses and needs.
+    pub capabilities: Capabilities,
+    pub(crate) build: BuildFn,
+    pub(crate) batch: Option<BatchFn>,
+}
+
+impl EstimatorEntry {
+    /// Whether it can estimate from all samples at once.
+    #[must_use]
+    pub fn has_batch(&self) -> bool {
+        self.batch.is_some()
+    }
+}
+
+/// A registered solver backend.
+#[derive(Debug)]
+pub struct BackendEntry {
+    /// Name, as given in settings and on the command line.
+    pub name: &'static str,
+    /// One line for help texts.
+    pub summary: &'static str,
+    /// Why this build cannot run it, when it cannot.
+    pub unavailable: Option<&'static str>,
+    pub(crate) build: fn() -> Box<dyn Backend + Send>,
+}
+
+impl BackendEntry {
+    /// A fresh backend of this (validated) entry.
+    pub(crate) fn build(&self) -> Box<dyn Backend + Send> {
+        (self.build)()
+    }
+}

@@ -1,0 +1,56 @@
+//! What the pipeline asks of an estimator: the [`Estimator`] trait (`push` and
+//! `diagnostics`), what it uses and needs ([`Capabilities`]) and a batch run's answer
+//! ([`BatchOutput`]). Its registry entry is in [`super::config`], beside the validated
+//! settings it is built from; [`super::registry`] lists the entries.
+
+use super::diagnostics::Diagnostics;
+use crate::estimator::{Estimate, EstimatorError};
+use crate::sample::Sample;
+
+/// A streaming estimator as the pipeline drives it: what every estimator has.
+pub(crate) trait Estimator: Send {
+    /// Feed one sample; an estimate when one is due.
+    fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError>;
+    /// What the estimator can say about its run at its latest estimate.
+    fn diagnostics(&self) -> Diagnostics;
+}
+
+/// The answer of a batch run.
+#[derive(Debug, Clone)]
+pub struct BatchOutput {
+    /// The estimate from all samples.
+    pub estimate: Estimate,
+    /// What the estimator can say about the run.
+    pub diagnostics: Diagnostics,
+}
+
+/// What an estimator uses and needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Capabilities {
+    /// It needs gyro rates in the telemetry.
+    pub needs_gyro: bool,
+    /// It keeps J in the constraint set.
+    pub constraints: bool,
+    /// It compensates errors-in-variables given the gyro noise density.
+    pub compensation: bool,
+    /// It has an uncertainty model.
+    pub uncertainty: bool,
+    /// It takes the row-model settings (rotation source, model of ρ, torque bias).
+    pub row_model: bool,
+    /// It differentiates low-pass-filtered signals (takes `filter_cutoff_hz`).
+    pub filter: bool,
+}
+
+impl Capabilities {
+    /// The fewest input samples for one estimate: two for an estimator of gyro rates alone
+    /// (one momentum difference), else [`crate::estimator::MIN_SAMPLES`] (two 3-row blocks
+    /// over three nodes).
+    #[must_use]
+    pub const fn min_samples(&self) -> usize {
+        if self.needs_gyro && !self.constraints {
+            2
+        } else {
+            crate::estimator::MIN_SAMPLES
+        }
+    }
+}
