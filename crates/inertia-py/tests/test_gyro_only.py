@@ -42,3 +42,24 @@ def test_arrays_without_quaternions_match_the_file(files, tmp_path):
 
     with pytest.raises(ValueError, match="q=None"):
         inertia.estimate(t.t, None, t.rho, w=t.w, jpl=True)
+
+
+def test_dataframe_without_quaternions_matches_the_file(files, tmp_path):
+    """A DataFrame with gyro columns and no quaternion column: the attitude integrated
+    from the gyro, bit for bit as the gyro-only file; a column that looks like a
+    quaternion keeps the missing ``q_*`` an error instead."""
+    import pytest
+
+    pd = pytest.importorskip("pandas")
+    rows = files["slew"].read_text().splitlines()
+    f = tmp_path / "gyro.csv"
+    f.write_text("\n".join(",".join(r.split(",")[:1] + r.split(",")[5:]) for r in rows) + "\n")
+    frame = inertia.read_csv(files["slew"]).to_dataframe().drop(columns=["q_x", "q_y", "q_z", "q_w"])
+    got = inertia.estimate(frame).to_dict()
+    expected = inertia.estimate(f).to_dict()
+    assert got.pop("file") == "<DataFrame>"
+    expected.pop("file")
+    assert differences(expected, got) == 0.0
+    assert got["attitude_from_gyro"] is True
+    with pytest.raises(inertia.DataError, match="q_x"):
+        inertia.estimate(frame.assign(qx=0.0))

@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import warnings
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -429,7 +430,16 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
         # Elapsed seconds since the first row (pandas' datetimes have no leap seconds).
         t = (t - t.iloc[0]).dt.total_seconds()
     t = _float_array(names[0], t.to_numpy(), "(N,)")
-    q = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[1:5]])
+    # No quaternion column at all (none renamed, none that looks like one) and every gyro
+    # column: the attitude is integrated from the gyro rates, as for such a CSV file.
+    looks_like_q = any(re.fullmatch(r"(q|quat|quaternion)[_ ]?([0-3]|[xyzws]|scalar)", c.lower()) for c in present)
+    gyro_only = (
+        not any(n in present for n in names[1:5])
+        and names[1:5] == list(CSV_COLUMNS[1:5])
+        and all(n in present for n in names[11:14])
+        and not looks_like_q
+    )
+    q = None if gyro_only else np.column_stack([_float_array(n, need(n), "(N,)") for n in names[1:5]])
     rho = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[5:8]])
     return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
 
