@@ -543,6 +543,7 @@ pub struct BatchReduction {
     pub(crate) damping: Option<DampingRow>,
 }
 
+#[cfg(feature = "std")]
 impl BatchReduction {
     /// The damping `D` (N m s) that fits best at `j`, with its least-squares σ, where the
     /// rows estimate one.
@@ -554,6 +555,7 @@ impl BatchReduction {
 
 /// The damping's row of an upper-triangular factor over the shared unknowns, `j` last:
 /// `r_dd D + r_dj·j = z_d` once the unknowns after it are fixed, and its least-squares σ.
+#[cfg(feature = "std")]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct DampingRow {
     r_dd: f64,
@@ -562,6 +564,7 @@ pub(crate) struct DampingRow {
     sigma_nms: Option<f64>,
 }
 
+#[cfg(feature = "std")]
 impl DampingRow {
     /// `D` at `j` with its σ (the unknowns between `D` and `j` are none: `D` is the last
     /// before `j`, [`super::unknowns::Block::ALL`]).
