@@ -176,6 +176,8 @@ pub struct Report {
     #[serde(skip)]
     held_speeds: Option<(usize, f64)>,
     #[serde(skip)]
+    gyro_range: std::vec::Vec<crate::telemetry::gyro_range::ClippedAxis>,
+    #[serde(skip)]
     rotor_inertia_error: Option<(crate::estimator::rotor_inertia::RotorInertiaError, f64)>,
     #[serde(skip)]
     observability: Observability,
@@ -208,6 +210,9 @@ pub enum Warning {
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
+    /// A gyro axis reads its range limit while the attitude turns faster
+    /// ([`crate::telemetry::gyro_range`]).
+    GyroAtRangeLimit(crate::telemetry::gyro_range::ClippedAxis),
 }
 
 /// The rotors' spin-inertia consider term as the report carries it.
@@ -263,6 +268,7 @@ impl Warning {
             Warning::WheelDelayNotEstimated(_) => "wheel_delay_not_estimated",
             Warning::HeldWheelSpeeds(..) => "held_wheel_speeds",
             Warning::RotorInertiaNotComputed(..) => "rotor_inertia_not_computed",
+            Warning::GyroAtRangeLimit(_) => "gyro_at_range_limit",
         }
     }
 }
@@ -321,6 +327,17 @@ impl fmt::Display for Warning {
                 f,
                 "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
+            ),
+            Warning::GyroAtRangeLimit(c) => write!(
+                f,
+                "the gyro's {} axis reads its largest rate, {} rad/s, in {} samples while the \
+                 attitude turns faster about it (up to {} rad/s): the gyro is at its range \
+                 limit there, and an estimator that uses its rates sees the wrong motion; \
+                 drop those spans or estimate without the gyro's rates",
+                ["x", "y", "z"][c.axis.min(2)],
+                Num(c.limit_rad_s),
+                c.samples,
+                Num(c.attitude_rate_rad_s)
             ),
         }
     }
@@ -398,6 +415,7 @@ impl Report {
             wheel_delay: None,
             wheel_delay_error: None,
             held_speeds: None,
+            gyro_range: std::vec::Vec::new(),
             rotor_inertia: None,
             rotor_inertia_error: None,
             observability: estimate.observability,
@@ -436,6 +454,12 @@ impl Report {
         if let Some((every, period_s)) = self.held_speeds {
             w.push(Warning::HeldWheelSpeeds(every, period_s));
         }
+        w.extend(
+            self.gyro_range
+                .iter()
+                .copied()
+                .map(Warning::GyroAtRangeLimit),
+        );
         if let Some((e, r)) = self.rotor_inertia_error {
             w.push(Warning::RotorInertiaNotComputed(e, r));
         }
@@ -448,6 +472,18 @@ impl Report {
     #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
     pub(crate) fn with_held_speeds(mut self, held: Option<(usize, f64)>) -> Self {
         self.held_speeds = held;
+        self.refreshed()
+    }
+
+    /// With the gyro axes found at their range limit
+    /// ([`crate::telemetry::gyro_range`]).
+    #[must_use]
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_gyro_range(
+        mut self,
+        clipped: std::vec::Vec<crate::telemetry::gyro_range::ClippedAxis>,
+    ) -> Self {
+        self.gyro_range = clipped;
         self.refreshed()
     }
 

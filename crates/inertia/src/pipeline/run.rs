@@ -29,6 +29,7 @@ use crate::estimator::Estimate;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
 use crate::telemetry::gate::Order;
+use crate::telemetry::gyro_range::GyroRange;
 use crate::telemetry::held_speeds::HeldSpeeds;
 use std::collections::VecDeque;
 use std::vec::Vec;
@@ -96,6 +97,8 @@ pub struct Run {
     delay: Option<Result<DelayFit, DelayError>>,
     /// Whether the wheel speeds look held between updates ([`HeldSpeeds`]).
     speeds: HeldSpeeds,
+    /// Whether a gyro axis stops at a range limit the attitude exceeds ([`GyroRange`]).
+    gyro_range: GyroRange,
     /// The spacecraft file's rotors, whose speeds give each sample's rotor momentum.
     rotors: Option<Spacecraft>,
     /// Their stored speeds, one per rotor and sample (kept only where a rotor's spin
@@ -141,6 +144,7 @@ impl Run {
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
             delay: None,
             speeds: HeldSpeeds::default(),
+            gyro_range: GyroRange::default(),
             rotors: None,
             rotor_speeds: Vec::new(),
             rotor_consider: None,
@@ -303,6 +307,7 @@ impl Run {
         self.recent.push_back((s.t_s, index));
         self.input += 1;
         self.speeds.push(&s.rho_nms);
+        self.gyro_range.push(s);
         if let Some(held) = &mut self.held {
             held.push(*s);
             return Ok(());
@@ -582,6 +587,7 @@ impl Run {
                     self.held_speeds_period_samples()
                         .map(|p| (p, p as f64 * self.sample_period_s())),
                 )
+                .with_gyro_range(self.gyro_range.clipped().collect())
                 .with_input(super::report::InputSummary {
                     file: file.into(),
                     sample_period_s: self.sample_period_s(),

@@ -8,6 +8,7 @@ pub mod convention;
 pub mod csv;
 pub mod gate;
 pub mod glitch;
+pub mod gyro_range;
 pub mod held_speeds;
 #[cfg(feature = "csv")]
 mod line_cap;

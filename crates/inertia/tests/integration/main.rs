@@ -17,6 +17,7 @@ mod discrete_convergence;
 mod discrete_momentum;
 mod dynamics;
 mod estimators;
+mod gyro_range;
 mod inertial_torque;
 mod lab_realism;
 mod numeric_range;
