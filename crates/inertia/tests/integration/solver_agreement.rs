@@ -141,7 +141,7 @@ fn backends_agree_on_every_estimator_where_the_constraints_barely_press() {
         for s in &out.samples {
             p.push_each(s, |e| history.push(*e)).unwrap();
         }
-        (history, p.row_model())
+        (history, p.diagnostics().row_model)
     };
     let relative = |a: &inertia::tensor::InertiaVector, b: &inertia::tensor::InertiaVector| {
         (a - b).norm() / a.norm()
