@@ -198,6 +198,9 @@ typedef enum InertiaInertialTorque {
   INERTIA_INERTIAL_TORQUE_ON = 1,
   // Estimated where a nested χ² test says the data need it.
   INERTIA_INERTIAL_TORQUE_AUTO = 2,
+  // `Auto` on a record shorter than 30 s, `Off` on a longer one (the library's and the
+  // command line's default; heap engine).
+  INERTIA_INERTIAL_TORQUE_SHORT = 3,
 } InertiaInertialTorque;
 
 // What to do when the attitude jumps against the gyro (`InertiaSettings::glitches`).

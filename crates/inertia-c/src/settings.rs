@@ -73,6 +73,9 @@ pub enum InertiaInertialTorque {
     On = 1,
     /// Estimated where a nested χ² test says the data need it.
     Auto = 2,
+    /// `Auto` on a record shorter than 30 s, `Off` on a longer one (the library's and the
+    /// command line's default; heap engine).
+    Short = 3,
 }
 
 /// What to do when the attitude jumps against the gyro (`InertiaSettings::glitches`).

@@ -443,9 +443,10 @@ pub struct EstimateArgs {
     pub no_torque_bias: bool,
     /// A disturbance torque constant in the inertial frame (discrete-momentum estimator;
     /// aerodynamic or solar force fixed in space, or the momentum's drift over a short
-    /// record), one per chain: `off` (default), `on`, or `auto` (both models folded; it is
-    /// taken where a nested chi-squared test at 1e-3 and the BIC both say the data need
-    /// it, and the report's `rows:` line says so).
+    /// record), one per chain: `short` (default: `auto` on a record shorter than 30 s,
+    /// `off` on a longer one), `off`, `on`, or `auto` (both models folded; it is taken
+    /// where a nested chi-squared test at 1e-3 and the BIC both say the data need it, and
+    /// the report's `rows:` line says so).
     #[arg(long, value_name = "MODE", value_parser = choice::<InertialTorque>())]
     pub inertial_torque: Option<InertialTorque>,
     /// Estimate a linear damping torque −D·ω (air drag on a tumbling body; one more

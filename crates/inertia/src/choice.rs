@@ -87,10 +87,11 @@ choice!(RotationSource, "rotation_source", "attitude, gyro", [
     RotationSource::Attitude => "attitude",
     RotationSource::Gyro => "gyro",
 ]);
-choice!(InertialTorque, "inertial_torque", "off, on, auto", [
+choice!(InertialTorque, "inertial_torque", "off, on, auto, short", [
     InertialTorque::Off => "off",
     InertialTorque::On => "on",
     InertialTorque::Auto => "auto",
+    InertialTorque::Short => "short",
 ]);
 choice!(GlitchPolicy, "glitches", "stop, keep", [
     GlitchPolicy::Stop => "stop",

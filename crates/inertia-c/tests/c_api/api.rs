@@ -188,7 +188,7 @@ fn bad_settings_name_the_setting() {
         ),
         (
             InertiaSettings {
-                inertial_torque: 3,
+                inertial_torque: 4,
                 ..inertia_settings_default()
             },
             InertiaStatus::InvalidSetting,
@@ -501,6 +501,7 @@ fn the_choice_constants_are_the_librarys_values() {
         (InertiaInertialTorque::Off as u32, "off"),
         (InertiaInertialTorque::On as u32, "on"),
         (InertiaInertialTorque::Auto as u32, "auto"),
+        (InertiaInertialTorque::Short as u32, "short"),
     ] {
         assert_eq!(name::<InertialTorque>(id), n);
     }

@@ -490,7 +490,7 @@ def estimate(
     rotation_source: Optional[str] = None,
     rho_model: str = "auto",
     torque_bias: bool = True,
-    inertial_torque: str = "off",
+    inertial_torque: str = "short",
     damping: bool = False,
     rotor_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
@@ -557,8 +557,10 @@ def estimate(
         every: solve every N samples. rotation_source: ``"attitude"`` or ``"gyro"``
             (default: chosen from the data). rho_model: ``"auto"``, ``"smooth"``,
             ``"held"``, ``"plain"``. torque_bias: estimate an unknown constant torque.
-            inertial_torque: a torque constant in the inertial frame, per chain: ``"off"``,
-            ``"on"`` or ``"auto"`` (a nested χ² test decides; ``report["row_model"]``).
+            inertial_torque: a torque constant in the inertial frame, per chain: ``"short"``
+            (default: ``"auto"`` on a record shorter than 30 s, ``"off"`` on a longer one),
+            ``"off"``, ``"on"`` or ``"auto"`` (a nested χ² test decides;
+            ``report["row_model"]``).
             damping: estimate a linear damping torque −D ω (air drag; ``report["damping_nms"]``).
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
@@ -667,7 +669,7 @@ class Estimator:
         rotation_source: Optional[str] = None,
         rho_model: str = "auto",
         torque_bias: bool = True,
-        inertial_torque: str = "off",
+        inertial_torque: str = "short",
         damping: bool = False,
         rotor_scale_sigma: Optional[float] = None,
         filter_cutoff_hz: Optional[float] = None,

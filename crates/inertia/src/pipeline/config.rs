@@ -226,8 +226,15 @@ impl PipelineConfig {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum InertialTorque {
-    /// Not estimated (default).
+    /// [`InertialTorque::Auto`] on a record shorter than [`SHORT_RECORD_S`], from its
+    /// first sample, and [`InertialTorque::Off`] once it is longer (default): over a short
+    /// record (a thrown device, a test article, a manoeuvre of seconds) a force fixed in
+    /// space acts on the whole of one momentum chain, which no chain restart absorbs; over
+    /// a long one the chains absorb the momentum's slow drift, and a test would take its
+    /// random walk for a torque. With a memory (forgetting) it is `Off`.
     #[default]
+    Short,
+    /// Not estimated.
     Off,
     /// Always estimated.
     On,
@@ -236,6 +243,10 @@ pub enum InertialTorque {
     /// are folded, and the report says which answered.
     Auto,
 }
+
+/// The longest record, s, on which [`InertialTorque::Short`] tests for a torque fixed in
+/// the inertial frame: the default chain length ([`super::DEFAULT_MAX_CHAIN_S`]).
+pub const SHORT_RECORD_S: f64 = 30.0;
 
 /// Build a streaming estimator from a validated configuration.
 pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;

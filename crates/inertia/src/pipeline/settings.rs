@@ -60,7 +60,8 @@ pub struct PipelineSettings {
     /// estimator; default `true`).
     pub torque_bias: bool,
     /// Whether to estimate a disturbance torque constant in the inertial frame, per chain
-    /// (discrete momentum estimator; default [`InertialTorque::Off`]).
+    /// (discrete momentum estimator; default [`InertialTorque::Short`]: tested for on a
+    /// record shorter than 30 s, not estimated on a longer one).
     pub inertial_torque: InertialTorque,
     /// Estimate a linear damping torque `−D ω` (air drag on a tumbling body; discrete
     /// momentum estimator; default `false`): one more shared unknown `D`, N m s
@@ -118,7 +119,7 @@ impl Default for PipelineSettings {
             rotation_source: None,
             rho_model: RhoModel::Auto,
             torque_bias: true,
-            inertial_torque: InertialTorque::Off,
+            inertial_torque: InertialTorque::Short,
             damping: false,
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
@@ -239,9 +240,13 @@ impl PipelineSettings {
                 ),
                 ("rho_model", self.rho_model != defaults.rho_model),
                 ("torque_bias", self.torque_bias != defaults.torque_bias),
+                // Off and the default (off past a short record) ask for no torque.
                 (
                     "inertial_torque",
-                    self.inertial_torque != defaults.inertial_torque,
+                    !matches!(
+                        self.inertial_torque,
+                        InertialTorque::Short | InertialTorque::Off
+                    ),
                 ),
                 ("damping", self.damping != defaults.damping),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),

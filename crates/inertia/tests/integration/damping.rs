@@ -168,7 +168,15 @@ fn a_negative_damping_fails_the_model_check() {
     ]);
     p.common.seed = 1;
     let out = p.simulate().expect("valid settings");
-    let on = streaming(&out.samples, config(true));
+    let off = PipelineSettings {
+        damping: true,
+        inertial_torque: inertia::pipeline::InertialTorque::Off,
+        solve_every: 400,
+        ..PipelineSettings::default()
+    }
+    .validate()
+    .expect("valid settings");
+    let on = streaming(&out.samples, off);
     let e = on.last().expect("answer");
     let (d, sigma) = on.diagnostics().damping_nms.expect("estimated");
     eprintln!("D = {d:.3e} ± {:.1e}", sigma.unwrap_or(f64::NAN));

@@ -149,3 +149,71 @@ fn auto_with_a_memory_is_refused() {
     );
     assert!(with(InertialTorque::On).validate().is_ok());
 }
+
+/// The default (`InertialTorque::Short`): on a record shorter than 30 s it tests for a
+/// torque fixed in the inertial frame as `auto` does, and on a longer one its answer is
+/// `off`'s, J and σ bit for bit, once the record passes 30 s.
+#[test]
+fn the_default_tests_for_the_torque_on_short_records_only() {
+    use inertia::sim::presets::{LabEffect, Preset};
+    use inertia::sim::scenario::Scenario;
+    let run = |samples: &[inertia::sample::Sample], mode: Option<InertialTorque>| {
+        let settings = PipelineSettings {
+            inertial_torque: mode.unwrap_or_default(),
+            solve_every: 50,
+            ..PipelineSettings::default()
+        };
+        let mut p = Pipeline::new(&settings).expect("settings");
+        let mut answers = Vec::new();
+        for s in samples {
+            if let Some(e) = p.push(s).expect("push") {
+                answers.push((s.t_s, e));
+            }
+        }
+        (answers, p.diagnostics().row_model.expect("rows"))
+    };
+    // A throw with the inertial torque alone: the default answers as `auto`.
+    let mut throw = Preset::throw_without(&[
+        LabEffect::Vibration,
+        LabEffect::SpeedTelemetry,
+        LabEffect::Drag,
+    ]);
+    throw.common.seed = 2;
+    let out = throw.simulate().expect("simulation");
+    let (default, rows) = run(&out.samples, None);
+    let (auto, _) = run(&out.samples, Some(InertialTorque::Auto));
+    let (off, _) = run(&out.samples, Some(InertialTorque::Off));
+    assert!(rows.inertial_torque, "the torque is taken on the throw");
+    let last = |a: &[(f64, inertia::estimator::Estimate)]| a.last().expect("answers").1;
+    assert_eq!(last(&default), last(&auto));
+    let truth = &out.inertia_kg_m2;
+    assert_eq!(last(&default).within_3sigma(truth), Some(true));
+    let error =
+        |e: inertia::estimator::Estimate| relative_frobenius_error(&e.inertia().expect("J"), truth);
+    assert!(
+        error(last(&default)) < 0.5 * error(last(&off)),
+        "{} vs {}",
+        error(last(&default)),
+        error(last(&off))
+    );
+    // A 120 s slew: past 30 s every answer is `off`'s.
+    let slew = Scenario::slew()
+        .simulate(&Common {
+            duration_s: Some(120.0),
+            ..Common::paper()
+        })
+        .expect("simulation");
+    let (default, rows) = run(&slew.samples, None);
+    let (off, _) = run(&slew.samples, Some(InertialTorque::Off));
+    assert!(!rows.inertial_torque);
+    let mut compared = 0;
+    for ((t, a), (_, b)) in default.iter().zip(&off) {
+        if *t > 31.0 {
+            assert_eq!(a.j(), b.j(), "t = {t}");
+            assert_eq!(a.sigma_kg_m2(), b.sigma_kg_m2(), "t = {t}");
+            assert_eq!(a.observability.code(), b.observability.code(), "t = {t}");
+            compared += 1;
+        }
+    }
+    assert!(compared > 10, "{compared}");
+}

@@ -22,7 +22,7 @@ use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::uncertainty::noise_sigma;
 use crate::estimator::{batch, Estimate, EstimatorError};
-use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
 use crate::pipeline::diagnostics::Diagnostics;
 use crate::pipeline::error::PipelineError;
 use crate::pipeline::interface::BatchOutput;
@@ -57,7 +57,18 @@ pub(super) fn run_batch(
     }
     let has_gyro = samples.first().is_some_and(|s| s.omega_rad_s.is_some());
     let mut reduced: Vec<(MomentumRowSettings, BatchReduction)> = Vec::new();
+    // A record longer than [`SHORT_RECORD_S`] is no longer short: without the torque the
+    // default adds to short ones ([`InertialTorque::Short`]), as the streaming run rules it
+    // out past that span.
+    let span = match (samples.first(), samples.last()) {
+        (Some(a), Some(b)) => b.t_s - a.t_s,
+        _ => 0.0,
+    };
+    let long = c.inertial_torque == InertialTorque::Short && span > SHORT_RECORD_S;
     for rows in candidates(c, has_gyro) {
+        if long && rows.inertial_torque {
+            continue;
+        }
         reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
     }
     let attitude_is_gyro_integral = drop_batch_twins(&mut reduced, c);

@@ -44,6 +44,11 @@ pub(super) fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowS
     };
     let inertial: &[bool] = match c.inertial_torque {
         InertialTorque::Off => &[false],
+        // Both while the record is short ([`InertialTorque::Short`]: the streaming
+        // estimator rules the torque's out past it, the batch run leaves them out of a
+        // longer record); unweighted fits only, as for `Auto`.
+        InertialTorque::Short if c.memory_s.is_none() => &[false, true],
+        InertialTorque::Short => &[false],
         InertialTorque::On => &[true],
         // Both, the test deciding at each solve ([`super::select::test_inertial_torque`]).
         InertialTorque::Auto => &[false, true],

@@ -55,7 +55,7 @@ use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::config::EstimatorEntry;
-use crate::pipeline::config::PipelineConfig;
+use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
 use crate::pipeline::diagnostics::Diagnostics;
 use crate::pipeline::error::PipelineError;
 use crate::pipeline::interface::{Capabilities, Estimator};
@@ -122,6 +122,9 @@ struct DiscreteMomentum {
     samples: usize,
     /// Samples that completed a row block (the cross-check's clock).
     blocks: usize,
+    /// The first sample's time, s, while the record may still be short
+    /// ([`InertialTorque::Short`]); `None` once it is not (or before the first sample).
+    first_t_s: Option<f64>,
     /// The even sample waiting for its successor (the shadow's next sample).
     held: Option<Sample>,
     /// The other candidates' answers for [`cross_check::reconcile`], kept between solves so that a
@@ -178,6 +181,7 @@ impl DiscreteMomentum {
             damping: None,
             samples: 0,
             blocks: 0,
+            first_t_s: None,
             held: None,
             others: Vec::new(),
             drift: None,
@@ -228,7 +232,9 @@ impl DiscreteMomentum {
     fn push_sample(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         if self.candidates.is_empty() {
             self.start(s)?;
+            self.first_t_s = Some(s.t_s);
         }
+        self.end_short_record(s.t_s);
         let folded = self.fold(s)?;
         self.feed_shadow(s);
         self.samples += 1;
@@ -237,6 +243,23 @@ impl DiscreteMomentum {
         }
         self.pick_candidate();
         self.solve(s.t_s)
+    }
+
+    /// Past [`SHORT_RECORD_S`] from the first sample, a record is no longer short: the
+    /// candidates with a torque fixed in the inertial frame that
+    /// [`InertialTorque::Short`] added are ruled out ([`standing`]), and the run goes on
+    /// as with the torque off.
+    fn end_short_record(&mut self, t_s: f64) {
+        let Some(t0) = self.first_t_s else { return };
+        if self.config.inertial_torque != InertialTorque::Short || t_s - t0 <= SHORT_RECORD_S {
+            return;
+        }
+        self.first_t_s = None;
+        for (i, c) in self.candidates.iter().enumerate() {
+            if c.row_settings().inertial_torque {
+                self.standing.rule_out(i);
+            }
+        }
     }
 
     /// Sample `s` through the row sources still wanted (a source whose candidates are all

@@ -9,6 +9,16 @@ use super::select::{alternatives_from_s, choose, pick};
 use super::sigma::sibling_jackknife;
 use super::*;
 use crate::pipeline::PipelineSettings;
+
+/// The default settings with the inertial torque off: the candidates these tests name by
+/// index are the eight of one torque model (the default adds the torque's twins while
+/// the record is short, [`InertialTorque::Short`]).
+fn off_settings() -> PipelineSettings {
+    PipelineSettings {
+        inertial_torque: InertialTorque::Off,
+        ..PipelineSettings::default()
+    }
+}
 use crate::sim::realism::{AttitudeSource, Realism};
 use crate::sim::scenario::{Common, Scenario};
 
@@ -138,7 +148,7 @@ fn ruling_out_candidates_changes_no_answer() {
         },
         ..Common::paper()
     };
-    let config = PipelineSettings::default().validate().unwrap();
+    let config = off_settings().validate().unwrap();
     for scenario in [Scenario::slew(), Scenario::spin()] {
         let run = scenario.simulate(&common).unwrap();
         let mut pruned = DiscreteMomentum::new(&config).unwrap();
@@ -180,7 +190,7 @@ fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
         duration_s: Some(400.0),
         ..Common::paper()
     };
-    let config = PipelineSettings::default().validate().unwrap();
+    let config = off_settings().validate().unwrap();
     let run = Scenario::slew().simulate(&common).unwrap();
     let mut pruned = DiscreteMomentum::new(&config).unwrap();
     let mut full = DiscreteMomentum {
@@ -366,7 +376,7 @@ fn the_shortest_chains_are_chosen_where_they_are_steadier() {
 
 #[test]
 fn a_whole_record_candidate_has_two_chained_siblings_and_others_none() {
-    let config = PipelineSettings::default().validate().unwrap();
+    let config = off_settings().validate().unwrap();
     let all = candidates(&config, true);
     assert_eq!(all.len(), 8);
     for (i, rows) in all.iter().enumerate() {
@@ -395,7 +405,7 @@ fn a_whole_record_candidate_has_two_chained_siblings_and_others_none() {
     let unchained = PipelineSettings {
         estimator: "discrete-momentum".into(),
         max_chain_s: None,
-        ..PipelineSettings::default()
+        ..off_settings()
     }
     .validate()
     .unwrap();
