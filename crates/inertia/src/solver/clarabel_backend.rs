@@ -49,11 +49,11 @@ fn svec(m: &Matrix3<f64>) -> [f64; 6] {
 pub struct ClarabelSolver {
     /// Clarabel's settings (defaults: gap and feasibility tolerances 1e-10, 200 iterations,
     /// quiet).
-    pub(crate) settings: DefaultSettings<f64>,
+    pub settings: DefaultSettings<f64>,
     /// Re-solve from the first answer, in units of its residual, where that residual is
     /// far below the data's scale (module docs; default `true`, the reference in accuracy
     /// tests). `false` is Clarabel as one would call it once (the speed comparison).
-    pub(crate) two_pass: bool,
+    pub two_pass: bool,
 }
 
 impl ClarabelSolver {

@@ -10,7 +10,7 @@ use crate::tensor::paper_j_true;
 use nalgebra::Vector3;
 
 /// A smooth wheel-momentum rate, N m.
-pub fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+pub(crate) fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
     Vector3::new(
         0.05 * (0.7 * t).sin(),
         0.03 * (1.1 * t).cos(),
@@ -19,7 +19,7 @@ pub fn rho_dot(t: f64, _x: &GyrostatState) -> Vector3<f64> {
 }
 
 /// A smooth known external torque, N m.
-pub fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
+pub(crate) fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
     Vector3::new(
         0.02 * (0.9 * t).cos(),
         -0.015 * (1.3 * t).sin(),
@@ -28,7 +28,7 @@ pub fn torque(t: f64, _x: &GyrostatState) -> Vector3<f64> {
 }
 
 /// A noise-free run of `duration_s` from a tumbling initial state, sample period `dt`.
-pub fn config(dt: f64, substeps: usize, duration_s: f64) -> SimConfig {
+pub(crate) fn config(dt: f64, substeps: usize, duration_s: f64) -> SimConfig {
     SimConfig {
         inertia_kg_m2: paper_j_true(),
         initial: GyrostatState {
@@ -49,7 +49,7 @@ pub fn config(dt: f64, substeps: usize, duration_s: f64) -> SimConfig {
 }
 
 /// Telemetry of that run, integrated with 64 RK4 substeps per sample.
-pub fn exact_samples(
+pub(crate) fn exact_samples(
     h: f64,
     duration_s: f64,
     rho: &dyn InputLaw,
