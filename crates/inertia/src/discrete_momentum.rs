@@ -44,20 +44,25 @@ use nalgebra::{Matrix3, Matrix3x6, Vector3};
 
 /// The coefficients of one interval's momentum: `L_k = a j − b`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IntervalMomentum {
+pub(crate) struct IntervalMomentum {
     /// `(2/h) C N(φ) G(φ)`, 3×6, s⁻¹.
-    pub a: Matrix3x6<f64>,
+    pub(crate) a: Matrix3x6<f64>,
     /// `−C N(φ) ρ̄`, N m s.
-    pub b: Vector3<f64>,
+    pub(crate) b: Vector3<f64>,
     /// `C N(φ)`, the rotor momentum's coefficient ([`Self::rotor`]).
-    pub cn: Matrix3<f64>,
+    pub(crate) cn: Matrix3<f64>,
 }
 
 impl IntervalMomentum {
     /// The coefficients for attitude `c` (body → inertial) at the interval's start, its
     /// incremental rotation `φ`, its trapezoid rotor momentum `ρ̄` and its length `h_s`.
     #[must_use]
-    pub fn new(c: &Matrix3<f64>, phi: &Vector3<f64>, rho_bar_nms: &Vector3<f64>, h_s: f64) -> Self {
+    pub(crate) fn new(
+        c: &Matrix3<f64>,
+        phi: &Vector3<f64>,
+        rho_bar_nms: &Vector3<f64>,
+        h_s: f64,
+    ) -> Self {
         let cn = c * n_matrix(phi);
         Self {
             a: cn * g_matrix(phi) * (2.0 / h_s),
@@ -68,13 +73,14 @@ impl IntervalMomentum {
 
     /// `b` of the same interval for another rotor momentum `ρ̄` (N m s): `−C N(φ) ρ̄`.
     #[must_use]
-    pub fn rotor(&self, rho_bar_nms: &Vector3<f64>) -> Vector3<f64> {
+    pub(crate) fn rotor(&self, rho_bar_nms: &Vector3<f64>) -> Vector3<f64> {
         -(self.cn * rho_bar_nms)
     }
 
     /// `L = a j − b` for a given `j`, N m s.
+    #[cfg(test)]
     #[must_use]
-    pub fn momentum(&self, j: &crate::tensor::InertiaVector) -> Vector3<f64> {
+    pub(crate) fn momentum(&self, j: &crate::tensor::InertiaVector) -> Vector3<f64> {
         self.a * j - self.b
     }
 }

@@ -45,6 +45,7 @@ impl GyrostatState {
 /// `ω̇` from eq. 26: `J⁻¹ (τ − ω × (J ω + ρ) − ρ̇)`.
 #[must_use]
 #[inline]
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 pub(crate) fn omega_dot(
     j: &Matrix3<f64>,
     j_inv: &Matrix3<f64>,
@@ -59,6 +60,7 @@ pub(crate) fn omega_dot(
 /// `q̇ = ½ q ω̂` (eq. 24).
 #[must_use]
 #[inline]
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 pub(crate) fn quaternion_rate(q: &Quaternion, omega: &Vector3<f64>) -> Quaternion {
     let d = q.mul(&Quaternion::pure(omega));
     Quaternion::new(0.5 * d.v, 0.5 * d.s)
@@ -77,12 +79,14 @@ impl<F: Fn(f64, &GyrostatState) -> (Vector3<f64>, Vector3<f64>)> Inputs for F {
 }
 
 #[derive(Clone, Copy)]
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 struct Deriv {
     q: Quaternion,
     omega: Vector3<f64>,
     rho: Vector3<f64>,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 fn derivative(
     j: &Matrix3<f64>,
     j_inv: &Matrix3<f64>,
@@ -98,6 +102,7 @@ fn derivative(
     }
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 fn advance(x: &GyrostatState, d: &Deriv, dt: f64) -> GyrostatState {
     GyrostatState {
         q: Quaternion::new(x.q.v + d.q.v * dt, x.q.s + d.q.s * dt),

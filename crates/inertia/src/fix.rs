@@ -7,7 +7,7 @@
 //! ([`crate::pipeline::PipelineError::fixes`], [`Unobservable::fixes`]). Each front end
 //! renders them in its own vocabulary after the message with [`Fixes`]: the CLI as its
 //! options (`--jpl`), Python as keyword arguments (`jpl=True`), C as what the caller changes
-//! before pushing. Without a front end's names, [`Fix::setting`] names the library's own
+//! before pushing. Without a front end's names, `Fix::setting` names the library's own
 //! setting.
 //!
 //! [`Unobservable::fixes`]: crate::estimator::observability::Unobservable::fixes
@@ -60,7 +60,7 @@ impl Fix {
     /// The library's own name for the setting it changes (the settings' field, or the
     /// CSV options' field), for messages read without a front end.
     #[must_use]
-    pub const fn setting(self) -> &'static str {
+    pub(crate) const fn setting(self) -> &'static str {
         match self {
             Fix::Jpl => "format = jpl",
             Fix::ScalarFirst => "format = scalar-first",
@@ -82,7 +82,7 @@ impl Fix {
 
 /// How a front end names a fix: `None` where it has no such setting (then the library's
 /// [`Fix::setting`] is shown).
-pub type FixNames = fn(Fix) -> Option<&'static str>;
+pub(crate) type FixNames = fn(Fix) -> Option<&'static str>;
 
 /// The library's names ([`Fix::setting`]).
 #[must_use]

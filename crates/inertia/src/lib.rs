@@ -89,7 +89,7 @@ mod barrier;
 pub mod choice;
 pub mod constraints;
 pub mod discrete;
-pub mod discrete_momentum;
+pub(crate) mod discrete_momentum;
 pub mod dynamics;
 mod eigen3;
 pub mod error_kind;

@@ -5,7 +5,7 @@
 //! interval** `[t_k, t_{k+1}]`, as an integrating (delta-angle) gyro reports it. Units SI,
 //! body axes, quaternion per [`crate::attitude`] (scalar last, Hamilton, body → inertial).
 //!
-//! The gap rule ([`is_gap`]) lives here so that the row sources and the resampler apply
+//! The gap rule (`is_gap`) lives here so that the row sources and the resampler apply
 //! the same one.
 
 use crate::attitude::Quaternion;
@@ -30,12 +30,12 @@ pub struct Sample {
 
 /// A step longer than this many times the previous one is a gap (missing samples, a
 /// pause): no row spans it, and the resampler restarts its grid after it.
-pub const GAP_RATIO: f64 = 3.0;
+pub(crate) const GAP_RATIO: f64 = 3.0;
 
 /// Whether a step of `step_s` after one of `previous_step_s` is a gap ([`GAP_RATIO`]).
 #[must_use]
 #[inline]
-pub fn is_gap(previous_step_s: f64, step_s: f64) -> bool {
+pub(crate) fn is_gap(previous_step_s: f64, step_s: f64) -> bool {
     step_s > GAP_RATIO * previous_step_s
 }
 

@@ -1,7 +1,7 @@
 //! Generalised least squares for a drifting attitude (beyond the paper): the momentum
 //! rows of a chain weighted for the random walk of a gyro-propagated attitude.
 //!
-//! Each momentum row block reads `−X_p + a·y = b` ([`super::augmented_qr`]): the chain's
+//! Each momentum row block reads `−X_p + a·y = b` (`super::augmented_qr`): the chain's
 //! inertial momentum `X_p` is a constant. With an attitude propagated from a gyro, the
 //! measured body→inertial matrix `C_k` carries an angle error `θ_k` that random-walks, so
 //! the block's error has two parts (design note §5, "GLS"):
@@ -9,7 +9,7 @@
 //! * white: the noise of the incremental rotation `φ_k` through `(2/h) C N G(φ) j`, of
 //!   covariance `r I` per row with `r = σ_g² · noise_s · s`, `σ_g` the rate-noise density of
 //!   the rotation's source, `noise_s` the block's errors-in-variables coefficient
-//!   ([`super::momentum_rows::AugmentedRow::noise_s`]) and `s = tr(J²)/3` (isotropic
+//!   (`super::momentum_rows::AugmentedRow::noise_s`) and `s = tr(J²)/3` (isotropic
 //!   approximation of `C J Jᵀ Cᵀ`);
 //! * a random walk: `C_k (θ_k × h_k) = Θ_k × Π` with `Π = C h` the inertial momentum
 //!   (`≈ X_p`) and `Θ_k = C_k θ_k`, whose increment over `Δt` has covariance
@@ -24,7 +24,7 @@
 //! are independent with unit variance: the GLS rows of the chain (de Jong's augmented
 //! filter: the gains do not depend on the data, so the same filter whitens the
 //! regressors and the right-hand side). With `Q = 0` it is the centring of
-//! [`super::augmented_qr`]: `P = I/w`, rows scaled by `√(w/(w+1))`, gain `1/(w+1)`.
+//! `super::augmented_qr`: `P = I/w`, rows scaled by `√(w/(w+1))`, gain `1/(w+1)`.
 //!
 //! The errors-in-variables compensation ([`super::compensation`]) still counts each
 //! whitened block's full `noise_s`, while whitening by `F = P + Q + I` leaves it less of
@@ -43,20 +43,25 @@ use nalgebra::{Matrix3, SVector, Vector3};
 /// The drift model of [`super::augmented_qr::AugmentedQr`]: the ratio of densities and
 /// the estimate of `J` that sets `Π` and `s` (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AttitudeDrift {
+pub(crate) struct AttitudeDrift {
     /// `σ_a²/σ_g²` (dimensionless): the attitude's angle random walk (rad/√s) squared
     /// over the rotation source's rate-noise density (rad/s/√Hz) squared.
-    pub ratio_s: f64,
+    pub(crate) ratio_s: f64,
     /// The estimate of `j` the weights are formed with.
-    pub j: InertiaVector,
+    pub(crate) j: InertiaVector,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl AttitudeDrift {
     /// The model for an attitude random walk of `attitude_deg_rth` (deg/√h) against a
     /// rate-noise density of `gyro_deg_s_rthz` (deg/s/√Hz), at the estimate `j`; `None`
     /// where the ratio is not a finite positive number or `j` is not finite.
     #[must_use]
-    pub fn new(attitude_deg_rth: f64, gyro_deg_s_rthz: f64, j: InertiaVector) -> Option<Self> {
+    pub(crate) fn new(
+        attitude_deg_rth: f64,
+        gyro_deg_s_rthz: f64,
+        j: InertiaVector,
+    ) -> Option<Self> {
         // deg/√h → deg/√s is /60; the degrees cancel in the ratio.
         let a = attitude_deg_rth / 60.0;
         let ratio_s = (a * a) / (gyro_deg_s_rthz * gyro_deg_s_rthz);

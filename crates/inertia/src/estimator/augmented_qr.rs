@@ -65,7 +65,7 @@ impl SlotMean {
 
 /// The least-squares state: the shared unknowns' QR and the chain's slot means.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AugmentedQr {
+pub(crate) struct AugmentedQr {
     shared: SharedQr,
     slots: [SlotMean; 2],
     /// The attitude drift the rows are weighted for, if any ([`Self::set_drift`]).
@@ -76,11 +76,12 @@ pub struct AugmentedQr {
     inertial_torque: bool,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl AugmentedQr {
     /// The empty state; `shared_nuisance` unknowns (the disturbance torque) are counted
     /// from the start.
     #[must_use]
-    pub fn new(shared_nuisance: usize) -> Self {
+    pub(crate) fn new(shared_nuisance: usize) -> Self {
         Self {
             shared: SharedQr::new(shared_nuisance),
             slots: [SlotMean::empty(); 2],
@@ -117,7 +118,7 @@ impl AugmentedQr {
     ///
     /// The block must involve one slot with coefficient `−I` (as every block of
     /// [`super::momentum_rows::MomentumRows`] does) and no other.
-    pub fn add(&mut self, row: &AugmentedRow, chain: Option<&mut NormalEquations>) {
+    pub(crate) fn add(&mut self, row: &AugmentedRow, chain: Option<&mut NormalEquations>) {
         if let Some(block) = self.centre(row, chain) {
             self.shared.add(block, &row_y(row), row.noise_s);
         }
@@ -127,7 +128,7 @@ impl AugmentedQr {
     /// [`super::discrete_momentum::DiscreteMomentumEstimator::fold_shared_pair`]), their
     /// reflections interleaved (`SharedQr::add_pair`): the same states as two
     /// [`Self::add`], bit for bit.
-    pub fn add_pair(
+    pub(crate) fn add_pair(
         (a, chain_a): (&mut Self, Option<&mut NormalEquations>),
         (b, chain_b): (&mut Self, Option<&mut NormalEquations>),
         row: &AugmentedRow,
@@ -253,7 +254,7 @@ impl AugmentedQr {
 
     /// Minimise the initial-momentum unknowns out of the rows so far (a chain ended):
     /// their rows are in the shared state already, centred; the means are forgotten.
-    pub fn eliminate_anchors(&mut self) {
+    pub(crate) fn eliminate_anchors(&mut self) {
         self.slots = [SlotMean::empty(); 2];
     }
 
@@ -284,12 +285,6 @@ impl AugmentedQr {
         self.shared.rows()
     }
 
-    /// Row weight folded in (rows, discounted by forgetting).
-    #[must_use]
-    pub fn weight(&self) -> f64 {
-        self.shared.weight()
-    }
-
     /// Residual sum of squares `ρ²` (weighted).
     #[must_use]
     #[cfg_attr(not(feature = "std"), allow(dead_code))]
@@ -299,7 +294,7 @@ impl AugmentedQr {
 
     /// Residual degrees of freedom: rows minus `j` minus the nuisance unknowns (weighted).
     #[must_use]
-    pub fn residual_dof(&self) -> f64 {
+    pub(crate) fn residual_dof(&self) -> f64 {
         self.shared.residual_dof()
     }
 
@@ -312,7 +307,7 @@ impl AugmentedQr {
 
     /// The reduced problem in `j` ([`SharedQr::reduced`]).
     #[must_use]
-    pub fn reduced(&self) -> RecursiveQr {
+    pub(crate) fn reduced(&self) -> RecursiveQr {
         self.shared.reduced()
     }
 

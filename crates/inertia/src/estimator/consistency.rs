@@ -68,7 +68,7 @@ pub const INCONSISTENT_RATIO: f64 = 300.0;
 /// reach ratios of 970 from the discretisation remainder alone, the answers moved by up
 /// to 10.1 of their early σ (which, without noise, is too small); in the broken runs of
 /// `tests/integration/consistency.rs`, by at least 52.
-pub(crate) const SHIFT_Z: f64 = 20.0;
+pub const SHIFT_Z: f64 = 20.0;
 
 /// An answer and its stated σ per element.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -317,7 +317,7 @@ fn shift_z(j: &InertiaVector, r: &Snapshot, stated: f64) -> f64 {
 }
 
 /// Below this ratio of the residual variance to the part the stated gyro density alone
-/// implies ([`gyro_density_ratio`]), the density is overstated.
+/// implies (`gyro_density_ratio`), the density is overstated.
 pub const DENSITY_OVERSTATED_RATIO: f64 = 0.5;
 
 /// Withdraw the answer of `e` when its residuals contradict the model or the noise: a
@@ -364,7 +364,7 @@ pub(crate) fn check(
 /// the errors-in-variables compensation built on it removes information the rows do not
 /// lack. `None` without residual degrees of freedom or modelled noise.
 #[must_use]
-pub fn gyro_density_ratio(
+pub(crate) fn gyro_density_ratio(
     qr: &RecursiveQr,
     j: &InertiaVector,
     gyro_noise_rad_s_rthz: f64,

@@ -1,12 +1,12 @@
 //! The discrete momentum estimator (beyond the paper): the rows of
 //! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; κ; j]`
-//! ([`super::augmented_qr`]), the nuisance unknowns minimised out exactly (the torque
+//! (`super::augmented_qr`), the nuisance unknowns minimised out exactly (the torque
 //! `τ_b` held at zero instead where the data give no evidence of one, [`torque_tested`]),
 //! and the same observability test, constraint sets and solvers as Algorithm 1 on the
 //! reduced problem in `j`.
 //!
 //! * [`DiscreteMomentumEstimator`] — recursive, no allocation per sample;
-//! * [`reduce_batch`] — every row stacked, one dense Householder QR per chain and one for
+//! * `reduce_batch` — every row stacked, one dense Householder QR per chain and one for
 //!   the shared unknowns: an independent code path that must agree with the recursive one.
 
 use super::augmented_qr::AugmentedQr;
@@ -59,7 +59,7 @@ pub struct TorqueTest {
 
 /// The reduced state to solve, and the torque test: `with` has the disturbance torque
 /// `τ_b` minimised out, `without` (when the torque is estimated at all) holds it at zero,
-/// with the growth of `ρ²` that costs ([`super::shared_qr::SharedQr::reduced_without_torque`]).
+/// with the growth of `ρ²` that costs (`super::shared_qr::SharedQr::reduced_without_torque`).
 ///
 /// A nested-model test (beyond the paper): with `s² = ρ²/ν` of `with`, `Δρ²/s²` is
 /// χ²-distributed with 3 degrees of freedom when there is no torque. There is no test
@@ -74,7 +74,7 @@ pub struct TorqueTest {
 /// record's vibration) make `s²` too small and the statistic too large, which errs
 /// toward keeping a torque that is not there, and three unknowns more cost a short record
 /// 5–10× its error. So where the χ² test keeps the torque and the answer has a jackknife
-/// σ (`sigma`, [`super::jackknife`]: correlated errors count there as they are), the
+/// σ (`sigma`, `super::jackknife`: correlated errors count there as they are), the
 /// torque is held at zero unless holding it moves some element of the answer by more than
 /// [`TORQUE_SHIFT_Z`] of that σ: the torque must matter to the answer, not only to the
 /// residuals. The held answer's σ then carries the move `|ĵ − ĵ|τ_b=0|`
@@ -152,7 +152,7 @@ pub struct MomentumEstimatorSettings {
     pub rows: MomentumRowSettings,
     /// Solve cadence, memory, observability thresholds, and the gyro rate-noise density
     /// for errors-in-variables compensation ([`super::compensation`] with the rows'
-    /// [`super::momentum_rows::AugmentedRow::noise_s`]).
+    /// `super::momentum_rows::AugmentedRow::noise_s`).
     pub recursive: RecursiveSettings,
 }
 
@@ -195,6 +195,7 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     last: Option<Estimate>,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// A new estimator.
     pub fn new(
@@ -235,7 +236,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     /// Fold one sample into the least-squares state without solving. Returns whether it
     /// completed a row block.
-    pub fn fold(&mut self, s: &Sample) -> Result<bool, EstimatorError> {
+    pub(crate) fn fold(&mut self, s: &Sample) -> Result<bool, EstimatorError> {
         let index = self.samples;
         self.samples += 1;
         let row = self.source.push(s).map_err(|source| EstimatorError::Row {
@@ -255,7 +256,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// so share their rows (module docs of [`super::momentum_rows`], "Chains"). `source`
     /// must have this estimator's row settings but for `max_chain_s`, and the same source
     /// must feed it every block from the first on.
-    pub fn fold_shared(&mut self, row: &AugmentedRow, source: &MomentumRows, t_s: f64) {
+    pub(crate) fn fold_shared(&mut self, row: &AugmentedRow, source: &MomentumRows, t_s: f64) {
         debug_assert_eq!(
             source.settings().source_key(),
             self.settings.rows.source_key()
@@ -267,7 +268,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// [`Self::fold_shared`] for two candidates fed by the same source, their folds
     /// interleaved ([`AugmentedQr::add_pair`]): the same states as two
     /// [`Self::fold_shared`], bit for bit, faster.
-    pub fn fold_shared_pair(
+    pub(crate) fn fold_shared_pair(
         a: &mut Self,
         b: &mut Self,
         row: &AugmentedRow,
@@ -320,7 +321,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     /// Weigh the row blocks folded from now on for an attitude that drifts
     /// ([`super::attitude_drift`]; `None`, the default: unweighted).
-    pub fn set_drift(&mut self, drift: Option<super::attitude_drift::AttitudeDrift>) {
+    pub(crate) fn set_drift(&mut self, drift: Option<super::attitude_drift::AttitudeDrift>) {
         self.qr.set_drift(drift);
     }
 
@@ -328,7 +329,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// per row): for a state whose noise σ is not wanted, such as the pipeline's half-rate
     /// shadow or a candidate the data have ruled out. The noise σ is the least-squares
     /// one from then on.
-    pub fn stop_jackknife(&mut self) {
+    pub(crate) fn stop_jackknife(&mut self) {
         self.groups = None;
     }
 
@@ -336,7 +337,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// noise σ is the least-squares one, as after [`Self::stop_jackknife`], which this is
     /// where the torque is not tested. For a state whose σ comes from elsewhere (the
     /// whole record as one chain, whose siblings' jackknife σ it takes).
-    pub fn jackknife_for_torque_only(&mut self) {
+    pub(crate) fn jackknife_for_torque_only(&mut self) {
         if self.settings.rows.torque_bias && self.settings.recursive.memory_s.is_none() {
             self.jackknife_in_sigma = false;
         } else {
@@ -397,8 +398,8 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The delete-a-group jackknife σ per element over the completed chains
-    /// ([`super::jackknife`]), kg m²; `None` with too few chains, with forgetting or
-    /// after [`Self::stop_jackknife`].
+    /// (`super::jackknife`), kg m²; `None` with too few chains, with forgetting or
+    /// after `Self::stop_jackknife`.
     pub fn jackknife_sigma(&mut self) -> Option<[f64; 6]> {
         if !self.jackknife_in_sigma {
             return None;
@@ -413,7 +414,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
-    /// ([`super::jackknife`]), kg m² (the held torque's move is added by the caller,
+    /// (`super::jackknife`), kg m² (the held torque's move is added by the caller,
     /// [`Self::held_torque_shift`]).
     pub fn robust_noise_sigma(&mut self) -> Option<[f64; 6]> {
         let ls = self.noise_sigma()?;
@@ -433,11 +434,11 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     /// The reduced least-squares state in `j` at the last solve.
     #[must_use]
-    pub fn reduced(&self) -> &RecursiveQr {
+    pub(crate) fn reduced(&self) -> &RecursiveQr {
         &self.reduced
     }
 
-    /// [`Self::reduced`] with the prior knowledge stacked on: the state the last solve
+    /// `Self::reduced` with the prior knowledge stacked on: the state the last solve
     /// used.
     #[must_use]
     pub fn solved(&self) -> &RecursiveQr {
@@ -446,7 +447,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     /// The full least-squares state.
     #[must_use]
-    pub fn qr(&self) -> &AugmentedQr {
+    pub(crate) fn qr(&self) -> &AugmentedQr {
         &self.qr
     }
 
@@ -489,7 +490,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// larger of the least-squares σ (every unknown free) and the jackknife σ of the
     /// delete-one-group answers' `D` ([`super::jackknife`]), as for `j`'s noise σ.
     #[must_use]
-    pub fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+    pub(crate) fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
         self.settings.rows.damping.then(|| {
             let column = super::unknowns::Block::Damping.shared_column();
             let ls = self.qr.shared().marginal_sigma(column);
@@ -508,7 +509,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     /// The row settings.
     #[must_use]
-    pub fn row_settings(&self) -> &MomentumRowSettings {
+    pub(crate) fn row_settings(&self) -> &MomentumRowSettings {
         &self.settings.rows
     }
 
@@ -528,27 +529,27 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 /// The batch reduction: the reduced problem in `j` and what goes with it.
 #[cfg(feature = "std")]
 #[derive(Debug, Clone, PartialEq)]
-pub struct BatchReduction {
+pub(crate) struct BatchReduction {
     /// The reduced least-squares state in `j`.
-    pub qr: RecursiveQr,
+    pub(crate) qr: RecursiveQr,
     /// Gaps in the time stamps.
-    pub gaps: usize,
+    pub(crate) gaps: usize,
     /// The delete-a-group jackknife σ per element over the chains
     /// ([`super::jackknife`]), kg m²; `None` with too few chains.
-    pub jackknife_sigma_kg_m2: Option<[f64; 6]>,
+    pub(crate) jackknife_sigma_kg_m2: Option<[f64; 6]>,
     /// The reduced state with the disturbance torque held at zero, and the growth of `ρ²`
     /// that costs ([`torque_tested`]); `None` when the torque is not estimated.
-    pub without_torque: Option<(RecursiveQr, f64)>,
+    pub(crate) without_torque: Option<(RecursiveQr, f64)>,
     /// The damping's row of the shared factor, where the rows estimate one.
     pub(crate) damping: Option<DampingRow>,
 }
 
-#[cfg(feature = "std")]
+#[cfg(test)]
 impl BatchReduction {
     /// The damping `D` (N m s) that fits best at `j`, with its least-squares σ, where the
     /// rows estimate one.
     #[must_use]
-    pub fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+    pub(crate) fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
         self.damping.map(|d| d.at(j))
     }
 }
@@ -579,7 +580,7 @@ impl DampingRow {
 /// once over the stacked `[τ_b j]` rows of every chain (and, for the jackknife, of every
 /// chain but one group's).
 #[cfg(feature = "std")]
-pub fn reduce_batch(
+pub(crate) fn reduce_batch(
     samples: &[Sample],
     settings: &MomentumRowSettings,
 ) -> Result<BatchReduction, EstimatorError> {
@@ -840,3 +841,6 @@ pub fn reduce_batch(
             }),
     })
 }
+
+#[cfg(all(test, feature = "sim"))]
+mod tests;

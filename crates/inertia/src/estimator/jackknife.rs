@@ -55,16 +55,16 @@ use crate::solver::unconstrained_minimiser;
 use crate::tensor::InertiaVector;
 
 /// Number of jackknife groups.
-pub const GROUPS: usize = 8;
+pub(crate) const GROUPS: usize = 8;
 /// Fewest non-empty groups for a jackknife σ.
-pub const MIN_GROUPS: usize = 4;
+pub(crate) const MIN_GROUPS: usize = 4;
 /// Row blocks in a time block at first (module docs, "Records of few chains").
-pub const BLOCK_ROWS: usize = 16;
+pub(crate) const BLOCK_ROWS: usize = 16;
 
 /// `√((G − 1)/G · Σ (θ₍g₎ − θ̄)²)` per element from the delete-one-group estimates; `None`
 /// with fewer than [`MIN_GROUPS`] of them.
 #[must_use]
-pub fn jackknife_sigma(estimates: &[InertiaVector]) -> Option<[f64; 6]> {
+pub(crate) fn jackknife_sigma(estimates: &[InertiaVector]) -> Option<[f64; 6]> {
     let g = estimates.len();
     if g < MIN_GROUPS {
         return None;
@@ -83,7 +83,7 @@ pub fn jackknife_sigma(estimates: &[InertiaVector]) -> Option<[f64; 6]> {
 /// The noise σ reported: element by element the larger of the least-squares σ and the
 /// jackknife σ (when there is one), kg m².
 #[must_use]
-pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [f64; 6] {
+pub(crate) fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [f64; 6] {
     // An element the least squares fix exactly (an equality, σ 0) stays fixed.
     core::array::from_fn(|k| match jackknife {
         Some(jk) if least_squares[k] > 0.0 => least_squares[k].max(jk[k]),
@@ -96,7 +96,7 @@ pub fn robust_sigma(least_squares: &[f64; 6], jackknife: Option<&[f64; 6]>) -> [
 /// holding the rows. The block in progress is kept as normal equations
 /// ([`super::normal_equations`]) and factored when it ends.
 #[derive(Debug, Clone)]
-pub struct ChainGroups {
+pub(crate) struct ChainGroups {
     /// The time block in progress.
     block: NormalEquations,
     /// The chain in progress's completed blocks.
@@ -138,7 +138,7 @@ impl ChainGroups {
     /// ([`super::augmented_qr::AugmentedQr::add`]): it holds the rows of the shared
     /// unknowns only, the initial momenta being minimised out already. Call once per row
     /// block: a full time block is closed first.
-    pub fn chain_mut(&mut self) -> &mut NormalEquations {
+    pub(crate) fn chain_mut(&mut self) -> &mut NormalEquations {
         if self.in_block >= self.block_rows {
             self.close_block();
         }
@@ -173,7 +173,7 @@ impl ChainGroups {
 
     /// The chain in progress ended: its last block closes, and its rows are filed in its
     /// group. Nothing happens for a chain without rows.
-    pub fn end_chain(&mut self) {
+    pub(crate) fn end_chain(&mut self) {
         self.close_block();
         if self.chain.rows() == 0 {
             return;
@@ -190,7 +190,7 @@ impl ChainGroups {
     /// problem without a unique solution.
     /// Each delete-one-group problem carries the prior knowledge of `constraints`
     /// ([`super::prior::augment`]), as the estimate does.
-    pub fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
+    pub(crate) fn sigma(&mut self, constraints: &Constraints) -> Option<[f64; 6]> {
         // The chains' groups change only when a chain ends; the time blocks, when a block
         // closes.
         let key = (

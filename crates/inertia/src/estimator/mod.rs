@@ -13,7 +13,7 @@
 
 pub mod attitude_drift;
 pub(crate) mod audit;
-pub mod augmented_qr;
+pub(crate) mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
 pub mod compensation;
@@ -21,10 +21,10 @@ pub mod consistency;
 pub mod discrete_momentum;
 #[cfg(feature = "std")]
 pub mod excitation;
-pub mod jackknife;
+pub(crate) mod jackknife;
 pub mod momentum;
 pub mod momentum_rows;
-pub mod normal_equations;
+pub(crate) mod normal_equations;
 pub mod observability;
 #[cfg(feature = "std")]
 pub(crate) mod plain_fit;
@@ -35,11 +35,11 @@ pub mod resample;
 #[cfg(feature = "std")]
 pub mod rotor_inertia;
 pub mod rows;
-pub mod shared_qr;
+pub(crate) mod shared_qr;
 pub mod svd_tracker;
 pub(crate) mod trend_slot;
 pub mod uncertainty;
-pub mod unknowns;
+pub(crate) mod unknowns;
 #[cfg(feature = "std")]
 pub mod wheel_delay;
 

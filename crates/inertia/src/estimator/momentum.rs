@@ -53,12 +53,12 @@ pub fn not_physical(j: &InertiaVector) -> Option<Unobservable> {
 }
 
 /// Default initial covariance scale (units of the unknowns squared).
-pub const DEFAULT_P0: f64 = 1e6;
+pub(crate) const DEFAULT_P0: f64 = 1e6;
 
 /// Settings of the momentum RLS.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MomentumSettings {
-    /// Initial covariance `P_0 = p0 I` (default [`DEFAULT_P0`]); finite and > 0.
+    /// Initial covariance `P_0 = p0 I` (default `DEFAULT_P0`); finite and > 0.
     pub p0: f64,
     /// Memory time constant, s (`None`, the default: no forgetting); finite and > 0.
     pub memory_s: Option<f64>,

@@ -1,10 +1,10 @@
-//! Rows of the discrete momentum estimator ([`crate::discrete_momentum`]) from a stream of
+//! Rows of the discrete momentum estimator (`discrete_momentum.rs`, the interval momentum) from a stream of
 //! samples: plain, or Richardson-extrapolated to O(h⁴).
 //!
 //! # Unknowns
 //!
-//! `x = [X₀; X₁; τ_b; κ; j]` ([`UNKNOWNS`] = 16; the blocks are named in
-//! [`super::unknowns`]): two 3-vectors of initial momentum
+//! `x = [X₀; X₁; τ_b; κ; j]` (`UNKNOWNS` = 16; the blocks are named in
+//! `super::unknowns`): two 3-vectors of initial momentum
 //! (the plain rows use only `X₀ = L̄₀`), the constant body-frame disturbance torque `τ_b`
 //! (columns zero when [`MomentumRowSettings::torque_bias`] is off), the scalar `κ` of
 //! [`Stencil::Adaptive`] (zero column otherwise) and `j` last, so that the trailing 6×6
@@ -13,7 +13,7 @@
 //! # Plain rows
 //!
 //! One 3-row block per interval k: `A_k j − X₀ − S_k τ_b = b_k + T_k`
-//! ([`crate::discrete_momentum`]). Exact when `ρ` is linear and `τ` constant across each
+//! (`discrete_momentum.rs`). Exact when `ρ` is linear and `τ` constant across each
 //! interval apart from the O(h²) bias of the discrete Lagrangian; that is the case when
 //! the wheel commands are held over each telemetry step and change at the samples.
 //!
@@ -44,8 +44,8 @@
 //!
 //! # Chains
 //!
-//! A gap ([`crate::sample::is_gap`]) or a step that rotates too far restarts the chain:
-//! the sums restart and the initial momenta become new unknowns; [`MomentumRows::epoch`]
+//! A gap (`crate::sample::is_gap`) or a step that rotates too far restarts the chain:
+//! the sums restart and the initial momenta become new unknowns; `MomentumRows::epoch`
 //! counts the restarts so the estimator can eliminate the old ones. A chain that only
 //! grows too long ([`MomentumRowSettings::max_chain_s`]) is split by a `ChainClock`
 //! instead: its rows go on (no interval lost, the sums running), only the initial
@@ -63,7 +63,7 @@
 //! scalar `s_k = Σ_{m=1..k} h̄_m` (the time from the chain's first interval's midpoint to
 //! interval k's): the row gains `− s_k τ_I`, and the Richardson row the same
 //! combination of the three `s`. With [`MomentumRowSettings::inertial_torque`] each
-//! block carries its `s` ([`AugmentedRow::trend_s`]) and the torque is one more unknown of
+//! block carries its `s` (`AugmentedRow::trend_s`) and the torque is one more unknown of
 //! the block's initial-momentum slot: minimised out with it per chain (and per parity,
 //! so the Richardson rows' two slots each have their own), as a linear trend of the
 //! inertial momentum (`estimator/trend_slot.rs`). A split chain's torque before and after the
@@ -76,11 +76,11 @@ use crate::sample::{is_gap, Sample};
 use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
 
 use super::unknowns::Block;
-pub use super::unknowns::UNKNOWNS;
+pub(crate) use super::unknowns::UNKNOWNS;
 /// Column of the first initial-momentum unknown.
-pub const ANCHOR0: usize = Block::Anchor0.column();
+pub(crate) const ANCHOR0: usize = Block::Anchor0.column();
 /// Column of the second initial-momentum unknown (Richardson rows, odd centres).
-pub const ANCHOR1: usize = Block::Anchor1.column();
+pub(crate) const ANCHOR1: usize = Block::Anchor1.column();
 /// Column of the disturbance torque `τ_b`.
 pub(crate) const TORQUE: usize = Block::BodyTorque.column();
 /// Column of the wheel-momentum curvature coefficient `κ` ([`Stencil::Adaptive`]).
@@ -88,7 +88,7 @@ pub(crate) const KAPPA: usize = Block::Kappa.column();
 /// Column of the damping coefficient `D` ([`MomentumRowSettings::damping`]).
 pub(crate) const DAMPING: usize = Block::Damping.column();
 /// Column of `j`.
-pub const J: usize = Block::J.column();
+pub(crate) const J: usize = Block::J.column();
 
 /// Where the incremental rotation `φ_k` comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,7 +182,7 @@ pub enum Stencil {
 impl Stencil {
     /// Whether the rows are Richardson combinations.
     #[must_use]
-    pub fn richardson(&self) -> bool {
+    pub(crate) fn richardson(&self) -> bool {
         !matches!(self, Stencil::Plain)
     }
 }
@@ -204,12 +204,12 @@ pub struct MomentumRowSettings {
     /// Estimate a linear damping torque `−D ω` (air drag; module docs, "Damping";
     /// default `false`).
     pub damping: bool,
-    /// Longest chain, s (the first [`super::jackknife::MIN_GROUPS`] chains a quarter of
+    /// Longest chain, s (the first `super::jackknife::MIN_GROUPS` chains a quarter of
     /// it): a chain is split (its initial momentum becomes a new unknown) once it spans
     /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
     /// random walk) rotates the momentum by at most the drift within one chain. `None`:
     /// chains end only at gaps. The rows themselves do not depend on it: the split is
-    /// the estimator's `ChainClock`'s, downstream of [`MomentumRows`].
+    /// the estimator's `ChainClock`'s, downstream of `MomentumRows`.
     pub max_chain_s: Option<f64>,
 }
 
@@ -263,6 +263,7 @@ impl core::fmt::Display for MomentumRowSettings {
     }
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl MomentumRowSettings {
     /// The model but for the chain length, which only [`ChainClock`] uses: candidates
     /// equal in it fit the same model in different chains.
@@ -304,7 +305,7 @@ impl MomentumRowSettings {
 
     /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`, `D`).
     #[must_use]
-    pub fn shared_nuisance(&self) -> usize {
+    pub(crate) fn shared_nuisance(&self) -> usize {
         let torque = if self.torque_bias { 3 } else { 0 };
         torque + usize::from(self.stencil == Stencil::Adaptive) + usize::from(self.damping)
     }
@@ -312,23 +313,23 @@ impl MomentumRowSettings {
 
 /// One 3-row block `a x = b` in the unknowns `x` ([`UNKNOWNS`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AugmentedRow {
+pub(crate) struct AugmentedRow {
     /// Coefficients, 3×16.
-    pub a: SMatrix<f64, 3, UNKNOWNS>,
+    pub(crate) a: SMatrix<f64, 3, UNKNOWNS>,
     /// Right-hand side, N m s.
-    pub b: Vector3<f64>,
+    pub(crate) b: Vector3<f64>,
     /// Errors-in-variables coefficient, s⁻¹: a gyro rate-noise density σ (rad/s/√Hz),
     /// entering `φ` as a white angle noise, adds `σ² · noise_s · D` to the expected
     /// `AᵀA` of the block's `j` columns (`D` of [`super::compensation`]). Plain rows:
     /// `noise_s = 1/h` (`φ` is a half angle, so its noise variance is `σ² h/4`, and
     /// `A = (2/h) C N G(φ)`); Richardson rows: `Σ_i c_i² h_i/4` with `c_i` the stencil's
     /// coefficient on `δφ_i` (`c_i = 1/h`, so `noise_s = 1/(2h)`, for equal steps).
-    pub noise_s: f64,
+    pub(crate) noise_s: f64,
     /// The coefficient `s` of the block's inertial torque, s, for a state that estimates
     /// one ([`MomentumRowSettings::inertial_torque`]): the block then reads
     /// `−X_p − s τ_{I,p} + a_rest x = b` (module docs, "Inertial torque"); only
     /// differences of `s` within a chain matter.
-    pub trend_s: f64,
+    pub(crate) trend_s: f64,
 }
 
 /// A plain row's parts, kept for the Richardson combination.
@@ -414,7 +415,7 @@ impl ChainClock {
 
 /// The row source.
 #[derive(Debug, Clone)]
-pub struct MomentumRows {
+pub(crate) struct MomentumRows {
     settings: MomentumRowSettings,
     /// The last three nodes of the chain, newest last (`None` before they exist).
     nodes: [Option<Node>; 3],
@@ -447,10 +448,11 @@ pub struct MomentumRows {
     gaps: usize,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl MomentumRows {
     /// A new source.
     #[must_use]
-    pub fn new(settings: MomentumRowSettings) -> Self {
+    pub(crate) fn new(settings: MomentumRowSettings) -> Self {
         Self {
             settings,
             nodes: [None; 3],
@@ -482,13 +484,13 @@ impl MomentumRows {
     /// Chains started so far minus one: changes whenever the initial momenta of later
     /// rows are new unknowns.
     #[must_use]
-    pub fn epoch(&self) -> u64 {
+    pub(crate) fn epoch(&self) -> u64 {
         self.epoch
     }
 
     /// Gaps seen so far.
     #[must_use]
-    pub fn gaps(&self) -> usize {
+    pub(crate) fn gaps(&self) -> usize {
         self.gaps
     }
 
@@ -520,13 +522,8 @@ impl MomentumRows {
         }
     }
 
-    /// Forget the chain (the next sample starts a new one).
-    pub fn reset(&mut self) {
-        self.restart(None);
-    }
-
     /// Feed a sample; the row block it completes, if any.
-    pub fn push(&mut self, s: &Sample) -> Result<Option<AugmentedRow>, RowError> {
+    pub(crate) fn push(&mut self, s: &Sample) -> Result<Option<AugmentedRow>, RowError> {
         check_unit(&s.q, 2)?;
         let node = Node {
             t_s: s.t_s,

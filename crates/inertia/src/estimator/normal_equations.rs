@@ -37,7 +37,7 @@ pub(crate) const PIVOT_DIGITS: i32 = 12;
 /// `AᵀA`, `Aᵀβ`, `βᵀβ` of a chain's centred rows in the shared unknowns, and the same
 /// counters as [`SharedQr`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NormalEquations {
+pub(crate) struct NormalEquations {
     /// `AᵀA`, upper triangle (column-major: column `k` holds rows `0..=k`).
     ata: SMatrix<f64, SHARED, SHARED>,
     atb: SVector<f64, SHARED>,

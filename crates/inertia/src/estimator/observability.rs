@@ -5,7 +5,7 @@
 //! test here looks at the singular values `σ_1 ≥ … ≥ σ_6` of `R` and at `Σ‖y_k‖²`:
 //!
 //! * `y ≡ 0` → [`Unobservable::NoExcitation`];
-//! * `σ_6` below [`crate::solver::SINGULAR_RATIO`] of `σ_1`, or fewer than six rows →
+//! * `σ_6` below `crate::solver::SINGULAR_RATIO` of `σ_1`, or fewer than six rows →
 //!   [`Unobservable::RankDeficient`];
 //! * `σ_1/σ_6` above the threshold ([`DEFAULT_CONDITION_THRESHOLD`]) →
 //!   [`Unobservable::IllConditioned`];
@@ -38,7 +38,7 @@ pub(crate) const MIN_RESIDUAL_DOF: usize = 6;
 
 /// How many least-squares σ below zero an estimated damping may lie before the model
 /// check fails ([`Unobservable::NegativeDamping`]).
-pub const NEGATIVE_DAMPING_Z: f64 = 3.0;
+pub(crate) const NEGATIVE_DAMPING_Z: f64 = 3.0;
 
 /// Thresholds of the observability test.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -125,7 +125,7 @@ pub enum Unobservable {
     },
     /// The residuals are smaller than the stated gyro noise density alone implies: the
     /// density is overstated, and the errors-in-variables compensation built on it
-    /// over-corrects ([`super::consistency::gyro_density_ratio`]).
+    /// over-corrects (`super::consistency::gyro_density_ratio`).
     DensityOverstated {
         /// Residual variance over the part the stated density implies.
         ratio: f64,
@@ -160,7 +160,7 @@ pub enum Unobservable {
         z: f64,
     },
     /// The estimated damping `D` of a torque `−D ω` is negative by more than
-    /// [`NEGATIVE_DAMPING_Z`] of its least-squares σ: a drag cannot feed energy in, so the
+    /// `NEGATIVE_DAMPING_Z` of its least-squares σ: a drag cannot feed energy in, so the
     /// damping stands in for another effect and the row model does not hold
     /// ([`Observability::ModelCheckFailed`]; the answer and its σ stay visible).
     NegativeDamping {

@@ -10,7 +10,7 @@
 //! The prior rows are weighed against the data by the data's own residual scale `s`, so
 //! the stacked factor `R'` gives the posterior covariance `P = s² (R'ᵀR')⁻¹ =
 //! (RᵀR/s² + Σ_p⁻¹)⁻¹` through the same formulas as the data alone
-//! ([`super::uncertainty::noise_sigma`], [`super::observability`]): the prior counts
+//! (`super::uncertainty::noise_sigma`, [`super::observability`]): the prior counts
 //! toward observability, and σ combines data and prior. The rows are added at each solve
 //! to the data's factor, never folded into it: they cost nothing per sample and are not
 //! forgotten under `memory_s`.
@@ -144,7 +144,10 @@ fn reduce(qr: &RecursiveQr, fixed: &[Option<f64>; 6]) -> (RecursiveQr, f64) {
 /// (and no fit) when there is no equality and no prior. The state's `rss` and `weight`
 /// stay the data's, so its residual variance is `s²`.
 #[must_use]
-pub fn augment(qr: &RecursiveQr, constraints: &Constraints) -> (RecursiveQr, Option<PriorFit>) {
+pub(crate) fn augment(
+    qr: &RecursiveQr,
+    constraints: &Constraints,
+) -> (RecursiveQr, Option<PriorFit>) {
     if !applies(constraints) {
         return (*qr, None);
     }
@@ -223,3 +226,6 @@ pub fn augment(qr: &RecursiveQr, constraints: &Constraints) -> (RecursiveQr, Opt
     };
     (out, Some(fit))
 }
+
+#[cfg(all(test, feature = "sim"))]
+mod tests;

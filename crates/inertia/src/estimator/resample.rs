@@ -8,7 +8,7 @@
 //! second of the four nodes, then `q = q_ref exp(r(t))`; rotor momentum, torque and gyro
 //! rate component by component. Output time `t` is produced once the input brackets it
 //! with two nodes on each side; gaps (a step longer than
-//! [`crate::sample::GAP_RATIO`] times the previous) restart the grid after the gap.
+//! `crate::sample::GAP_RATIO` times the previous) restart the grid after the gap.
 //! Streaming, fixed size, no allocation.
 
 use super::InvalidArgument;

@@ -58,7 +58,7 @@ pub struct RotorInertiaConsider {
 impl RotorInertiaConsider {
     /// The consider term per element, `√(Σ_v m_v,k²)`, kg m² ([module docs](self)).
     #[must_use]
-    pub fn consider_kg_m2(&self) -> [f64; 6] {
+    pub(crate) fn consider_kg_m2(&self) -> [f64; 6] {
         core::array::from_fn(|k| {
             self.moves_kg_m2
                 .iter()
@@ -84,7 +84,7 @@ pub enum RotorInertiaError {
 /// rotor, flat) and the wheel-speed time tag `delay_s` the run applied; `solve` runs the
 /// estimator over samples and gives its final answer, and is called first on `samples`
 /// themselves.
-pub fn consider(
+pub(crate) fn consider(
     samples: &[Sample],
     speeds: &[f64],
     spacecraft: &Spacecraft,

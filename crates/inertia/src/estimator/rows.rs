@@ -16,7 +16,7 @@ pub trait RowSource {
     fn push(&mut self, s: &Sample) -> Option<Result<Row, RowError>>;
     /// Forget buffered samples (e.g. across a gap).
     fn reset(&mut self);
-    /// Gaps seen so far ([`crate::sample::is_gap`]).
+    /// Gaps seen so far (`crate::sample::is_gap`).
     fn gaps(&self) -> usize;
 }
 

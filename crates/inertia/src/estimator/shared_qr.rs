@@ -77,7 +77,7 @@ impl RowCounts {
 
 /// `(R, z, ρ²)` over the shared unknowns, and counters.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SharedQr {
+pub(crate) struct SharedQr {
     /// `Rᵀ`: the rows of `R` contiguous, for the reflections
     /// (the crate's `householder` module).
     pub(super) rt: SMatrix<f64, SHARED, SHARED>,
@@ -88,6 +88,7 @@ pub struct SharedQr {
     nuisance: f64,
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl SharedQr {
     /// The empty state; `nuisance` unknowns (the disturbance torque) are counted from the
     /// start.
@@ -253,7 +254,7 @@ impl SharedQr {
     /// The reduced problem in `j`: the trailing 6×6 block, with the nuisance unknowns
     /// counted in [`RecursiveQr::nuisance`].
     #[must_use]
-    pub fn reduced(&self) -> RecursiveQr {
+    pub(crate) fn reduced(&self) -> RecursiveQr {
         RecursiveQr {
             r: Matrix6::from_fn(|i, k| self.rt[(J_SHARED + k, J_SHARED + i)]),
             z: Vector6::from_fn(|i, _| self.z[J_SHARED + i]),
@@ -303,7 +304,7 @@ impl SharedQr {
     /// The three torque unknowns are no longer counted as nuisance. Without forgetting
     /// only (the count of the torque unknowns is not weighted).
     #[must_use]
-    pub fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
+    pub(crate) fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
         const _: () = assert!(Block::BodyTorque.shared_column() == 0, "τ_b leads");
         const REST: usize = SHARED - 3;
         // Rᵀ of the trailing factor, and the torque's rows of R without its columns.

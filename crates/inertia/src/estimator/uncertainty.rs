@@ -38,16 +38,17 @@ pub struct Uncertainty {
     /// (zero unless given, [`Uncertainty::with_rotor_scale`]).
     pub rotor_scale_kg_m2: [f64; 6],
     /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m² (zero
-    /// unless one was estimated, [`Uncertainty::with_time_tag`]).
+    /// unless one was estimated, `Uncertainty::with_time_tag`).
     pub time_tag_kg_m2: [f64; 6],
     /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
-    /// unless given, [`Uncertainty::with_rotor_inertia`]).
+    /// unless given, `Uncertainty::with_rotor_inertia`).
     pub rotor_inertia_kg_m2: [f64; 6],
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
     pub principal_sigma_kg_m2: [f64; 3],
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl Uncertainty {
     /// This σ widened by a relative uncertainty `r` of the rotor momentum's scale (a
     /// consider parameter): the momentum rows are linear in `ρ`, so without a known torque
@@ -75,7 +76,7 @@ impl Uncertainty {
     /// ([`crate::estimator::wheel_delay`]): `√(σ² + c²)`, propagated to the principal
     /// moments of `j` as [`with_bias`] does.
     #[must_use]
-    pub fn with_time_tag(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
+    pub(crate) fn with_time_tag(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
         Uncertainty {
             time_tag_kg_m2: *c,
             ..self.with_consider(j, c)
@@ -86,7 +87,7 @@ impl Uncertainty {
     /// ([`crate::estimator::rotor_inertia`]): `√(σ² + c²)`, propagated to the principal
     /// moments of `j` as [`with_bias`] does.
     #[must_use]
-    pub fn with_rotor_inertia(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
+    pub(crate) fn with_rotor_inertia(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
         Uncertainty {
             rotor_inertia_kg_m2: *c,
             ..self.with_consider(j, c)
@@ -121,7 +122,11 @@ impl Uncertainty {
 /// `σ_LS` per element from singular values `sv` and right singular vectors `v` (columns)
 /// of `R`. `None` without residual degrees of freedom or with a singular `R`.
 #[must_use]
-pub fn noise_sigma(qr: &RecursiveQr, sv: &Vector6<f64>, v: &Matrix6<f64>) -> Option<[f64; 6]> {
+pub(crate) fn noise_sigma(
+    qr: &RecursiveQr,
+    sv: &Vector6<f64>,
+    v: &Matrix6<f64>,
+) -> Option<[f64; 6]> {
     if !(qr.residual_dof() > 0.0 && qr.y_energy > 0.0) || sv.iter().any(|s| !(*s > 0.0)) {
         return None;
     }
@@ -150,7 +155,7 @@ pub fn combine(
 /// Combine a noise part and a bias part per element, `σ = √(noise² + bias²)`, and
 /// propagate to the principal moments of `j`.
 #[must_use]
-pub fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> Uncertainty {
+pub(crate) fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> Uncertainty {
     with_bias_at(
         noise,
         bias,
@@ -161,7 +166,7 @@ pub fn with_bias(noise: &[f64; 6], bias: &[f64; 6], j_full: &InertiaVector) -> U
 /// [`with_bias`] given the eigenpairs of `j` (as the crate's 3×3 eigensolver gives
 /// them), for a caller that has them already.
 #[must_use]
-pub fn with_bias_at(
+pub(crate) fn with_bias_at(
     noise: &[f64; 6],
     bias: &[f64; 6],
     eig: &(Vector3<f64>, [Vector3<f64>; 3]),

@@ -23,7 +23,7 @@
 
 /// Where a block's unknowns live.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Scope {
+pub(crate) enum Scope {
     /// One set per chain of rows, minimised out per chain.
     Chain,
     /// One set for the whole record.
@@ -32,7 +32,7 @@ pub enum Scope {
 
 /// A block of columns of the unknown vector `x`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Block {
+pub(crate) enum Block {
     /// `X₀`: the chain's initial momentum, N m s (plain rows; even Richardson centres).
     Anchor0,
     /// `X₁`: the initial momentum of the odd Richardson centres' subgrid, N m s.
@@ -49,7 +49,7 @@ pub enum Block {
 
 impl Block {
     /// Every block, in column order: per-chain blocks first, `j` last.
-    pub const ALL: [Block; 6] = [
+    pub(crate) const ALL: [Block; 6] = [
         Block::Anchor0,
         Block::Anchor1,
         Block::BodyTorque,
@@ -60,7 +60,7 @@ impl Block {
 
     /// Columns of the block.
     #[must_use]
-    pub const fn width(self) -> usize {
+    pub(crate) const fn width(self) -> usize {
         match self {
             Block::Anchor0 | Block::Anchor1 | Block::BodyTorque => 3,
             Block::Kappa | Block::Damping => 1,
@@ -70,7 +70,7 @@ impl Block {
 
     /// Where its unknowns live.
     #[must_use]
-    pub const fn scope(self) -> Scope {
+    pub(crate) const fn scope(self) -> Scope {
         match self {
             Block::Anchor0 | Block::Anchor1 => Scope::Chain,
             Block::BodyTorque | Block::Kappa | Block::Damping | Block::J => Scope::Shared,
@@ -78,8 +78,9 @@ impl Block {
     }
 
     /// Name for reports.
+    #[cfg(test)]
     #[must_use]
-    pub const fn name(self) -> &'static str {
+    pub(crate) const fn name(self) -> &'static str {
         match self {
             Block::Anchor0 => "initial momentum",
             Block::Anchor1 => "initial momentum (odd subgrid)",
@@ -92,7 +93,7 @@ impl Block {
 
     /// Its first column in `x`.
     #[must_use]
-    pub const fn column(self) -> usize {
+    pub(crate) const fn column(self) -> usize {
         let mut column = 0;
         let mut i = 0;
         while i < Self::ALL.len() {
@@ -107,7 +108,7 @@ impl Block {
 
     /// Its first column among the shared unknowns (a shared block).
     #[must_use]
-    pub const fn shared_column(self) -> usize {
+    pub(crate) const fn shared_column(self) -> usize {
         self.column() - FIRST_SHARED
     }
 }
@@ -129,7 +130,7 @@ const fn total(scope: Option<Scope>) -> usize {
 }
 
 /// Number of unknowns in one row block.
-pub const UNKNOWNS: usize = total(None);
+pub(crate) const UNKNOWNS: usize = total(None);
 /// Number of per-chain unknowns (the first columns).
 pub(crate) const PER_CHAIN: usize = total(Some(Scope::Chain));
 /// Number of shared unknowns (the columns from [`FIRST_SHARED`] on).

@@ -4,7 +4,7 @@
 //! # Why a shift and not a column
 //!
 //! To first order `ρ(t) = ρ_meas(t + δ) ≈ ρ_meas(t) + δ ρ̇(t)`, so `δ` could be one more
-//! unknown of the momentum rows ([`crate::discrete_momentum`]) with the column
+//! unknown of the momentum rows (`discrete_momentum.rs`) with the column
 //! `C_k N(φ_k) ρ̇̄_k`. But wheel speeds are often held between telemetry updates (a
 //! staircase), whose `ρ̇` is a train of spikes: the column must then come from a smoothed
 //! `ρ̇`, and on the lab throw ([`crate::sim::presets`], speed held at 100 Hz, so 5 ms late
@@ -12,7 +12,7 @@
 //! off, against 5e-4 for the same rows with `ρ` read 5 ms later by interpolation: the
 //! estimate leans on the spin-up's corners, where a smoothed `ρ̇` is wrong. So the time
 //! tag is applied exactly, as a shift of the speed telemetry ([`shift_rho`]), and
-//! estimated by profiling ([`estimate`]).
+//! estimated by profiling (`estimate`).
 //!
 //! # The profile
 //!
@@ -22,8 +22,8 @@
 //! with each chain's initial momentum `L̄₀` and a torque fixed in the inertial frame `τ_I`
 //! minimised out per chain ([`crate::estimator::momentum_rows`], "Inertial torque"): a
 //! disturbance of either kind must not pass for a time tag. `δ̂` minimises the residual
-//! sum of squares `RSS(δ)`: on a grid of [`GRID`] steps each side over `±H`,
-//! `H = min(`[`MAX_HALF_RANGE_S`]`, T/10)` with `T` the shortest stretch between gaps (of
+//! sum of squares `RSS(δ)`: on a grid of `GRID` steps each side over `±H`,
+//! `H = min(MAX_HALF_RANGE_S, T/10)` with `T` the shortest stretch between gaps (of
 //! at least 16 samples), then on a fine grid over two steps each side of the best node,
 //! whose least-squares parabola's vertex is `δ̂` (the profile wiggles at the sample
 //! period where the speeds are held; the parabola smooths that). Only the rows of each
@@ -35,10 +35,10 @@
 //! `δ̂`'s standard deviation is the sandwich over time blocks: with `r_k` the rows'
 //! residuals at `δ̂` and `d_k = ∂r_k/∂δ` with `[τ_b; j]` and each chain's unknowns
 //! minimised out (the least-squares residual of the column `d` on the same regressors),
-//! `var δ̂ = B/(B−1) · Σ_b (Σ_{k∈b} d_k r_k)² / (Σ_k d_k²)²` over `B` = [`BLOCKS`]
+//! `var δ̂ = B/(B−1) · Σ_b (Σ_{k∈b} d_k r_k)² / (Σ_k d_k²)²` over `B` = `BLOCKS`
 //! contiguous blocks of rows, so residuals correlated within a block count once. Its
 //! effect on the answer, the consider term, is `|∂ĵ/∂δ| σ_δ` per element, `∂ĵ/∂δ` from
-//! the same fit at `δ̂ ±` one grid step, as `d_k` ([`DelayFit::consider_kg_m2`]).
+//! the same fit at `δ̂ ±` one grid step, as `d_k` (`DelayFit::consider_kg_m2`).
 //!
 //! What σ leaves out: the plain rows' own O(h²) bias (about −50 µs at 10 Hz, within 2σ
 //! on the slew), and the difference between this fit's `∂ĵ/∂δ` and the estimator's.
@@ -52,13 +52,13 @@ use nalgebra::Vector3;
 use std::vec::Vec;
 
 /// Largest time tag searched, s, each side of zero.
-pub const MAX_HALF_RANGE_S: f64 = 0.25;
+pub(crate) const MAX_HALF_RANGE_S: f64 = 0.25;
 
 /// Grid steps each side of zero in the search.
-pub const GRID: usize = 20;
+pub(crate) const GRID: usize = 20;
 
 /// Contiguous blocks of rows in the sandwich σ of `δ̂`.
-pub const BLOCKS: usize = 16;
+pub(crate) const BLOCKS: usize = 16;
 
 /// What the run knows of the wheel-speed telemetry's time tag.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -70,7 +70,7 @@ pub enum WheelDelay {
     Off,
     /// Known: `ρ` telemetered this many seconds late (negative: early).
     KnownS(f64),
-    /// Estimated from the data ([`estimate`]).
+    /// Estimated from the data (`estimate`).
     Estimate,
 }
 
@@ -98,7 +98,7 @@ pub struct DelayFit {
     pub delay_s: f64,
     /// Its standard deviation, s (zero when given).
     pub sigma_s: f64,
-    /// Whether it was estimated ([`estimate`]) or given.
+    /// Whether it was estimated (`estimate`) or given.
     pub estimated: bool,
     /// The half-width of the search, s (zero when given).
     pub half_range_s: f64,
@@ -109,7 +109,7 @@ pub struct DelayFit {
 impl DelayFit {
     /// A time tag the user gave.
     #[must_use]
-    pub fn known(delay_s: f64) -> Self {
+    pub(crate) fn known(delay_s: f64) -> Self {
         Self {
             delay_s,
             sigma_s: 0.0,
@@ -121,7 +121,7 @@ impl DelayFit {
 
     /// The consider term per element, `|∂ĵ/∂δ| σ_δ`, kg m².
     #[must_use]
-    pub fn consider_kg_m2(&self) -> [f64; 6] {
+    pub(crate) fn consider_kg_m2(&self) -> [f64; 6] {
         core::array::from_fn(|k| (self.dj_ds[k] * self.sigma_s).abs())
     }
 }
@@ -291,7 +291,7 @@ fn parabola_vertex(p: &[(f64, f64)]) -> Option<f64> {
 }
 
 /// Estimate the wheel-speed telemetry's time tag from `samples` ([module docs](self)).
-pub fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
+pub(crate) fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
     let n = samples.len();
     if n < 8 {
         return Err(DelayError::NotEstimable("too few samples"));

@@ -226,7 +226,7 @@ impl PipelineConfig {
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum InertialTorque {
-    /// [`InertialTorque::Auto`] on a record shorter than [`SHORT_RECORD_S`], from its
+    /// [`InertialTorque::Auto`] on a record shorter than 30 s (`SHORT_RECORD_S`), from its
     /// first sample, and [`InertialTorque::Off`] once it is longer (default): over a short
     /// record (a thrown device, a test article, a manoeuvre of seconds) a force fixed in
     /// space acts on the whole of one momentum chain, which no chain restart absorbs; over

@@ -121,7 +121,7 @@ pub enum PipelineError {
         quaternions: Verdict,
     },
     /// One step of the attitude jumps against the gyro ([`crate::telemetry::glitch`]),
-    /// and the policy is [`GlitchPolicy::Stop`].
+    /// and the policy is [`crate::telemetry::glitch::GlitchPolicy::Stop`].
     #[error("{glitch} (the step ends at this line; keep glitches to estimate anyway)")]
     AttitudeGlitch {
         /// 0-based index of the input sample that ends the step.

@@ -39,7 +39,7 @@ pub const RECENT: usize = 8;
 
 /// A setting that the first step `dt` (s) of the data shows to be meaningless: a memory
 /// shorter than the sample period (`resample_s` where resampling, else `dt`). Resampling
-/// to more than [`MAX_RESAMPLE_FACTOR`] samples per step the pipeline refuses at every
+/// to more than [`super::MAX_RESAMPLE_FACTOR`] samples per step the pipeline refuses at every
 /// step. For engines that hold no [`Run`] (the C API's caller storage).
 pub fn check_first_step(
     memory_s: Option<f64>,

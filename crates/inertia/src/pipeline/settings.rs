@@ -81,7 +81,7 @@ pub struct PipelineSettings {
     /// (generalised least squares, [`crate::estimator::attitude_drift`]) from the first
     /// answer on, refolded from the first sample (up to an hour at 10 Hz is kept for
     /// that), beside the same rows unweighted; each answer is the weighted one unless
-    /// the unweighted one's bias σ exceeds its noise σ ([`super::Pipeline::drift_weighted`]
+    /// the unweighted one's bias σ exceeds its noise σ (`drift_weighted` in [`super::Diagnostics`]
     /// says which; so it needs `uncertainty`). Twice the work per sample. `None`
     /// (default): unweighted, right for a star tracker or an MEKF, whose attitude error
     /// is bounded.

@@ -8,7 +8,7 @@
 //! from Python's keyword arguments; the command line builds one from the options given.
 //! [`RunDescription::overridden_by`] lays one over another (explicit options over a
 //! file), and [`RunDescription::pipeline_settings`] and [`RunDescription::csv_options`]
-//! turn it into the library's [`PipelineSettings`] and [`CsvOptions`] with their
+//! turn it into the library's [`PipelineSettings`] and [`crate::telemetry::csv::CsvOptions`] with their
 //! documented defaults for what it leaves out. Validation stays with
 //! [`PipelineSettings::validate`]: a description only feeds the same settings.
 //!

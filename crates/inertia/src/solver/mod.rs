@@ -137,10 +137,10 @@ pub trait Backend {
 /// path refuses a triangular solve past it, and the observability test counts the rank
 /// with it. (How *weak* a present direction may be before J counts as undetermined is
 /// the observability test's condition threshold, which the excitation report shares.)
-pub const SINGULAR_RATIO: f64 = 1e-10;
+pub(crate) const SINGULAR_RATIO: f64 = 1e-10;
 
 /// The unconstrained minimiser `R⁻¹ z` of an upper-triangular `R` by back substitution,
-/// or `None` when a pivot is below [`SINGULAR_RATIO`] of the largest.
+/// or `None` when a pivot is below `SINGULAR_RATIO` of the largest.
 #[must_use]
 pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<InertiaVector> {
     let dmax = r.diagonal().amax();

@@ -11,7 +11,7 @@
 //! `m > RELATIVE_FLOOR · |w| + ABSOLUTE_FLOOR_RAD_S` (0.1 and 1e-3 rad/s; so that a gyro-propagated
 //! attitude, whose mismatch is round-off, or the O(h²) remainder at 1 Hz never trip it).
 //! A 1° jump at 10 Hz is a 0.17 rad/s mismatch; a star tracker's 40″ roll noise about
-//! 3e-3 rad/s. Steps across a gap ([`crate::sample::is_gap`]) are not tested. Fixed size,
+//! 3e-3 rad/s. Steps across a gap (`crate::sample::is_gap`) are not tested. Fixed size,
 //! no allocation.
 
 // The crate-internal helpers here serve the std front ends (pipeline, CSV reader).
@@ -72,7 +72,7 @@ pub enum GlitchPolicy {
 }
 
 /// Glitches listed in full; beyond, only counted.
-pub(crate) const LISTED: usize = 16;
+pub const LISTED: usize = 16;
 
 /// The running test ([module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,18 +8,21 @@
 //! The test: the rotor momentum `ρ` changes (as a vector, exactly) at most every other
 //! sample, and the numbers of samples between its changes are one period `P ≥ 2` (or
 //! `P ± 1`, for an update rate that is not a whole fraction of the sample rate) in at
-//! least [`REGULAR`] of at least [`MIN_CHANGES`] changes. Speeds quantised but sampled
+//! least `REGULAR` of at least `MIN_CHANGES` changes. Speeds quantised but sampled
 //! at every sample change at irregular intervals, and constant speeds do not change at
 //! all: neither passes.
 
 use nalgebra::Vector3;
 
 /// Longest update period counted, in samples.
-pub const MAX_PERIOD: usize = 256;
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
+pub(crate) const MAX_PERIOD: usize = 256;
 /// Fewest changes of `ρ` for a verdict.
-pub const MIN_CHANGES: u32 = 10;
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
+pub(crate) const MIN_CHANGES: u32 = 10;
 /// Fraction of the intervals between changes that must be one period (±1 sample).
-pub const REGULAR: f64 = 0.8;
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
+pub(crate) const REGULAR: f64 = 0.8;
 
 /// Counts of the intervals between changes of `ρ`, in samples ([module docs](self)).
 #[derive(Debug, Clone)]
@@ -43,9 +46,10 @@ impl Default for HeldSpeeds {
     }
 }
 
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl HeldSpeeds {
     /// Count the next sample's `ρ`.
-    pub fn push(&mut self, rho_nms: &Vector3<f64>) {
+    pub(crate) fn push(&mut self, rho_nms: &Vector3<f64>) {
         self.since += 1;
         match self.last {
             Some(l) if l == *rho_nms => {}
@@ -67,7 +71,7 @@ impl HeldSpeeds {
     /// The update period in samples when the speeds are held ([module docs](self)),
     /// else `None`.
     #[must_use]
-    pub fn period_samples(&self) -> Option<usize> {
+    pub(crate) fn period_samples(&self) -> Option<usize> {
         if self.changes < MIN_CHANGES {
             return None;
         }

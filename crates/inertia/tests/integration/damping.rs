@@ -82,49 +82,6 @@ fn damping_recovers_the_drag_and_removes_its_bias() {
 }
 
 #[test]
-fn recursive_and_batch_agree_with_damping() {
-    use inertia::estimator::discrete_momentum::reduce_batch;
-    use inertia::estimator::momentum_rows::{MomentumRowSettings, Stencil};
-    // The reductions agree (j, residual, nuisance count, torque test) on a slew with a gap.
-    let slew = Scenario::slew()
-        .simulate(&Common {
-            duration_s: Some(120.0),
-            ..Common::paper()
-        })
-        .expect("simulation");
-    let mut gapped = slew.samples.clone();
-    gapped.retain(|s| !(50.0..60.0).contains(&s.t_s));
-    let out = drag_only(3);
-    for stencil in [Stencil::Plain, Stencil::Adaptive] {
-        let rows = MomentumRowSettings {
-            stencil,
-            damping: true,
-            ..Default::default()
-        };
-        let gaps = super::discrete_momentum::assert_recursive_matches_batch(&gapped, rows, 1e-8);
-        assert_eq!(gaps, 1);
-        // On the throw, D at the true J from both factors, and the drag recovered.
-        let mut e = super::discrete_momentum::estimator(rows);
-        for s in &out.samples {
-            e.push(s).expect("push");
-        }
-        let j = inertia::tensor::j_from_matrix(&out.inertia_kg_m2);
-        let b = reduce_batch(&out.samples, &rows).expect("batch");
-        let (dr, _) = e.damping_at(&j).expect("recursive D");
-        let (db, sb) = b.damping_at(&j).expect("batch D");
-        assert!(
-            (dr - db).abs() <= 1e-6 * db.abs(),
-            "{stencil:?}: {dr:e} vs {db:e}"
-        );
-        let sb = sb.expect("σ");
-        assert!(
-            (db - THROW.damping_nms).abs() <= 3.0 * sb,
-            "{stencil:?}: D = {db:e} ± {sb:e}"
-        );
-    }
-}
-
-#[test]
 fn damping_without_drag_is_zero_within_its_sigma() {
     let mut within = 0;
     for seed in 1..=5 {

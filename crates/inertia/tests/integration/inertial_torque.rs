@@ -10,9 +10,7 @@ use inertia::sim::scenario::Common;
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::Vector3;
 
-use crate::discrete_momentum::{
-    assert_recursive_matches_batch, final_error, slew_for, slew_with_hidden_torque,
-};
+use crate::discrete_momentum::{final_error, slew_with_hidden_torque};
 
 /// The paper's slew with `common`'s noise and a constant torque fixed in the inertial
 /// frame (`C τ_body = τ_I`) acting and left out of the telemetry.
@@ -45,34 +43,6 @@ fn an_unknown_inertial_torque_is_estimated_and_does_not_bias_j() {
         without > 100.0 * with,
         "body torque only: {without:e} vs {with:e}"
     );
-}
-
-/// Problem: the paper's slew with its gyro noise, a one-minute gap and chains of 20 s,
-/// every stencil, the inertial torque unknown. Reference: the dense batch reduction
-/// (one Householder QR per chain with the torques' columns explicit), an independent
-/// path: the same `j` to 1e-8, residual, nuisance count and gaps.
-#[test]
-fn recursive_and_batch_agree_with_an_inertial_torque() {
-    let run = slew_for(120.0, Common::paper());
-    let mut samples = run.samples.clone();
-    samples.retain(|s| !(50.0..110.0).contains(&s.t_s));
-    for stencil in [
-        Stencil::Plain,
-        Stencil::Smooth,
-        Stencil::Held,
-        Stencil::Adaptive,
-    ] {
-        for max_chain_s in [None, Some(20.0)] {
-            let rows = MomentumRowSettings {
-                stencil,
-                max_chain_s,
-                inertial_torque: true,
-                ..Default::default()
-            };
-            let gaps = assert_recursive_matches_batch(&samples, rows, 1e-8);
-            assert_eq!(gaps, 1, "{stencil:?} chain {max_chain_s:?}");
-        }
-    }
 }
 
 /// The pipeline's answer (recursive, and batch) with the inertial torque `mode`: its

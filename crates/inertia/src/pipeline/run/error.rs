@@ -46,7 +46,7 @@ pub enum RunErrorKind {
     TooFewSamples {
         /// The estimator.
         estimator: &'static str,
-        /// Its minimum ([`super::Capabilities::min_samples`]).
+        /// Its minimum ([`crate::pipeline::Capabilities::min_samples`]).
         need: usize,
         /// Samples it saw (after resampling).
         got: usize,

@@ -81,7 +81,7 @@ pub enum TelemetryError {
         /// Extra explanation (may be empty).
         hint: &'static str,
     },
-    /// A value the sample gate refused ([`super::gate`]).
+    /// A value the sample gate refused ([`crate::telemetry::gate`]).
     #[error("{file}:{line}: {} `{}`: {source}", noun(.source), Clipped::new(.column))]
     Sample {
         /// File name.
