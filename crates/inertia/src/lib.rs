@@ -100,6 +100,8 @@ mod householder;
 mod math;
 #[cfg(feature = "std")]
 pub mod pipeline;
+#[cfg(feature = "std")]
+pub mod plan;
 pub mod sample;
 #[cfg(feature = "sim")]
 pub mod sim;
