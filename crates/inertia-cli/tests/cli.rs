@@ -2,6 +2,8 @@
 
 #[path = "cli/bad_inputs.rs"]
 mod bad_inputs;
+#[path = "cli/plan.rs"]
+mod plan;
 #[path = "cli/simulate_options.rs"]
 mod simulate_options;
 #[path = "cli/spacecraft.rs"]

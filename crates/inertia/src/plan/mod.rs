@@ -94,6 +94,23 @@ pub enum PlanError {
     /// A setting is out of range.
     #[error("plan setting `{0}`: {1}")]
     Setting(&'static str, String),
+    /// The spacecraft file lacks a key a plan needs.
+    #[error("{file}: `{key}` is needed to plan a manoeuvre ({why})")]
+    Missing {
+        /// The file.
+        file: String,
+        /// The key.
+        key: String,
+        /// What it gives.
+        why: &'static str,
+    },
+}
+
+/// The largest fraction of a limit a plan uses: 0.9, less where the prior is uncertain
+/// (the rate is `J⁻¹ρ` of the prior J; a J smaller by 3σ turns faster by `1/(1 − 3r)`).
+#[must_use]
+pub fn margin_for(prior_relative_sigma: f64) -> f64 {
+    (1.0 / (1.0 + 3.0 * prior_relative_sigma)).min(0.9)
 }
 
 /// A plan: the commands, the design behind them and the prediction.
@@ -116,6 +133,68 @@ pub struct Plan {
 }
 
 impl Vehicle {
+    /// The vehicle of a spacecraft file: its wheels with `max_torque_nm` and
+    /// `max_momentum_nms`, `[prior]`, `[sensors]` and `[limits]`; `file` names it in
+    /// errors. The prior's σ sets the margin ([`margin_for`]); the rotors' stated σ is
+    /// the consider term. The prior does not inform the prediction (the default
+    /// estimator does not use it).
+    pub fn from_spacecraft(
+        sc: &crate::spacecraft::Spacecraft,
+        file: &str,
+    ) -> Result<Vehicle, PlanError> {
+        let missing = |key: String, why| PlanError::Missing {
+            file: file.into(),
+            key,
+            why,
+        };
+        let mut wheels = Vec::with_capacity(sc.rotors.len());
+        for (i, r) in sc.rotors.iter().enumerate() {
+            wheels.push(Wheel {
+                name: r.name.clone(),
+                axis: nalgebra::Vector3::from(r.axis),
+                max_torque_nm: r.max_torque_nm.ok_or_else(|| {
+                    missing(
+                        std::format!("rotor[{i}].max_torque_nm"),
+                        "the wheel's torque limit",
+                    )
+                })?,
+                max_momentum_nms: r.max_momentum_nms.ok_or_else(|| {
+                    missing(
+                        std::format!("rotor[{i}].max_momentum_nms"),
+                        "the wheel's momentum limit",
+                    )
+                })?,
+            });
+        }
+        let prior = sc
+            .prior
+            .as_ref()
+            .ok_or_else(|| missing("prior".into(), "the prior J and its σ"))?;
+        let sensors = sc
+            .sensors
+            .ok_or_else(|| missing("sensors".into(), "noise densities and rates"))?;
+        let j = Matrix3::from_fn(|r, c| prior.inertia_kg_m2[r][c]);
+        let r = (0..3)
+            .map(|i| prior.sigma_kg_m2[i] / j[(i, i)])
+            .fold(0.0, f64::max);
+        Ok(Vehicle {
+            prior_kg_m2: j,
+            prior_sigma_kg_m2: None,
+            limits: Limits {
+                wheels,
+                max_rate_rad_s: sc.max_rate_deg_s.map(f64::to_radians),
+                margin: margin_for(r),
+            },
+            noise: NoiseModel {
+                gyro_rad_s_rthz: sensors.gyro_noise_deg_s_rthz.to_radians(),
+                wheel_nms: sensors.wheel_noise_nms,
+                telemetry_period_s: 1.0 / sensors.telemetry_hz,
+            },
+            controller_period_s: 1.0 / sensors.controller_hz,
+            rotor_relative_sigma: sc.stated_relative_sigma(),
+        })
+    }
+
     fn validate(&self) -> Result<(), PlanError> {
         self.limits.validate()?;
         let bad = |k, w: &str| Err(PlanError::Setting(k, w.into()));

@@ -186,3 +186,62 @@ pub fn rehearse(
         .map(|seed| fly(v, profile, &v.prior_kg_m2, settings, 0x5EED_0000 + seed))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::limits::{Limits, Wheel};
+    use crate::plan::predict::NoiseModel;
+    use crate::plan::{plan, PlanSettings};
+
+    /// A plan for the peer's small satellite flown on a true J off the prior: the true
+    /// wheel momenta stay within the margin of their limits (the momentum is the
+    /// commands' integral whatever J is), and the final error of every element is within
+    /// 4 predicted σ (information matrix) and within 3 of the σ the estimator reports.
+    #[test]
+    fn a_planned_flight_keeps_the_limits_and_lands_within_its_sigma() {
+        let truth = Matrix3::from_diagonal(&Vector3::new(0.26, 0.26, 0.16));
+        let v = Vehicle {
+            prior_kg_m2: Matrix3::new(
+                0.28, 0.0045, -0.0045, 0.0045, 0.244, 0.0045, -0.0045, 0.0045, 0.168,
+            ),
+            prior_sigma_kg_m2: None,
+            limits: Limits {
+                wheels: (0..3)
+                    .map(|i| Wheel {
+                        name: std::format!("rw{i}"),
+                        axis: Vector3::ith(i, 1.0),
+                        max_torque_nm: 0.01,
+                        max_momentum_nms: 0.046,
+                    })
+                    .collect(),
+                max_rate_rad_s: None,
+                margin: 0.77,
+            },
+            noise: NoiseModel {
+                gyro_rad_s_rthz: 1e-4,
+                wheel_nms: 0.0,
+                telemetry_period_s: 0.1,
+            },
+            controller_period_s: 1.0,
+            rotor_relative_sigma: 0.0,
+        };
+        let p = plan(&v, &PlanSettings::default()).unwrap();
+        assert!(p.limit_use.worst() <= 0.77 + 1e-12, "{:?}", p.limit_use);
+        let fs = FlightSettings {
+            duration_s: p.profile.duration_s(),
+            disturbance_nm_rthz: 1e-8,
+            estimator: PipelineSettings::default(),
+        };
+        let f = fly(&v, &p.profile, &truth, &fs, 7).unwrap();
+        assert!(f.momentum_use <= 0.77 * (1.0 + 1e-9), "{}", f.momentum_use);
+        let sigma = p.prediction.last().unwrap();
+        for k in 0..6 {
+            assert!(
+                f.element_error_kg_m2[k].abs() <= 4.0 * sigma[k],
+                "{k}: {f:?} {sigma:?}"
+            );
+        }
+        assert!(f.covered, "{f:?}");
+    }
+}
