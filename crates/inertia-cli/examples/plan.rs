@@ -28,8 +28,9 @@
 //! or the second argument), solved every 1 s. Time to target: the first estimate whose
 //! reported σ gives `3 σ_F ≤ 1 %` (σ_F with the true ‖J‖). Predicted σ: the
 //! information-matrix σ_F at the plan's end, over the RMS of the final errors over seeds
-//! (the achieved error σ), and the rehearsal's median reported σ_F at the plan's end
-//! over the check flights' median there. Coverage: the fraction of flights whose final
+//! (the achieved error σ), and the rehearsal's median reported σ_F over the check
+//! flights' median, at the plan's end or the rehearsal's (it stops at its target),
+//! whichever is first. Coverage: the fraction of flights whose final
 //! estimate has every element within ±3 reported σ. Saturation: the largest
 //! wheel-momentum use of the true flights and the largest commanded torque use (1 = the
 //! limit).
@@ -246,15 +247,18 @@ fn main() {
             / ok.len().max(1) as f64;
         let rms_f = ms.sqrt() / s.truth.norm();
         // The rehearsal's median reported σ_F at the plan's end against the check flights'.
-        let at = |t: &[f64], x: &[f64]| -> f64 {
+        let at = |t: &[f64], x: &[f64], end: f64| -> f64 {
             t.iter()
                 .zip(x)
                 .rfind(|(t, _)| **t <= end + 1e-9)
                 .map_or(f64::NAN, |(_, x)| *x)
         };
-        let rehearsal_sf = at(&rp.t_s, &rp.median_reported_relative_sigma);
+        // At the plan's end, or the rehearsal's, whichever is first (a rehearsal stops
+        // where its target is met).
+        let end = end.min(rp.t_s.last().copied().unwrap_or(end));
+        let rehearsal_sf = at(&rp.t_s, &rp.median_reported_relative_sigma, end);
         let (ct, cmed, _) = median_reported(&plan_row.flights, TARGET);
-        let check_sf = at(&ct, &cmed);
+        let check_sf = at(&ct, &cmed, end);
         let cov = |r: &Row| {
             r.flights.iter().filter(|f| f.covered).count() as f64 / r.flights.len() as f64
         };

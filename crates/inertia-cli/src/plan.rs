@@ -5,9 +5,8 @@ use crate::args::PlanArgs;
 use crate::error::{input, write_failed, CliError};
 use crate::output::Pending;
 use crate::plot::{figure, register_font, Panel, Series, COLORS};
-use inertia::pipeline::PipelineSettings;
-use inertia::plan::rehearse::FlightSettings;
-use inertia::plan::{plan, plan_full, plan_rehearsed, PlanSettings, Vehicle};
+use inertia::plan::request::{make, Request};
+use inertia::plan::Vehicle;
 use inertia::spacecraft::Spacecraft;
 use inertia::tensor::COMPONENT_NAMES;
 use inertia::text::Num;
@@ -19,46 +18,24 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
     let file = a.spacecraft.display().to_string();
     let sc = Spacecraft::load(&a.spacecraft).map_err(|e| input(e.to_string()))?;
     let v = Vehicle::from_spacecraft(&sc, &file).map_err(input)?;
-    if !(a.target.is_finite() && a.target > 0.0) {
-        return Err(input(format!(
-            "--target {}: must be finite and > 0",
-            Num(a.target)
-        )));
-    }
     if !(a.chain >= 0.0 && a.chain.is_finite()) {
         return Err(input(format!(
             "--chain {}: must be finite and >= 0",
             Num(a.chain)
         )));
     }
-    let chain = (a.chain > 0.0).then_some(a.chain);
-    let settings = PlanSettings {
-        target_relative: a.duration.is_none().then_some(a.target),
-        max_duration_s: a.duration.unwrap_or(a.max_duration),
-        estimator: inertia::plan::EstimatorModel {
-            chain_s: chain,
-            ..Default::default()
-        },
-        ..PlanSettings::default()
-    };
-    let flight = FlightSettings {
-        duration_s: settings.max_duration_s,
+    let request = Request {
+        target_relative: a.target,
+        duration_s: a.duration,
+        max_duration_s: a.max_duration,
+        chain_s: (a.chain > 0.0).then_some(a.chain),
+        rehearsals: a.rehearsals,
         disturbance_nm_rthz: a.disturbance,
-        estimator: PipelineSettings {
-            solve_every: ((1.0 / v.noise.telemetry_period_s).round() as usize).max(1),
-            max_chain_s: chain,
-            ..PipelineSettings::default()
-        },
     };
-    let (plan, rehearsal) = if a.rehearsals > 0 && a.duration.is_none() {
-        let r = plan_rehearsed(&v, &settings, &flight, a.rehearsals).map_err(input)?;
-        let series = (r.t_s.clone(), r.median_reported_relative_sigma.clone());
-        (r.plan, Some((series, r.reported_target_met_s, r.seeds)))
-    } else if a.duration.is_some() {
-        (plan_full(&v, &settings).map_err(input)?, None)
-    } else {
-        (plan(&v, &settings).map_err(input)?, None)
-    };
+    let out = make(&v, &request).map_err(input)?;
+    let plan = out.plan;
+    let rehearsal =
+        (out.rehearsals > 0).then_some((out.rehearsal, out.reported_target_met_s, out.rehearsals));
     let names: Vec<String> = v.limits.wheels.iter().map(|w| w.name.clone()).collect();
     let alloc = v.limits.allocation().map_err(input)?;
     let (pending, mut w) = Pending::create(&a.output)?;

@@ -8,6 +8,7 @@
 //! its JSON text (the `--json` schema), which the Python half turns into an `Estimate`.
 
 mod errors;
+mod plan;
 mod run;
 mod samples;
 mod settings;
@@ -627,5 +628,6 @@ fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimators, m)?)?;
     m.add_function(wrap_pyfunction!(restore, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     Ok(())
 }

@@ -284,7 +284,10 @@ pub fn library_for(
 
 /// The two three-phase trains (triangle and quick ramp) of one doublet per axis that fill
 /// `horizon_s` exactly (period `0.6 horizon`, the lags `0.4 horizon`): the longest build-up
-/// of rate a flight of that length allows.
+/// of rate a rest-to-rest flight of that length allows. (Trains longer than the horizon,
+/// which build rate up beyond it and return to rest after, were tried: the time-share
+/// relaxation assumes every manoeuvre is flown within the horizon, and with them the
+/// planned time to target grew.)
 pub fn trains_for(
     limits: &Limits,
     j: &Matrix3<f64>,
@@ -310,10 +313,12 @@ pub fn design(
     chain_s: Option<f64>,
 ) -> Result<Design, LimitsError> {
     let atoms = library_for(limits, j, period_s, chain_s)?;
-    Ok(design_over(atoms, j, noise, period_s, chain_s))
+    Ok(design_over(atoms, j, noise, period_s, chain_s, None))
 }
 
-/// The A-optimal shares over `atoms` (module docs).
+/// The A-optimal shares over `atoms` (module docs); with a horizon, a manoeuvre longer
+/// than it counts with the information of its first `horizon_s` seconds only (what it
+/// gives by then).
 #[must_use]
 pub fn design_over(
     atoms: Vec<Atom>,
@@ -321,6 +326,7 @@ pub fn design_over(
     noise: &NoiseModel,
     period_s: f64,
     chain_s: Option<f64>,
+    horizon_s: Option<f64>,
 ) -> Design {
     // Each tour alone, the estimator's chains, no torque unknown: information per second.
     let model = EstimatorModel {
@@ -332,7 +338,7 @@ pub fn design_over(
         .iter()
         .map(|a| {
             let p = CommandProfile::new(0.0, period_s, a.commands.clone());
-            let d = p.duration_s();
+            let d = horizon_s.map_or(p.duration_s(), |h| p.duration_s().min(h));
             information(&p, j, noise, &model, d) / d
         })
         .collect();

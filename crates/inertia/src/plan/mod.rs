@@ -31,6 +31,8 @@ pub mod predict;
 pub mod profile;
 #[cfg(feature = "sim")]
 pub mod rehearse;
+#[cfg(feature = "sim")]
+pub mod request;
 
 pub use design::Design;
 pub use limits::{LimitUse, Limits, LimitsError, Wheel};
@@ -269,8 +271,8 @@ pub fn plan_full(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
 }
 
 /// The design for horizon `horizon_s` (the library's manoeuvres that fit in it and the
-/// three-phase trains that fill it), scheduled to `max_duration_s`, with its prediction
-/// (`None` when nothing fits).
+/// three-phase trains made for it, [`design::trains_for`]), scheduled to
+/// `max_duration_s`, with its prediction (`None` when nothing fits).
 pub fn plan_for_horizon(
     v: &Vehicle,
     s: &PlanSettings,
@@ -291,7 +293,7 @@ pub fn plan_for_horizon(
     if atoms.is_empty() {
         return Ok(None);
     }
-    let design = design::design_over(atoms, j, &v.noise, p, s.estimator.chain_s);
+    let design = design::design_over(atoms, j, &v.noise, p, s.estimator.chain_s, Some(horizon_s));
     let (profile, order) = design::schedule(&design, p, s.max_duration_s);
     let prediction = predict::predict(
         &profile,
