@@ -266,7 +266,7 @@ fn main() {
         println!(
             "| {} | plan ({:.0} s) | {} / {} | {} [{:.0}, {:.0}] | {}/{} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.name,
-            end,
+            pl.profile.duration_s(),
             fmt_t(pl.target_met_s.unwrap_or(f64::INFINITY)),
             fmt_t(rp.reported_target_met_s.unwrap_or(f64::INFINITY)),
             fmt_t(plan_row.time),
