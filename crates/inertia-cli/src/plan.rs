@@ -3,7 +3,7 @@
 
 use crate::args::PlanArgs;
 use crate::error::{input, write_failed, CliError};
-use crate::output::Pending;
+use crate::output::{to_stdout, Pending};
 use crate::plot::{figure, register_font, Panel, Series, COLORS};
 use inertia::plan::request::{make, Request};
 use inertia::plan::Vehicle;
@@ -55,6 +55,7 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
         rehearsal.as_ref().map(|r| &r.0),
     )?;
 
+    let mut lines: Vec<String> = Vec::new();
     let shares: Vec<String> = plan
         .design
         .weights
@@ -63,34 +64,38 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
         .filter(|(w, _)| **w > 0.005)
         .map(|(w, m)| format!("{} {} s {:.0} %", m.set, Num(m.doublet_s), w * 100.0))
         .collect();
-    println!(
-        "plan: {} s of wheel torque commands at {} Hz, {} manoeuvres ({}); design horizon {} s, A-optimality gap {:.1e}",
+    lines.push(format!(
+        "plan: {} s of wheel torque commands at {} Hz, {} manoeuvre{} ({}); design horizon {} s, A-optimality gap {:.1e}",
         Num(plan.profile.duration_s()),
         Num(1.0 / v.controller_period_s),
         plan.order.len(),
+        if plan.order.len() == 1 { "" } else { "s" },
         shares.join(", "),
         Num(plan.horizon_s),
         plan.design.gap,
-    );
-    println!(
+    ));
+    lines.push(format!(
         "limits used (margin {:.2}): wheel torque {:.2}, wheel momentum {:.2}, rate {:.2}",
         v.limits.margin, plan.limit_use.torque, plan.limit_use.momentum, plan.limit_use.rate
-    );
+    ));
     let t = |x: Option<f64>| {
         x.map_or("not within the plan".to_string(), |t| {
             format!("{} s", Num(t))
         })
     };
-    println!(
+    lines.push(format!(
         "target 3σ_F ≤ {}: information matrix {}",
         Num(a.target),
-        t(plan.target_met_s)
-    );
+        // With --duration the plan has no target of its own: when the prediction meets it.
+        t(plan
+            .target_met_s
+            .or_else(|| plan.prediction.time_to(a.target)))
+    ));
     if let Some((_, reported, seeds)) = &rehearsal {
-        println!(
+        lines.push(format!(
             "rehearsal (estimator on the prior J, median of {seeds} flights): {}",
             t(*reported)
-        );
+        ));
     }
     if let Some(s) = plan.prediction.last() {
         let parts: Vec<String> = COMPONENT_NAMES
@@ -98,8 +103,12 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
             .zip(s)
             .map(|(n, x)| format!("{n} {x:.2e}"))
             .collect();
-        println!("predicted σ at the end, kg m²: {}", parts.join(", "));
+        lines.push(format!(
+            "predicted σ at the end, kg m²: {}",
+            parts.join(", ")
+        ));
     }
+    to_stdout(|w| lines.iter().try_for_each(|l| writeln!(w, "{l}")))?;
     eprintln!(
         "wrote {}, {} and {} (.svg)",
         a.output.display(),

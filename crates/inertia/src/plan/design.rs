@@ -378,26 +378,26 @@ pub fn design_over(
     }
 }
 
-/// Whole tours in the order that follows the shares (largest deficit first) until
-/// `horizon_s`; returns the commands and, per tour flown, its index and end time.
+/// Whole manoeuvres in the order that follows the shares (largest deficit first), as
+/// many as fit in `horizon_s`; returns the commands and, per manoeuvre flown, its index
+/// and end time.
 #[must_use]
 pub fn schedule(d: &Design, period_s: f64, horizon_s: f64) -> (CommandProfile, Vec<(usize, f64)>) {
     let mut spent = std::vec![0.0; d.atoms.len()];
     let mut t = 0.0;
     let mut cmds = Vec::new();
     let mut order = Vec::new();
-    while t < horizon_s - 1e-9 {
-        let (i, _) = d
-            .weights
-            .iter()
-            .enumerate()
-            .filter(|(_, w)| **w > 1e-3)
-            .map(|(i, w)| {
-                let dur = d.atoms[i].commands.len() as f64 * period_s;
-                (i, w * (t + dur) - spent[i])
-            })
-            .fold((0, f64::NEG_INFINITY), |b, x| if x.1 > b.1 { x } else { b });
-        let dur = d.atoms[i].commands.len() as f64 * period_s;
+    let dur = |i: usize| d.atoms[i].commands.len() as f64 * period_s;
+    // The manoeuvre furthest behind its share, among those that still fit.
+    while let Some((i, _)) = d
+        .weights
+        .iter()
+        .enumerate()
+        .filter(|(i, w)| **w > 1e-3 && t + dur(*i) <= horizon_s + 1e-9)
+        .map(|(i, w)| (i, w * (t + dur(i)) - spent[i]))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+    {
+        let dur = dur(i);
         cmds.extend_from_slice(&d.atoms[i].commands);
         spent[i] += dur;
         t += dur;
@@ -468,7 +468,8 @@ mod tests {
             assert!(phi <= d.objective(&one) * (1.0 + d.gap), "{k}");
         }
         let (p, order) = schedule(&d, 1.0, 300.0);
-        assert!(p.duration_s() >= 300.0);
+        let longest = d.atoms.iter().map(|a| a.commands.len()).max().unwrap() as f64;
+        assert!(p.duration_s() <= 300.0 && p.duration_s() > 300.0 - longest);
         assert_eq!(order.last().unwrap().1, p.duration_s());
     }
 }
