@@ -37,6 +37,42 @@ pub enum Command {
     /// Run a Monte Carlo campaign of a scenario (one seed per run, in parallel) and write
     /// error percentiles (5/50/95 %) over time for each estimator, as CSV and a figure.
     MonteCarlo(MonteCarloArgs),
+    /// Plan the calibration manoeuvre: the wheel torque commands that reach a target σ of
+    /// J soonest within the spacecraft file's limits, with the σ predicted over time
+    /// (CSV) and a figure.
+    Plan(PlanArgs),
+}
+
+/// `inertia plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// The spacecraft file (TOML): rotors with max_torque_nm and max_momentum_nms,
+    /// [prior], [sensors] and optionally [limits] max_rate_deg_s.
+    #[arg(long, value_name = "FILE.toml")]
+    pub spacecraft: PathBuf,
+    /// Target: relative Frobenius error of J at 3σ.
+    #[arg(long, value_name = "REL", default_value_t = 0.01)]
+    pub target: f64,
+    /// Fly this long instead of stopping where the target is met, s.
+    #[arg(long, value_name = "S")]
+    pub duration: Option<f64>,
+    /// Longest plan, s.
+    #[arg(long, value_name = "S", default_value_t = 1800.0)]
+    pub max_duration: f64,
+    /// The estimator's short momentum chain, s (as `estimate --chain`; 0: none).
+    #[arg(long, value_name = "S", default_value_t = inertia::pipeline::DEFAULT_MAX_CHAIN_S)]
+    pub chain: f64,
+    /// Rehearsal flights of the estimator on the prior J (0: the information matrix
+    /// alone decides where the plan stops).
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub rehearsals: u64,
+    /// Unknown white disturbance torque density of the rehearsals, N m/√Hz.
+    #[arg(long, value_name = "NM_RTHZ", default_value_t = 1e-8)]
+    pub disturbance: f64,
+    /// Output: the wheel torque commands (CSV, units in the header). The predicted σ go
+    /// to OUTPUT with `.prediction.csv`, the figure to `.png` and `.svg`.
+    #[arg(short = 'o', long, value_name = "FILE.csv")]
+    pub output: PathBuf,
 }
 
 /// `inertia monte-carlo`.
@@ -122,7 +158,7 @@ pub struct SimulateArgs {
     #[arg(
         long,
         value_enum,
-        required_unless_present = "preset",
+        required_unless_present_any = ["preset", "commands"],
         conflicts_with = "preset"
     )]
     pub scenario: Option<ScenarioArg>,
@@ -253,6 +289,18 @@ pub struct SimulateArgs {
     /// telemetry rate) [default: every sample, or the preset's].
     #[arg(long, value_name = "HZ")]
     pub wheel_hold_hz: Option<f64>,
+    /// Fly these wheel torque commands (an `inertia plan` CSV) from rest instead of the
+    /// scenario's manoeuvres; the duration defaults to the profile's.
+    #[arg(long, value_name = "PLAN.csv", conflicts_with = "scenario")]
+    pub commands: Option<PathBuf>,
+    /// The true inertia of the run, kg m²: J11:J22:J33:J12:J13:J23 (default: the
+    /// scenario's or the preset's).
+    #[arg(
+        long,
+        value_name = "J11:J22:J33:J12:J13:J23",
+        allow_hyphen_values = true
+    )]
+    pub inertia: Option<String>,
     /// A spacecraft file (TOML) whose rotors carry the simulated rotor momentum: the CSV
     /// holds their speed columns instead of rho_*, split among them as a pseudo-inverse
     /// allocator does, with the file's spin inertias as the truth.

@@ -23,6 +23,7 @@ mod estimate;
 mod history;
 mod monte_carlo;
 mod output;
+mod plan;
 mod plot;
 mod reproduce;
 mod runner;
@@ -40,6 +41,7 @@ fn main() -> ExitCode {
         Command::Estimate(a) => estimate::run(a),
         Command::Reproduce(a) => reproduce::run(a),
         Command::MonteCarlo(a) => monte_carlo::run(a),
+        Command::Plan(a) => plan::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,7 +5,9 @@
 //! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
 //! at each sample (ignored by `estimate`, which reads columns by name). With a spacecraft
 //! file (`--spacecraft`), the rotors' speed columns replace `rho_*`
-//! (`inertia::sim::rotors`).
+//! (`inertia::sim::rotors`). With `--commands PLAN.csv` (an `inertia plan` profile) the
+//! spacecraft starts at rest and flies those wheel torque commands instead of the
+//! scenario's manoeuvres, for the profile's length unless `--duration` is given.
 //!
 //! A run is held in memory (at most [`MAX_SAMPLES`] samples, about 0.25 kB each; at most
 //! [`MAX_INTEGRATION_STEPS`] integrator steps) and the
@@ -14,8 +16,9 @@
 
 use crate::args::{AttitudeArg, PresetArg, ScenarioArg, SimulateArgs};
 use crate::config::InertiaFile;
-use crate::error::{input, write_failed, CliError};
+use crate::error::{input, read_failed, write_failed, CliError};
 use crate::output::{is_special, is_stdio, to_stdout, Pending};
+use inertia::plan::CommandProfile;
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
@@ -70,8 +73,12 @@ fn vector(flag: &str, s: &Option<String>) -> Result<Option<Vector3<f64>>, CliErr
         .transpose()
 }
 
-/// The scenario and its settings from the arguments.
-fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
+/// The scenario and its settings from the arguments (`commands_duration`: the length of
+/// a `--commands` profile, the default duration then).
+fn settings(
+    a: &SimulateArgs,
+    commands_duration: Option<f64>,
+) -> Result<(Scenario, Common), CliError> {
     let (sc, mut common) = match (a.preset, a.scenario) {
         (Some(p), _) => {
             let p = match p {
@@ -83,8 +90,18 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
         }
         (None, Some(s)) if a.paper_inertia => (scenario(s), Common::paper()),
         (None, Some(s)) => (scenario(s), Common::physical()),
+        // `--commands`: the scenario only carries the settings; the commands fly.
+        (None, None) if a.commands.is_some() => (Scenario::slew(), Common::physical()),
         (None, None) => return Err(input("one of --scenario and --preset is required")),
     };
+    if let Some(j) = &a.inertia {
+        let v = numbers("--inertia", j, 6)?;
+        common.inertia_kg_m2 = nalgebra::Matrix3::new(
+            v[0], v[3], v[4], //
+            v[3], v[1], v[5], //
+            v[4], v[5], v[2],
+        );
+    }
     if let Some(d) = a.duration {
         if !(d.is_finite() && d > 0.0) {
             return Err(input(format!(
@@ -125,7 +142,7 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
         common.substeps = ((dt / 0.005).round() as usize).max(1);
     }
     common.dt_s = dt;
-    common.duration_s = a.duration;
+    common.duration_s = a.duration.or(commands_duration);
     common.seed = a.seed;
     if let Some(d) = a.disturbance {
         common.disturbance_nm_rthz = d;
@@ -149,7 +166,10 @@ fn settings(a: &SimulateArgs) -> Result<(Scenario, Common), CliError> {
         r.telemetry_every = every as usize;
     }
     let period = dt * r.telemetry_every as f64;
-    let duration = a.duration.unwrap_or_else(|| sc.default_duration_s());
+    let duration = a
+        .duration
+        .or(commands_duration)
+        .unwrap_or_else(|| sc.default_duration_s());
     if SimConfig::samples_for(duration, period) > MAX_SAMPLES {
         return Err(input(format!(
             "--duration {}: more than {MAX_SAMPLES} samples at the telemetry period {} s (a run is held in memory); at most {} s",
@@ -288,7 +308,22 @@ fn write_csv(w: &mut dyn Write, out: &SimOutput, speeds: Option<&Speeds>) -> std
 
 /// Run the command.
 pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
-    let (sc, common) = settings(a)?;
+    let commands = a
+        .commands
+        .as_deref()
+        .map(|p| -> Result<CommandProfile, CliError> {
+            let text = std::fs::read_to_string(p).map_err(|e| read_failed(p, e))?;
+            CommandProfile::parse_csv(&text, &p.display().to_string()).map_err(input)
+        })
+        .transpose()?;
+    let (sc, mut common) = settings(a, commands.as_ref().map(CommandProfile::duration_s))?;
+    if let Some(p) = &commands {
+        // The simulator splits its steps at the commands' ticks.
+        common
+            .realism
+            .commands
+            .get_or_insert(CommandHold::at(1.0 / p.period_s));
+    }
     let spacecraft = a
         .spacecraft
         .as_deref()
@@ -303,7 +338,19 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     let truth = (!stdout && !special)
         .then(|| Pending::create(&truth_file))
         .transpose()?;
-    let out = sc.simulate(&common).map_err(sim_error)?;
+    let out = match &commands {
+        None => sc.simulate(&common).map_err(sim_error)?,
+        Some(p) => {
+            // From rest, the wheels at zero momentum, the commands as the wheel torque.
+            let mut cfg = sc.config(&common);
+            cfg.initial = inertia::dynamics::GyrostatState {
+                q: inertia::attitude::Quaternion::IDENTITY,
+                omega_rad_s: Vector3::zeros(),
+                rho_nms: Vector3::zeros(),
+            };
+            inertia::sim::simulate(&cfg, p, &inertia::sim::Zero).map_err(sim_error)?
+        }
+    };
     let speeds = spacecraft
         .map(|s| -> Result<Speeds, CliError> {
             let v = inertia::sim::rotors::speeds(&out.samples, &s).map_err(sim_error)?;
@@ -333,11 +380,18 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
     eprintln!(
         "wrote {} samples ({} scenario, h = {} s) to {written}",
         out.samples.len(),
-        a.preset.map_or(sc.name(), |p| match p {
-            PresetArg::SmallSat => "small-sat",
-            PresetArg::Microsat => "microsat",
-            PresetArg::Throw => "throw",
-        }),
+        a.preset.map_or(
+            if commands.is_some() {
+                "commands"
+            } else {
+                sc.name()
+            },
+            |p| match p {
+                PresetArg::SmallSat => "small-sat",
+                PresetArg::Microsat => "microsat",
+                PresetArg::Throw => "throw",
+            }
+        ),
         Num(common.dt_s * common.realism.telemetry_every as f64),
     );
     Ok(())

@@ -2,6 +2,8 @@
 
 #[path = "cli/bad_inputs.rs"]
 mod bad_inputs;
+#[path = "cli/plan.rs"]
+mod plan;
 #[path = "cli/settings_file.rs"]
 mod settings_file;
 #[path = "cli/simulate_options.rs"]

@@ -9,6 +9,7 @@
 
 mod errors;
 mod kwargs;
+mod plan;
 mod run;
 mod samples;
 mod settings;
@@ -623,5 +624,6 @@ fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimators, m)?)?;
     m.add_function(wrap_pyfunction!(restore, m)?)?;
     m.add_function(wrap_pyfunction!(sim::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan, m)?)?;
     Ok(())
 }

@@ -102,6 +102,8 @@ mod householder;
 mod math;
 #[cfg(feature = "std")]
 pub mod pipeline;
+#[cfg(feature = "std")]
+pub mod plan;
 #[cfg(feature = "serde")]
 pub mod run_description;
 pub mod sample;

@@ -20,6 +20,25 @@
 //! spin_axis_sigma_deg = 0.5           # 1σ tilt of the axis, each way (default 0)
 //! speed_column = "rw1_speed"          # the telemetry column of its speed
 //! speed_unit = "rpm"                  # rad/s (default), rpm or deg/s
+//! max_torque_nm = 0.01                # motor torque limit (optional; `plan` needs it)
+//! max_momentum_nms = 0.046            # momentum limit: speed limit × spin inertia (same)
+//! ```
+//!
+//! `inertia plan` ([`crate::plan`]) needs three more tables, optional otherwise:
+//!
+//! ```toml
+//! [prior]                             # what is known of J before the manoeuvre
+//! inertia_kg_m2 = [[0.28, 0.005, -0.005], [0.005, 0.245, 0.005], [-0.005, 0.005, 0.168]]
+//! relative_sigma = 0.1                # 1σ of every element, relative to the largest
+//!                                     # moment (or sigma_kg_m2 = [six values, order J11,
+//!                                     # J22, J33, J12, J13, J23])
+//! [sensors]
+//! gyro_noise_deg_s_rthz = 0.0057      # gyro rate noise density
+//! wheel_noise_nms = 0.0               # wheel momentum telemetry noise per sample (default 0)
+//! telemetry_hz = 10.0                 # telemetry rate
+//! controller_hz = 1.0                 # wheel command rate (a whole fraction of it)
+//! [limits]
+//! max_rate_deg_s = 5.0                # body rate limit (optional)
 //! ```
 //!
 //! # Convention
@@ -54,6 +73,30 @@ use std::string::String;
 #[cfg(feature = "spacecraft")]
 use std::string::ToString;
 use std::vec::Vec;
+
+/// What is known of J before a manoeuvre (`[prior]`).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Prior {
+    /// Prior inertia, kg m², symmetric positive definite.
+    pub inertia_kg_m2: [[f64; 3]; 3],
+    /// 1σ per element, kg m² (order of eq. 48).
+    pub sigma_kg_m2: [f64; 6],
+}
+
+/// Sensor noise and rates (`[sensors]`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Sensors {
+    /// Gyro rate noise density, deg/s/√Hz.
+    pub gyro_noise_deg_s_rthz: f64,
+    /// Wheel-momentum telemetry noise per sample, N m s.
+    pub wheel_noise_nms: f64,
+    /// Telemetry rate, Hz.
+    pub telemetry_hz: f64,
+    /// Wheel command rate, Hz.
+    pub controller_hz: f64,
+}
 
 /// The most rotors a spacecraft file may list.
 pub const MAX_ROTORS: usize = 16;
@@ -137,6 +180,10 @@ pub struct Rotor {
     pub speed_column: String,
     /// The unit of that column.
     pub speed_unit: SpeedUnit,
+    /// Motor torque limit, N m (`None`: not given).
+    pub max_torque_nm: Option<f64>,
+    /// Momentum limit, N m s (`None`: not given).
+    pub max_momentum_nms: Option<f64>,
 }
 
 impl Rotor {
@@ -172,6 +219,12 @@ pub struct Spacecraft {
     pub rotors: Vec<Rotor>,
     /// How their spin-inertia errors are related.
     pub rotor_errors: RotorErrors,
+    /// The prior J (`[prior]`), if given.
+    pub prior: Option<Prior>,
+    /// Sensor noise and rates (`[sensors]`), if given.
+    pub sensors: Option<Sensors>,
+    /// Body rate limit, deg/s (`[limits] max_rate_deg_s`), if given.
+    pub max_rate_deg_s: Option<f64>,
 }
 
 /// A spacecraft file that cannot be used: the file, the line (where the problem has
@@ -197,6 +250,42 @@ struct RawFile {
     rotor_errors: Option<toml::Spanned<String>>,
     #[serde(default, rename = "rotor")]
     rotors: Vec<toml::Spanned<RawRotor>>,
+    #[serde(default)]
+    prior: Option<toml::Spanned<RawPrior>>,
+    #[serde(default)]
+    sensors: Option<toml::Spanned<RawSensors>>,
+    #[serde(default)]
+    limits: Option<toml::Spanned<RawLimits>>,
+}
+
+#[cfg(feature = "spacecraft")]
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPrior {
+    inertia_kg_m2: toml::Spanned<[[f64; 3]; 3]>,
+    #[serde(default)]
+    sigma_kg_m2: Option<toml::Spanned<[f64; 6]>>,
+    #[serde(default)]
+    relative_sigma: Option<toml::Spanned<f64>>,
+}
+
+#[cfg(feature = "spacecraft")]
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSensors {
+    gyro_noise_deg_s_rthz: toml::Spanned<f64>,
+    #[serde(default)]
+    wheel_noise_nms: Option<toml::Spanned<f64>>,
+    telemetry_hz: toml::Spanned<f64>,
+    controller_hz: toml::Spanned<f64>,
+}
+
+#[cfg(feature = "spacecraft")]
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLimits {
+    #[serde(default)]
+    max_rate_deg_s: Option<toml::Spanned<f64>>,
 }
 
 #[cfg(feature = "spacecraft")]
@@ -213,6 +302,10 @@ struct RawRotor {
     speed_column: toml::Spanned<String>,
     #[serde(default)]
     speed_unit: Option<toml::Spanned<String>>,
+    #[serde(default)]
+    max_torque_nm: Option<toml::Spanned<f64>>,
+    #[serde(default)]
+    max_momentum_nms: Option<toml::Spanned<f64>>,
 }
 
 impl Spacecraft {
@@ -380,6 +473,17 @@ impl Spacecraft {
                     format!("rotor[{other}] reads the same column"),
                 ));
             }
+            let positive = |v: &Option<toml::Spanned<f64>>, k: &str| match v {
+                None => Ok(None),
+                Some(x) if x.get_ref().is_finite() && *x.get_ref() > 0.0 => Ok(Some(*x.get_ref())),
+                Some(x) => Err(err(
+                    Some(x.span()),
+                    key(k),
+                    format!("{} must be finite and > 0", crate::text::Num(*x.get_ref())),
+                )),
+            };
+            let max_torque_nm = positive(&r.max_torque_nm, "max_torque_nm")?;
+            let max_momentum_nms = positive(&r.max_momentum_nms, "max_momentum_nms")?;
             rotors.push(Rotor {
                 name,
                 axis: (Vector3::from(axis) / norm).into(),
@@ -388,11 +492,124 @@ impl Spacecraft {
                 spin_axis_sigma_deg: tilt,
                 speed_column,
                 speed_unit,
+                max_torque_nm,
+                max_momentum_nms,
             });
         }
+        let positive = |v: &toml::Spanned<f64>, k: &str, zero_ok: bool| {
+            let x = *v.get_ref();
+            if x.is_finite() && (x > 0.0 || (zero_ok && x == 0.0)) {
+                Ok(x)
+            } else {
+                Err(err(
+                    Some(v.span()),
+                    Some(k.into()),
+                    format!(
+                        "{} must be finite and {}",
+                        crate::text::Num(x),
+                        if zero_ok { ">= 0" } else { "> 0" }
+                    ),
+                ))
+            }
+        };
+        let prior = match &raw.prior {
+            None => None,
+            Some(p) => {
+                let p = p.get_ref();
+                let m = *p.inertia_kg_m2.get_ref();
+                let mat = nalgebra::Matrix3::from_fn(|r, c| m[r][c]);
+                let asym = (mat - mat.transpose()).norm();
+                if !mat.iter().all(|x| x.is_finite())
+                    || asym > 1e-9 * mat.norm()
+                    || mat.cholesky().is_none()
+                {
+                    return Err(err(
+                        Some(p.inertia_kg_m2.span()),
+                        Some("prior.inertia_kg_m2".into()),
+                        "must be a symmetric positive definite 3 × 3 matrix, kg m²".into(),
+                    ));
+                }
+                let sigma = match (&p.sigma_kg_m2, &p.relative_sigma) {
+                    (Some(_), Some(r)) => {
+                        return Err(err(
+                            Some(r.span()),
+                            Some("prior.relative_sigma".into()),
+                            "give sigma_kg_m2 or relative_sigma, not both".into(),
+                        ))
+                    }
+                    (Some(v), None) => {
+                        let a = *v.get_ref();
+                        if !a.iter().all(|x| x.is_finite() && *x > 0.0) {
+                            return Err(err(
+                                Some(v.span()),
+                                Some("prior.sigma_kg_m2".into()),
+                                "six finite values > 0, kg m² (J11, J22, J33, J12, J13, J23)"
+                                    .into(),
+                            ));
+                        }
+                        a
+                    }
+                    (None, Some(r)) => {
+                        let x = positive(r, "prior.relative_sigma", false)?;
+                        [x * mat.diagonal().max(); 6]
+                    }
+                    (None, None) => {
+                        return Err(err(
+                            Some(p.inertia_kg_m2.span()),
+                            Some("prior".into()),
+                            "needs its σ: sigma_kg_m2 or relative_sigma".into(),
+                        ))
+                    }
+                };
+                Some(Prior {
+                    inertia_kg_m2: m,
+                    sigma_kg_m2: sigma,
+                })
+            }
+        };
+        let sensors = match &raw.sensors {
+            None => None,
+            Some(v) => {
+                let v = v.get_ref();
+                let telemetry_hz = positive(&v.telemetry_hz, "sensors.telemetry_hz", false)?;
+                let controller_hz = positive(&v.controller_hz, "sensors.controller_hz", false)?;
+                let ratio = telemetry_hz / controller_hz;
+                if (ratio - ratio.round()).abs() > 1e-9 * ratio || ratio.round() < 1.0 {
+                    return Err(err(
+                        Some(v.controller_hz.span()),
+                        Some("sensors.controller_hz".into()),
+                        "must divide telemetry_hz a whole number of times".into(),
+                    ));
+                }
+                Some(Sensors {
+                    gyro_noise_deg_s_rthz: positive(
+                        &v.gyro_noise_deg_s_rthz,
+                        "sensors.gyro_noise_deg_s_rthz",
+                        true,
+                    )?,
+                    wheel_noise_nms: match &v.wheel_noise_nms {
+                        None => 0.0,
+                        Some(w) => positive(w, "sensors.wheel_noise_nms", true)?,
+                    },
+                    telemetry_hz,
+                    controller_hz,
+                })
+            }
+        };
+        let max_rate_deg_s = match raw
+            .limits
+            .as_ref()
+            .and_then(|l| l.get_ref().max_rate_deg_s.as_ref())
+        {
+            None => None,
+            Some(r) => Some(positive(r, "limits.max_rate_deg_s", false)?),
+        };
         Ok(Spacecraft {
             rotors,
             rotor_errors,
+            prior,
+            sensors,
+            max_rate_deg_s,
         })
     }
 

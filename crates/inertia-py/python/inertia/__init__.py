@@ -53,6 +53,7 @@ __all__ = [
     "Telemetry",
     "estimate",
     "estimators",
+    "plan",
     "read_csv",
     "simulate",
 ]
@@ -772,3 +773,40 @@ def simulate(scenario: Optional[str] = None, **options: Any) -> Simulation:
         kwargs["scenario"] = scenario
     tel, end, start, name, positions = _inertia.simulate(kwargs=kwargs)
     return Simulation(Telemetry(tel), end, start, name, positions)
+
+
+def plan(
+    spacecraft: Union[str, "os.PathLike[str]"],
+    target: float = 0.01,
+    duration: Optional[float] = None,
+    max_duration: float = 1800.0,
+    chain: Optional[float] = 30.0,
+    rehearsals: int = 8,
+    disturbance: float = 1e-8,
+) -> Dict[str, Any]:
+    """Plan the calibration manoeuvre as ``inertia plan`` does (book, "Planning the
+    calibration manoeuvre").
+
+    ``spacecraft`` is a spacecraft file whose rotors carry ``max_torque_nm`` and
+    ``max_momentum_nms``, with ``[prior]``, ``[sensors]`` and optionally ``[limits]``.
+    ``target`` is the relative Frobenius error at 3σ; ``duration`` (s) flies that long
+    instead; ``chain`` is the estimator's short momentum chain (s, ``None``: none);
+    ``rehearsals`` flights of the estimator on the prior J decide, with the information
+    matrix, where the plan stops (0: the information matrix alone).
+
+    Returns a dict: ``t`` (N,) command times, s; ``period_s``; ``rho_dot_nm`` (N, 3) the
+    body-axis wheel torque commands, N m, each held for ``period_s``; ``wheels`` (names)
+    and ``wheel_torque_nm`` (N lists, one torque per wheel, N m); ``prediction_t`` (K,),
+    ``sigma_kg_m2`` (K, 6) the predicted σ per element (J11, J22, J33, J12, J13, J23) and
+    ``relative_sigma`` (K,) the relative Frobenius σ; ``target_met_s`` (information
+    matrix) and ``reported_target_met_s`` (rehearsal), s or None; ``rehearsal_t`` and
+    ``rehearsal_relative_sigma`` (the median σ the estimator reported); ``margin``,
+    ``limit_use`` (``torque``, ``momentum``, ``rate``: the largest fraction of each limit
+    used) and ``gap`` (the A-optimality gap of the design). Raises ``ValueError`` naming
+    the file and key for a file that lacks what a plan needs.
+    """
+    return _inertia.plan(
+        os.fspath(spacecraft), float(target),
+        None if duration is None else float(duration), float(max_duration),
+        None if chain is None else float(chain), int(rehearsals), float(disturbance),
+    )

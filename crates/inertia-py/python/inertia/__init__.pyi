@@ -211,3 +211,13 @@ class Simulation:
     def __iter__(self) -> Iterator[Any]: ...
 
 def simulate(scenario: Optional[str] = ..., **options: Any) -> Simulation: ...
+
+def plan(
+    spacecraft: Union[str, "os.PathLike[str]"],
+    target: float = ...,
+    duration: Optional[float] = ...,
+    max_duration: float = ...,
+    chain: Optional[float] = ...,
+    rehearsals: int = ...,
+    disturbance: float = ...,
+) -> Dict[str, Any]: ...

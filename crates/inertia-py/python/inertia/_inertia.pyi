@@ -60,3 +60,12 @@ def estimators() -> List[Tuple[str, str]]: ...
 def simulate(
     kwargs: Optional[Dict[str, Any]] = ...,
 ) -> Tuple[Telemetry, np.ndarray, np.ndarray, str, Optional[np.ndarray]]: ...
+def plan(
+    spacecraft: str,
+    target: float,
+    duration: Optional[float],
+    max_duration: float,
+    chain: Optional[float],
+    rehearsals: int,
+    disturbance: float,
+) -> Dict[str, Any]: ...

@@ -37,9 +37,12 @@ pub fn pyramid(
                 spin_axis_sigma_deg: 0.0,
                 speed_column: std::format!("rw{}_rpm", i + 1),
                 speed_unit: SpeedUnit::Rpm,
+                max_torque_nm: None,
+                max_momentum_nms: None,
             })
             .collect(),
         rotor_errors: errors,
+        ..Spacecraft::default()
     }
 }
 

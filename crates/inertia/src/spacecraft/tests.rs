@@ -106,3 +106,91 @@ fn a_missing_file_is_named() {
     let e = Spacecraft::load(std::path::Path::new("/nonexistent/sc.toml")).unwrap_err();
     assert!(e.to_string().starts_with("/nonexistent/sc.toml:"), "{e}");
 }
+
+const PLANNABLE: &str = r#"
+[[rotor]]
+name = "rw1"
+axis = [1.0, 0.0, 0.0]
+spin_inertia_kg_m2 = 1.0e-4
+speed_column = "rw1_speed"
+max_torque_nm = 0.01
+max_momentum_nms = 0.046
+
+[prior]
+inertia_kg_m2 = [[0.28, 0.005, 0.0], [0.005, 0.245, 0.0], [0.0, 0.0, 0.17]]
+relative_sigma = 0.1
+
+[sensors]
+gyro_noise_deg_s_rthz = 0.0057
+telemetry_hz = 10.0
+controller_hz = 1.0
+
+[limits]
+max_rate_deg_s = 5.0
+"#;
+
+#[test]
+fn the_plan_keys_are_read() {
+    let s = Spacecraft::parse(PLANNABLE, "sc.toml").unwrap();
+    assert_eq!(s.rotors[0].max_torque_nm, Some(0.01));
+    assert_eq!(s.rotors[0].max_momentum_nms, Some(0.046));
+    let p = s.prior.unwrap();
+    assert_eq!(p.inertia_kg_m2[0][1], 0.005);
+    // Relative σ of the largest moment, for every element.
+    assert!((p.sigma_kg_m2[4] - 0.028).abs() < 1e-15);
+    let v = s.sensors.unwrap();
+    assert_eq!(
+        (v.telemetry_hz, v.controller_hz, v.wheel_noise_nms),
+        (10.0, 1.0, 0.0)
+    );
+    assert_eq!(s.max_rate_deg_s, Some(5.0));
+    // The files without them read as before.
+    let g = Spacecraft::parse(GOOD, "sc.toml").unwrap();
+    assert!(g.prior.is_none() && g.sensors.is_none() && g.max_rate_deg_s.is_none());
+    assert_eq!(g.rotors[0].max_torque_nm, None);
+}
+
+#[test]
+fn bad_plan_keys_are_refused_with_line_and_key() {
+    let cases = [
+        (
+            "max_torque_nm = 0.01",
+            "max_torque_nm = -1",
+            7,
+            "rotor[0].max_torque_nm",
+        ),
+        (
+            "[[0.28, 0.005, 0.0], [0.005, 0.245, 0.0], [0.0, 0.0, 0.17]]",
+            "[[0.28, 0.5, 0.0], [0.005, 0.245, 0.0], [0.0, 0.0, 0.17]]",
+            11,
+            "prior.inertia_kg_m2",
+        ),
+        (
+            "controller_hz = 1.0",
+            "controller_hz = 3.0",
+            17,
+            "sensors.controller_hz",
+        ),
+        (
+            "telemetry_hz = 10.0",
+            "telemetry_hz = 0",
+            16,
+            "sensors.telemetry_hz",
+        ),
+        (
+            "max_rate_deg_s = 5.0",
+            "max_rate_deg_s = nan",
+            20,
+            "limits.max_rate_deg_s",
+        ),
+        ("relative_sigma = 0.1", "", 11, "prior"),
+    ];
+    for (from, to, line, key) in cases {
+        let text = PLANNABLE.replace(from, to);
+        let e = Spacecraft::parse(&text, "sc.toml").unwrap_err();
+        assert_eq!(e.line, Some(line), "{key}: {e}");
+        assert_eq!(e.key.as_deref(), Some(key), "{e}");
+    }
+    let e = Spacecraft::parse(&PLANNABLE.replace("[limits]", "[limitz]"), "sc.toml").unwrap_err();
+    assert!(e.to_string().contains("limitz"), "{e}");
+}
