@@ -16,6 +16,7 @@ pub(crate) mod audit;
 pub(crate) mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
+pub(crate) mod chain_clock;
 pub mod compensation;
 pub mod consistency;
 pub mod discrete_momentum;

@@ -1,0 +1,321 @@
+//! The discrete momentum rows of all samples at once (paper eq. 57's batch form for the
+//! momentum rows): a dense Householder QR per chain over the columns the rows use, the
+//! chain's initial momenta minimised out, then once over the stacked shared rows; with
+//! the delete-a-group jackknife over chains or time blocks ([`crate::estimator::jackknife`]),
+//! the state with the body torque held at zero ([`super::torque_tested`]) and the
+//! damping's row. Independent of the recursive path: the two must agree.
+
+use super::*;
+use crate::estimator as est;
+
+/// The batch reduction: the reduced problem in `j` and what goes with it.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct BatchReduction {
+    /// The reduced least-squares state in `j`.
+    pub(crate) qr: RecursiveQr,
+    /// Gaps in the time stamps.
+    pub(crate) gaps: usize,
+    /// The delete-a-group jackknife σ per element over the chains
+    /// ([`crate::estimator::jackknife`]), kg m²; `None` with too few chains.
+    pub(crate) jackknife_sigma_kg_m2: Option<[f64; 6]>,
+    /// The reduced state with the disturbance torque held at zero, and the growth of `ρ²`
+    /// that costs ([`torque_tested`]); `None` when the torque is not estimated.
+    pub(crate) without_torque: Option<(RecursiveQr, f64)>,
+    /// The damping's row of the shared factor, where the rows estimate one.
+    pub(crate) damping: Option<DampingRow>,
+}
+
+#[cfg(test)]
+impl BatchReduction {
+    /// The damping `D` (N m s) that fits best at `j`, with its least-squares σ, where the
+    /// rows estimate one.
+    #[must_use]
+    pub(crate) fn damping_at(&self, j: &InertiaVector) -> Option<(f64, Option<f64>)> {
+        self.damping.map(|d| d.at(j))
+    }
+}
+
+/// The damping's row of an upper-triangular factor over the shared unknowns, `j` last:
+/// `r_dd D + r_dj·j = z_d` once the unknowns after it are fixed, and its least-squares σ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct DampingRow {
+    r_dd: f64,
+    r_dj: nalgebra::Vector6<f64>,
+    z_d: f64,
+    sigma_nms: Option<f64>,
+}
+
+impl DampingRow {
+    /// `D` at `j` with its σ (the unknowns between `D` and `j` are none: `D` is the last
+    /// before `j`, [`crate::estimator::unknowns::Block::ALL`]).
+    #[must_use]
+    pub(crate) fn at(&self, j: &InertiaVector) -> (f64, Option<f64>) {
+        ((self.z_d - self.r_dj.dot(j)) / self.r_dd, self.sigma_nms)
+    }
+}
+
+/// The reduced least-squares state of all samples at once, by dense Householder QR: per
+/// chain over `[X₀ X₁ τ_b κ j]` (the columns the rows use), keeping the rows free of the chain's initial momenta, then
+/// once over the stacked `[τ_b j]` rows of every chain (and, for the jackknife, of every
+/// chain but one group's).
+pub(crate) fn reduce_batch(
+    samples: &[Sample],
+    settings: &MomentumRowSettings,
+) -> Result<BatchReduction, EstimatorError> {
+    use est::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
+    use est::momentum_rows::J;
+    use est::unknowns::FIRST_SHARED;
+    use nalgebra::{DMatrix, DVector};
+    if samples.len() < est::MIN_SAMPLES {
+        return Err(EstimatorError::TooFewSamples {
+            need: est::MIN_SAMPLES,
+            got: samples.len(),
+        });
+    }
+    let mut source = MomentumRows::new(*settings);
+    let mut clock = ChainClock::new(settings.max_chain_s);
+    use std::{vec, vec::Vec};
+    let mut chains: Vec<Vec<AugmentedRow>> = vec![Vec::new()];
+    let mut epoch = 0;
+    for (i, s) in samples.iter().enumerate() {
+        let row = source
+            .push(s)
+            .map_err(|source| EstimatorError::Row { sample: i, source })?;
+        if let Some(row) = row {
+            let e = clock.epoch(&source);
+            if e != epoch {
+                epoch = e;
+                chains.push(Vec::new());
+            }
+            if let Some(c) = chains.last_mut() {
+                c.push(row);
+            }
+        }
+    }
+    chains.retain(|c| !c.is_empty());
+    // Householder QR of an m×n system (zero-padded to at least n rows): (R, Qᵀy, ‖y‖²).
+    let factor = |a: DMatrix<f64>, y: DVector<f64>| {
+        let (m, n) = a.shape();
+        let rows = m.max(n);
+        let a = a.resize_vertically(rows, 0.0);
+        let y = y.resize_vertically(rows, 0.0);
+        let energy = y.norm_squared();
+        let qr = a.qr();
+        let qty = qr.q().transpose() * &y;
+        (qr.r(), qty.rows(0, n).into_owned(), energy)
+    };
+    // Only the columns the rows use: a zero column would leave its row of R holding
+    // information about the others, which dropping that row would lose. The shared
+    // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
+    // initial momenta chain by chain (a short Richardson chain may use only X₀).
+    let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
+    let shared_columns: Vec<usize> = (FIRST_SHARED..J)
+        .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
+        .chain(J..J + 6)
+        .collect();
+    let shared = shared_columns.len();
+    // A chain's rows (those given) free of its initial momenta, in the shared unknowns:
+    // (rows of R, Qᵀy), and the chain's (rss, ‖y‖², scalar rows).
+    let reduce_chain = |chain: &[&AugmentedRow]| {
+        // The initial momenta the chain uses, then (with an inertial torque) each one's
+        // torque, whose column is the initial momentum's times the block's `s`
+        // ([`crate::estimator::momentum_rows`], "Inertial torque"), then the shared unknowns.
+        let used: Vec<usize> = (0..settings.anchors_per_chain())
+            .filter(|&k| chain.iter().any(|r| uses(r, k)))
+            .collect();
+        let trends = if settings.inertial_torque {
+            used.len()
+        } else {
+            0
+        };
+        let anchors = used.len() + trends;
+        let m = 3 * chain.len();
+        let columns = anchors + shared;
+        let a = DMatrix::from_fn(m, columns, |i, k| {
+            let row = chain[i / 3];
+            if k < used.len() {
+                row.a[(i % 3, used[k])]
+            } else if k < anchors {
+                row.a[(i % 3, used[k - used.len()])] * row.trend_s
+            } else {
+                row.a[(i % 3, shared_columns[k - anchors])]
+            }
+        });
+        let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);
+        let (r, qty, energy) = factor(a, y);
+        let mut block = (Vec::new(), Vec::new());
+        for i in anchors..columns {
+            block.0.extend((anchors..columns).map(|k| r[(i, k)]));
+            block.1.push(qty[i]);
+        }
+        let rss = (energy - qty.norm_squared()).max(0.0);
+        (block, (rss, energy, m))
+    };
+    let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+    let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
+    let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
+    let mut nuisance = settings.shared_nuisance() as f64;
+    for chain in &chains {
+        nuisance += settings.nuisance_per_chain() as f64;
+        let (block, (r, e, m)) = reduce_chain(&chain.iter().collect::<Vec<_>>());
+        (rss, y_energy, rows) = (rss + r, y_energy + e, rows + m);
+        blocks.push(block);
+    }
+    // Where the damping's column is among the shared ones.
+    let damping_at = shared_columns.iter().position(|&k| k == DAMPING);
+    // The stacked shared rows of the chains' `blocks` that `keep` selects, without their
+    // first `drop` columns (the torque's, held at zero): (R, z, rss) in j, and (all
+    // columns kept) the damping's row of the factor `(r_dd, r_dj, z_d)`.
+    let solve_shared =
+        |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop: usize| {
+            let (mut a, mut y) = (Vec::new(), Vec::new());
+            for (_, block) in blocks.iter().enumerate().filter(|(c, _)| keep(*c)) {
+                for row in block.0.chunks(shared) {
+                    a.extend_from_slice(&row[drop..]);
+                }
+                y.extend_from_slice(&block.1);
+            }
+            let m = y.len();
+            let n = shared - drop;
+            let (r, qty, energy) = factor(DMatrix::from_row_slice(m, n, &a), DVector::from_vec(y));
+            let off = n - 6;
+            let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
+            let mut z = Vector6::from_fn(|i, _| qty[off + i]);
+            for i in 0..6 {
+                if rr[(i, i)] < 0.0 {
+                    for k in 0..6 {
+                        rr[(i, k)] = -rr[(i, k)];
+                    }
+                    z[i] = -z[i];
+                }
+            }
+            let damping = damping_at.filter(|_| drop == 0).map(|p| {
+                let r_dj = Vector6::from_fn(|i, _| r[(p, off + i)]);
+                (r[(p, p)], r_dj, qty[p], r)
+            });
+            (rr, z, (energy - qty.norm_squared()).max(0.0), damping)
+        };
+    let (rr, z, shared_rss, damping_factor) = solve_shared(&blocks, &|_| true, 0);
+    let damping_of = |row: &Option<(f64, Vector6<f64>, f64, DMatrix<f64>)>, j: &InertiaVector| {
+        row.as_ref()
+            .map(|(r_dd, r_dj, z_d, _)| (z_d - r_dj.dot(j)) / r_dd)
+    };
+    // The torque's columns, when the rows use them: the same rows without them hold it
+    // at zero ([`torque_tested`]), at the cost of the growth of ρ².
+    let torque = if settings.torque_bias {
+        shared_columns.iter().filter(|&&k| k < TORQUE + 3).count()
+    } else {
+        0
+    };
+    let without_torque = (torque > 0).then(|| {
+        let (r, z, held_rss, _) = solve_shared(&blocks, &|_| true, torque);
+        let growth = (held_rss - shared_rss).max(0.0);
+        let qr = RecursiveQr {
+            r,
+            z,
+            rss: rss + held_rss,
+            y_energy,
+            rows,
+            weight: rows as f64,
+            noise_s,
+            nuisance: nuisance - torque as f64,
+        };
+        (qr, growth)
+    });
+    rss += shared_rss;
+    // The jackknife's groups: the chains, or with fewer than MIN_GROUPS of them, time
+    // blocks ([`crate::estimator::jackknife`], "Records of few chains"): each delete-one problem
+    // the raw rows of every other block, each chain's initial momenta fitted again —
+    // independent of the recursive path's innovations.
+    let mut time_block_scale = 1.0;
+    let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
+        (0..chains.len().min(GROUPS))
+            .map(|g| {
+                let (r, z, _, d) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
+                let j = crate::solver::unconstrained_minimiser(&r, &z)?;
+                Some((j, damping_of(&d, &j)))
+            })
+            .collect()
+    } else {
+        // The same blocks as the recursive path: the last chain's block in progress is
+        // in every delete-one problem and σ is scaled to it, as there.
+        let lengths: Vec<usize> = chains.iter().map(Vec::len).collect();
+        let ids = est::jackknife::time_blocks(&lengths);
+        let count = ids.iter().flatten().flatten().max().map_or(0, |m| m + 1);
+        let pending = ids.iter().flatten().filter(|id| id.is_none()).count();
+        let all = ids.iter().map(Vec::len).sum::<usize>();
+        time_block_scale = crate::math::sqrt((all - pending) as f64 / all.max(1) as f64);
+        (0..count)
+            .map(|g| {
+                let without: Vec<(Vec<f64>, Vec<f64>)> = chains
+                    .iter()
+                    .zip(&ids)
+                    .map(|(chain, ids)| {
+                        let kept: Vec<&AugmentedRow> = chain
+                            .iter()
+                            .zip(ids)
+                            .filter(|(_, &id)| id != Some(g))
+                            .map(|(r, _)| r)
+                            .collect();
+                        reduce_chain(&kept).0
+                    })
+                    .collect();
+                let (r, z, _, d) = solve_shared(&without, &|_| true, 0);
+                let j = crate::solver::unconstrained_minimiser(&r, &z)?;
+                Some((j, damping_of(&d, &j)))
+            })
+            .collect()
+    };
+    let estimates: Option<Vec<(InertiaVector, Option<f64>)>> = estimates;
+    // The delete-one answers' D, as one more element of the jackknife.
+    let damping_jackknife = estimates.as_deref().and_then(|e| {
+        let d: Option<Vec<InertiaVector>> = e
+            .iter()
+            .map(|(_, d)| d.map(InertiaVector::from_element))
+            .collect();
+        Some(jackknife_sigma(&d?)?[0] * time_block_scale)
+    });
+    Ok(BatchReduction {
+        qr: RecursiveQr {
+            r: rr,
+            z,
+            rss,
+            y_energy,
+            rows,
+            weight: rows as f64,
+            noise_s,
+            nuisance,
+        },
+        gaps: source.gaps(),
+        jackknife_sigma_kg_m2: estimates
+            .as_ref()
+            .map(|e| e.iter().map(|(j, _)| *j).collect::<Vec<_>>())
+            .as_deref()
+            .and_then(jackknife_sigma)
+            .map(|s| s.map(|v| v * time_block_scale)),
+        without_torque,
+        damping: damping_factor
+            .zip(damping_at)
+            .map(|((r_dd, r_dj, z_d, r), p)| {
+                let s2 = est::qr::residual_variance(rss, rows as f64 - 6.0 - nuisance);
+                // e_pᵀ (RᵀR)⁻¹ e_p = ‖R⁻ᵀ e_p‖².
+                let mut e = DVector::zeros(shared);
+                e[p] = 1.0;
+                let ls = r
+                    .transpose()
+                    .solve_lower_triangular(&e)
+                    .filter(|_| s2.is_finite() && r_dd != 0.0)
+                    .map(|u| crate::math::sqrt(s2 * u.norm_squared()));
+                let sigma_nms = match (ls, damping_jackknife) {
+                    (Some(l), Some(k)) => Some(l.max(k)),
+                    (l, k) => l.or(k),
+                };
+                DampingRow {
+                    r_dd,
+                    r_dj,
+                    z_d,
+                    sigma_nms,
+                }
+            }),
+    })
+}
