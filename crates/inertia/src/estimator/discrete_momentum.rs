@@ -10,10 +10,9 @@
 //!   the shared unknowns: an independent code path that must agree with the recursive one.
 
 use super::augmented_qr::AugmentedQr;
+use super::chain_clock::ChainClock;
 use super::jackknife::ChainGroups;
-use super::momentum_rows::{
-    AugmentedRow, ChainClock, MomentumRowSettings, MomentumRows, DAMPING, TORQUE,
-};
+use super::momentum_rows::{AugmentedRow, MomentumRowSettings, MomentumRows, DAMPING, TORQUE};
 
 use crate::tensor::InertiaVector;
 

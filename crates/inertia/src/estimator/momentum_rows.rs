@@ -69,7 +69,6 @@
 //! inertial momentum (`estimator/trend_slot.rs`). A split chain's torque before and after the
 //! split are then two unknowns, like its initial momenta.
 
-pub(crate) use super::chain_clock::ChainClock;
 use crate::attitude::Quaternion;
 use crate::discrete::{check_phi, check_unit, RowError};
 use crate::discrete_momentum::IntervalMomentum;
@@ -266,7 +265,7 @@ impl core::fmt::Display for MomentumRowSettings {
 
 #[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl MomentumRowSettings {
-    /// The model but for the chain length, which only [`ChainClock`] uses: candidates
+    /// The model but for the chain length, which only [`super::chain_clock::ChainClock`] uses: candidates
     /// equal in it fit the same model in different chains.
     #[must_use]
     pub(crate) fn rows_only(&self) -> Self {
