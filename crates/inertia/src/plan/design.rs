@@ -5,7 +5,7 @@
 //!
 //! The unit is a *doublet* about a body direction `u`: the rate `ω = a(t) u` rises at the
 //! largest acceleration `α` to the largest rate `a` the limits allow along `u`
-//! ([`super::limits::Limits::along`]) or that the doublet's length leaves time for,
+//! (`Limits::along`) or that the doublet's length leaves time for,
 //! coasts, returns to rest, does the same at `−a`, and ends at rest with the wheels at
 //! zero momentum and the attitude back near its start.
 //!
@@ -21,7 +21,7 @@
 //! period `T` (8 to 120 s) on each body axis at once, the y axis `T/3` and the z axis
 //! `2T/3` behind x, repeated over about 30 s, with a triangular rate (full torque
 //! throughout) or a quick ramp and coasts; each is scaled as a whole to the margin of its
-//! tightest limit ([`super::limits::Limits::scale_to_fit`]), so that the rate direction
+//! tightest limit (`Limits::scale_to_fit`), so that the rate direction
 //! sweeps the body while every wheel works.
 //!
 //! Only tours that fit in one estimator chain are offered, where any does. A train's
@@ -31,7 +31,7 @@
 //! # Time shares (convex)
 //!
 //! With `m_u` the information per second of tour `u` (its rows only, flown alone, the
-//! initial momentum of each estimator chain minimised out, [`super::predict`]), time shares `w` on the simplex give the
+//! initial momentum of each estimator chain minimised out, `predict`), time shares `w` on the simplex give the
 //! information `M(w) = T Σ_u w_u m_u` after `T` seconds. The target is the relative
 //! Frobenius σ, `σ_F² = tr(F M⁻¹)` with `F = diag(1,1,1,2,2,2)/‖J‖_F²`, so the shares
 //! minimise `Φ(w) = tr(F (Σ w_u m_u)⁻¹)`: A-optimal (weighted) design, convex in `w`.
@@ -47,7 +47,7 @@
 //! the trajectories. Not guaranteed: optimality over manoeuvres outside the library, the
 //! ordering (whole tours are sequenced to follow the shares, largest deficit first),
 //! the end effects of chains that straddle two tours, and the noise model itself
-//! ([`super::predict`], "What it omits").
+//! (`predict`, "What it omits").
 
 use crate::plan::limits::{Limits, LimitsError};
 use crate::plan::predict::{information, EstimatorModel, NoiseModel};
@@ -63,16 +63,16 @@ pub struct Atom {
     /// Length of each doublet, s.
     pub doublet_s: f64,
     /// Rotation directions, body axes, unit.
-    pub directions: Vec<Vector3<f64>>,
+    pub(crate) directions: Vec<Vector3<f64>>,
     /// Peak rate of each doublet, rad/s.
-    pub peak_rate_rad_s: Vec<f64>,
+    pub(crate) peak_rate_rad_s: Vec<f64>,
     /// The commands (from t = 0).
-    pub commands: Vec<Vector3<f64>>,
+    pub(crate) commands: Vec<Vector3<f64>>,
 }
 
 /// The doublet lengths of the library, s (rounded to whole multiples of four controller
 /// periods).
-pub const DOUBLET_S: [f64; 6] = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
+pub(crate) const DOUBLET_S: [f64; 6] = [4.0, 6.0, 8.0, 12.0, 16.0, 24.0];
 
 /// The library's time shares.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,7 +84,7 @@ pub struct Design {
     /// Relative optimality gap bound `(max_u d_u − Φ)/Φ` (module docs).
     pub gap: f64,
     /// `σ_F √T` of the shares: the relative Frobenius σ after `T` s is this over `√T`.
-    pub sigma_root_s: f64,
+    pub(crate) sigma_root_s: f64,
     /// Information per second of each doublet.
     per_s: Vec<SMatrix<f64, 6, 6>>,
     /// `F` of the objective.
@@ -94,7 +94,8 @@ pub struct Design {
 impl Design {
     /// `Φ(w) = tr(F (Σ w_u m_u)⁻¹)` for any shares `w` (∞ where singular).
     #[must_use]
-    pub fn objective(&self, w: &[f64]) -> f64 {
+    #[cfg(test)]
+    pub(crate) fn objective(&self, w: &[f64]) -> f64 {
         let m: SMatrix<f64, 6, 6> = self.per_s.iter().zip(w).map(|(m, w)| m * *w).sum();
         m.cholesky()
             .map_or(f64::INFINITY, |c| (self.f * c.inverse()).trace())
@@ -103,7 +104,7 @@ impl Design {
 
 /// The three direction sets.
 #[must_use]
-pub fn direction_sets() -> [(&'static str, Vec<Vector3<f64>>); 3] {
+pub(crate) fn direction_sets() -> [(&'static str, Vec<Vector3<f64>>); 3] {
     let axes = std::vec![Vector3::x(), Vector3::y(), Vector3::z()];
     let mut face = Vec::new();
     for (a, b) in [(0, 1), (0, 2), (1, 2)] {
@@ -127,13 +128,14 @@ pub fn direction_sets() -> [(&'static str, Vec<Vector3<f64>>); 3] {
 
 /// Every direction of the sets.
 #[must_use]
-pub fn directions() -> Vec<Vector3<f64>> {
+#[cfg(test)]
+pub(crate) fn directions() -> Vec<Vector3<f64>> {
     direction_sets().into_iter().flat_map(|(_, d)| d).collect()
 }
 
 /// The doublet about `u` (module docs) at controller period `period_s`, lasting
 /// `doublet_s` rounded to whole multiples of four periods: its peak rate and commands.
-pub fn doublet(
+pub(crate) fn doublet(
     u: &Vector3<f64>,
     limits: &Limits,
     j: &Matrix3<f64>,
@@ -218,7 +220,11 @@ fn three_phase(
 }
 
 /// The library: a tour per direction set and doublet length, and the three-phase trains.
-pub fn library(limits: &Limits, j: &Matrix3<f64>, period_s: f64) -> Result<Vec<Atom>, LimitsError> {
+pub(crate) fn library(
+    limits: &Limits,
+    j: &Matrix3<f64>,
+    period_s: f64,
+) -> Result<Vec<Atom>, LimitsError> {
     let mut out = Vec::new();
     for (set, dirs) in direction_sets() {
         for d in DOUBLET_S {
@@ -260,11 +266,11 @@ pub fn library(limits: &Limits, j: &Matrix3<f64>, period_s: f64) -> Result<Vec<A
 }
 
 /// The three-phase trains' periods, s.
-pub const THREE_PHASE_S: [f64; 6] = [8.0, 12.0, 16.0, 20.0, 24.0, 30.0];
+pub(crate) const THREE_PHASE_S: [f64; 6] = [8.0, 12.0, 16.0, 20.0, 24.0, 30.0];
 
 /// The library with its chain rule (module docs): tours that fit in one chain (where any
 /// does) and the three-phase trains.
-pub fn library_for(
+pub(crate) fn library_for(
     limits: &Limits,
     j: &Matrix3<f64>,
     period_s: f64,
@@ -288,7 +294,7 @@ pub fn library_for(
 /// which build rate up beyond it and return to rest after, were tried: the time-share
 /// relaxation assumes every manoeuvre is flown within the horizon, and with them the
 /// planned time to target grew.)
-pub fn trains_for(
+pub(crate) fn trains_for(
     limits: &Limits,
     j: &Matrix3<f64>,
     period_s: f64,
@@ -320,7 +326,7 @@ pub fn design(
 /// than it counts with the information of its first `horizon_s` seconds only (what it
 /// gives by then).
 #[must_use]
-pub fn design_over(
+pub(crate) fn design_over(
     atoms: Vec<Atom>,
     j: &Matrix3<f64>,
     noise: &NoiseModel,
@@ -382,7 +388,11 @@ pub fn design_over(
 /// many as fit in `horizon_s`; returns the commands and, per manoeuvre flown, its index
 /// and end time.
 #[must_use]
-pub fn schedule(d: &Design, period_s: f64, horizon_s: f64) -> (CommandProfile, Vec<(usize, f64)>) {
+pub(crate) fn schedule(
+    d: &Design,
+    period_s: f64,
+    horizon_s: f64,
+) -> (CommandProfile, Vec<(usize, f64)>) {
     let mut spent = std::vec![0.0; d.atoms.len()];
     let mut t = 0.0;
     let mut cmds = Vec::new();

@@ -10,7 +10,7 @@
 //! (`chirp-3axis`) and the steps staggered by one step per axis (`multi-step-3axis`).
 //!
 //! Each is built with unit amplitude over a horizon, then scaled by
-//! [`super::limits::Limits::scale_to_fit`] to use the same fraction of its tightest
+//! `Limits::scale_to_fit` to use the same fraction of its tightest
 //! limit (torque, wheel momentum or rate) as a plan does: the largest amplitude at
 //! which it flies.
 
@@ -21,7 +21,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::vec::Vec;
 
 /// The fixed profiles' names.
-pub const NAMES: [&str; 6] = [
+pub(crate) const NAMES: [&str; 6] = [
     "prbs",
     "chirp",
     "chirp-3axis",
@@ -50,7 +50,7 @@ fn binary(seed: u64, n: usize) -> Vec<f64> {
 /// The unit-amplitude shape `name` over `horizon_s` at controller period `period_s`
 /// (`None` for an unknown name).
 #[must_use]
-pub fn shape(name: &str, period_s: f64, horizon_s: f64) -> Option<CommandProfile> {
+pub(crate) fn shape(name: &str, period_s: f64, horizon_s: f64) -> Option<CommandProfile> {
     let n = (horizon_s / period_s).round() as usize;
     let t = |k: usize| k as f64 * period_s;
     let cmds: Vec<Vector3<f64>> = match name {
@@ -103,7 +103,7 @@ pub fn shape(name: &str, period_s: f64, horizon_s: f64) -> Option<CommandProfile
 }
 
 /// The fixed profile `name` over `horizon_s`, scaled to the limits.
-pub fn fixed(
+pub(crate) fn fixed(
     name: &str,
     period_s: f64,
     horizon_s: f64,

@@ -90,14 +90,14 @@ pub struct LimitUse {
 impl LimitUse {
     /// The largest of the three.
     #[must_use]
-    pub fn worst(&self) -> f64 {
+    pub(crate) fn worst(&self) -> f64 {
         self.torque.max(self.momentum).max(self.rate)
     }
 }
 
 impl Limits {
     /// Check the wheels, the rate limit and the margin.
-    pub fn validate(&self) -> Result<(), LimitsError> {
+    pub(crate) fn validate(&self) -> Result<(), LimitsError> {
         if self.wheels.is_empty() {
             return Err(LimitsError::NoWheel);
         }
@@ -182,7 +182,7 @@ impl Limits {
 
     /// The same check on a flown trajectory: the true wheel momenta `ρ` and body rates `ω`
     /// at the telemetry nodes (for the flight checks; torque is checked on the commands).
-    pub fn use_of_flight(
+    pub(crate) fn use_of_flight(
         &self,
         rho_nms: &[Vector3<f64>],
         omega_rad_s: &[Vector3<f64>],
@@ -204,7 +204,7 @@ impl Limits {
 
     /// The factor by which to scale `profile` so that it uses exactly [`Self::margin`] of
     /// its tightest limit (every limit is linear in the commands: module docs).
-    pub fn scale_to_fit(
+    pub(crate) fn scale_to_fit(
         &self,
         profile: &CommandProfile,
         j_kg_m2: &Matrix3<f64>,
@@ -220,7 +220,7 @@ impl Limits {
     /// `ω = a u` about the unit body direction `u` (the momentum `ρ = −a J u`): each
     /// wheel's share of `J u` against its momentum and torque limits, and the rate limit,
     /// all times the margin.
-    pub fn along(
+    pub(crate) fn along(
         &self,
         u: &Vector3<f64>,
         j_kg_m2: &Matrix3<f64>,

@@ -17,17 +17,17 @@
 //! * [`profile`]: the zero-order-hold command profile and its CSV (body axes and per
 //!   wheel);
 //! * [`design`]: the convex design and what it guarantees;
-//! * [`predict`]: the prediction's rows, noise model and omissions;
-//! * [`fixed`]: the fixed profiles a plan is compared with (PRBS, chirp, multi-sine,
+//! * `predict`: the prediction's rows, noise model and omissions;
+//! * `fixed`: the fixed profiles a plan is compared with (PRBS, chirp, multi-sine,
 //!   multi-step), scaled to the same limits.
 //!
 //! The target is the relative Frobenius σ `σ_F = √(Σ_i w_i σ_i²)/‖J‖_F` (`w` = 1 on the
 //! diagonal, 2 off it): met when `3 σ_F ≤ target`.
 
 pub mod design;
-pub mod fixed;
+pub(crate) mod fixed;
 pub mod limits;
-pub mod predict;
+pub(crate) mod predict;
 pub mod profile;
 #[cfg(feature = "sim")]
 pub mod rehearse;
@@ -44,7 +44,7 @@ use std::string::String;
 use std::vec::Vec;
 
 /// Step of the minimum-time scan over horizons, s.
-pub const SCAN_STEP_S: f64 = 5.0;
+pub(crate) const SCAN_STEP_S: f64 = 5.0;
 
 /// What a plan needs to know about the spacecraft.
 #[derive(Debug, Clone, PartialEq)]
@@ -111,7 +111,7 @@ pub enum PlanError {
 /// The largest fraction of a limit a plan uses: 0.9, less where the prior is uncertain
 /// (the rate is `J⁻¹ρ` of the prior J; a J smaller by 3σ turns faster by `1/(1 − 3r)`).
 #[must_use]
-pub fn margin_for(prior_relative_sigma: f64) -> f64 {
+pub(crate) fn margin_for(prior_relative_sigma: f64) -> f64 {
     (1.0 / (1.0 + 3.0 * prior_relative_sigma)).min(0.9)
 }
 
@@ -137,7 +137,7 @@ pub struct Plan {
 impl Vehicle {
     /// The vehicle of a spacecraft file: its wheels with `max_torque_nm` and
     /// `max_momentum_nms`, `[prior]`, `[sensors]` and `[limits]`; `file` names it in
-    /// errors. The prior's σ sets the margin ([`margin_for`]); the rotors' stated σ is
+    /// errors. The prior's σ sets the margin (`margin_for`); the rotors' stated σ is
     /// the consider term. The prior does not inform the prediction (the default
     /// estimator does not use it).
     pub fn from_spacecraft(
@@ -238,7 +238,7 @@ pub fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
 }
 
 /// The whole schedule to `max_duration_s` with its prediction, not truncated.
-pub fn plan_full(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
+pub(crate) fn plan_full(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
     v.validate()?;
     if !(s.max_duration_s.is_finite() && s.max_duration_s > 0.0) {
         return Err(PlanError::Setting(
@@ -273,7 +273,7 @@ pub fn plan_full(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
 /// The design for horizon `horizon_s` (the library's manoeuvres that fit in it and the
 /// three-phase trains made for it, [`design::trains_for`]), scheduled to
 /// `max_duration_s`, with its prediction (`None` when nothing fits).
-pub fn plan_for_horizon(
+pub(crate) fn plan_for_horizon(
     v: &Vehicle,
     s: &PlanSettings,
     horizon_s: f64,
@@ -318,7 +318,7 @@ pub fn plan_for_horizon(
 
 impl Plan {
     /// This plan cut at the end of the tour in progress at `t_s` (the prediction with it).
-    pub fn truncated_after(&self, t_s: f64, v: &Vehicle) -> Result<Plan, PlanError> {
+    pub(crate) fn truncated_after(&self, t_s: f64, v: &Vehicle) -> Result<Plan, PlanError> {
         let k = self
             .order
             .iter()
@@ -365,7 +365,7 @@ pub struct RehearsedPlan {
     /// When that median meets the target, s.
     pub reported_target_met_s: Option<f64>,
     /// Rehearsal flights flown.
-    pub seeds: u64,
+    pub(crate) seeds: u64,
 }
 
 /// Plan, then choose the design horizon by rehearsal: the designs for horizons from the
@@ -439,7 +439,7 @@ pub fn plan_rehearsed(
 /// A fixed profile at the same limits and its prediction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FixedRun {
-    /// Its name ([`fixed::NAMES`]).
+    /// Its name (`fixed::NAMES`).
     pub name: &'static str,
     /// The horizon it was built and scaled over, s.
     pub horizon_s: f64,

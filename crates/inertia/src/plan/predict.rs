@@ -118,7 +118,7 @@ impl Prediction {
 
 /// `Ω(ω)` with `J ω = Ω(ω) j`.
 #[must_use]
-pub fn omega_matrix(w: &Vector3<f64>) -> Matrix3x6<f64> {
+pub(crate) fn omega_matrix(w: &Vector3<f64>) -> Matrix3x6<f64> {
     Matrix3x6::new(
         w.x, 0.0, 0.0, w.y, w.z, 0.0, //
         0.0, w.y, 0.0, w.x, 0.0, w.z, //
@@ -249,7 +249,7 @@ fn sigma_from(m: &SMatrix<f64, 6, 6>, model: &EstimatorModel, j: &InertiaVector)
 /// telemetry node its time, body rate `ω = −J⁻¹ρ` and attitude (module docs of
 /// [`super::limits`]).
 #[must_use]
-pub fn nominal(
+pub(crate) fn nominal(
     profile: &CommandProfile,
     j: &Matrix3<f64>,
     period_s: f64,
@@ -285,7 +285,7 @@ pub fn nominal(
 
 /// The information of `j` (6 × 6) from flying `profile` for `duration_s`.
 #[must_use]
-pub fn information(
+pub(crate) fn information(
     profile: &CommandProfile,
     j: &Matrix3<f64>,
     noise: &NoiseModel,
@@ -298,7 +298,7 @@ pub fn information(
 
 /// The predicted σ every `every_s` seconds over `duration_s` of flying `profile`.
 #[must_use]
-pub fn predict(
+pub(crate) fn predict(
     profile: &CommandProfile,
     j: &Matrix3<f64>,
     noise: &NoiseModel,

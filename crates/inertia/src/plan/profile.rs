@@ -40,20 +40,20 @@ pub struct CommandProfile {
 #[error("{file}:{}{message}", .line.map_or_else(String::new, |l| format!("{l}:")))]
 pub struct ProfileError {
     /// The file.
-    pub file: String,
+    pub(crate) file: String,
     /// 1-based line, where there is one.
-    pub line: Option<usize>,
+    pub(crate) line: Option<usize>,
     /// What is wrong.
-    pub message: String,
+    pub(crate) message: String,
 }
 
 /// The body-axis command columns.
-pub const COLUMNS: [&str; 3] = ["rho_dot_x_nm", "rho_dot_y_nm", "rho_dot_z_nm"];
+pub(crate) const COLUMNS: [&str; 3] = ["rho_dot_x_nm", "rho_dot_y_nm", "rho_dot_z_nm"];
 
 impl CommandProfile {
     /// A profile of `torque_nm` from `t0_s` at period `period_s`.
     #[must_use]
-    pub fn new(t0_s: f64, period_s: f64, torque_nm: Vec<Vector3<f64>>) -> Self {
+    pub(crate) fn new(t0_s: f64, period_s: f64, torque_nm: Vec<Vector3<f64>>) -> Self {
         Self {
             t0_s,
             period_s,
@@ -69,7 +69,7 @@ impl CommandProfile {
 
     /// The command held at `t_s` (zero outside the profile).
     #[must_use]
-    pub fn at(&self, t_s: f64) -> Vector3<f64> {
+    pub(crate) fn at(&self, t_s: f64) -> Vector3<f64> {
         let k = ((t_s - self.t0_s) / self.period_s + 1e-9).floor();
         if k < 0.0 || !k.is_finite() {
             return Vector3::zeros();
@@ -83,7 +83,7 @@ impl CommandProfile {
     /// The rotor momentum at every tick from zero at the start (`n + 1` values): `ρ` is
     /// the running sum of `P ρ̇` (exact for the hold).
     #[must_use]
-    pub fn momentum_at_ticks(&self) -> Vec<Vector3<f64>> {
+    pub(crate) fn momentum_at_ticks(&self) -> Vec<Vector3<f64>> {
         let mut rho = Vector3::zeros();
         let mut out = Vec::with_capacity(self.torque_nm.len() + 1);
         out.push(rho);
@@ -96,7 +96,7 @@ impl CommandProfile {
 
     /// Every command times `s`.
     #[must_use]
-    pub fn scaled(&self, s: f64) -> Self {
+    pub(crate) fn scaled(&self, s: f64) -> Self {
         Self {
             torque_nm: self.torque_nm.iter().map(|c| c * s).collect(),
             ..self.clone()
@@ -105,7 +105,7 @@ impl CommandProfile {
 
     /// The first `n` commands.
     #[must_use]
-    pub fn truncated(&self, n: usize) -> Self {
+    pub(crate) fn truncated(&self, n: usize) -> Self {
         Self {
             torque_nm: self.torque_nm[..n.min(self.torque_nm.len())].to_vec(),
             ..self.clone()

@@ -1,6 +1,6 @@
 //! Rehearsal: fly a profile through the simulator and the estimator itself, to see what
 //! the estimator will *report* (its σ, which is not the information-matrix σ of
-//! [`super::predict`]: it takes the largest of its least-squares σ and a jackknife over
+//! `predict`: it takes the largest of its least-squares σ and a jackknife over
 //! its momentum chains, adds a discretisation-bias term, and withholds an answer until
 //! its checks pass).
 //!
@@ -52,9 +52,9 @@ pub struct Flight {
     /// Times of the estimates, s.
     pub t_s: Vec<f64>,
     /// The reported relative Frobenius σ at each (∞ where no σ was reported).
-    pub reported_relative_sigma: Vec<f64>,
+    pub(crate) reported_relative_sigma: Vec<f64>,
     /// The reported σ per element at the end (None: withheld).
-    pub final_sigma_kg_m2: Option<[f64; 6]>,
+    pub(crate) final_sigma_kg_m2: Option<[f64; 6]>,
     /// Every element within ±3 reported σ at the end.
     pub covered: bool,
     /// The final relative Frobenius error (NaN: withheld).
@@ -64,7 +64,7 @@ pub struct Flight {
     /// Largest wheel-momentum use of the flight (1 = a wheel at its limit).
     pub momentum_use: f64,
     /// Largest rate use (0 without a rate limit).
-    pub rate_use: f64,
+    pub(crate) rate_use: f64,
 }
 
 impl Flight {
@@ -176,7 +176,7 @@ pub fn median_reported(flights: &[Flight], target: f64) -> (Vec<f64>, Vec<f64>, 
 }
 
 /// Rehearse `profile` on the prior J with seeds `1..=seeds` (module docs).
-pub fn rehearse(
+pub(crate) fn rehearse(
     v: &Vehicle,
     profile: &CommandProfile,
     settings: &FlightSettings,
