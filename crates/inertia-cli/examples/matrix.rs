@@ -68,8 +68,8 @@
 //! one (cells whose label contains the filter; `throw` selects only them).
 //!
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
-//! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto` its
-//! `--inertial-torque` (unset: `off`); `DAMPING=1` its `--damping`. `DIGITS=1` prints the medians with
+//! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto|short` its
+//! `--inertial-torque` (unset: the default, `short`); `DAMPING=1` its `--damping`. `DIGITS=1` prints the medians with
 //! four significant digits. `WHEEL_DELAY=off|SECONDS|estimate` sets the lab cells' wheel
 //! speed time tag (every estimator; unset: off).
 
