@@ -111,6 +111,16 @@ pub enum LabEffect {
     Drag,
 }
 
+impl LabEffect {
+    /// Every lab effect.
+    pub const ALL: [LabEffect; 4] = [
+        LabEffect::Vibration,
+        LabEffect::SpeedTelemetry,
+        LabEffect::InertialTorque,
+        LabEffect::Drag,
+    ];
+}
+
 impl Preset {
     /// The hand-thrown lab device (module docs, [`THROW`]).
     #[must_use]
@@ -181,6 +191,16 @@ impl Preset {
             }
         }
         p
+    }
+
+    /// [`Preset::throw`] with only the effects listed.
+    #[must_use]
+    pub fn throw_with(on: &[LabEffect]) -> Self {
+        let off: std::vec::Vec<LabEffect> = LabEffect::ALL
+            .into_iter()
+            .filter(|e| !on.contains(e))
+            .collect();
+        Self::throw_without(&off)
     }
 
     /// The 12U-class small satellite (module docs).

@@ -36,11 +36,7 @@ fn streaming(samples: &[Sample], config: PipelineConfig) -> Pipeline {
 
 /// The throw with only air drag (and the gyro's noise) besides the ideal gyrostat.
 fn drag_only(seed: u64) -> inertia::sim::SimOutput {
-    let mut p = Preset::throw_without(&[
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::InertialTorque,
-    ]);
+    let mut p = Preset::throw_with(&[LabEffect::Drag]);
     p.common.seed = seed;
     p.simulate().expect("valid settings")
 }
@@ -118,11 +114,7 @@ fn damping_without_drag_is_zero_within_its_sigma() {
 fn a_negative_damping_fails_the_model_check() {
     // An inertial-frame torque and no drag: with the inertial torque not estimated the
     // damping column takes it up, with the wrong sign for a drag.
-    let mut p = Preset::throw_without(&[
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::Drag,
-    ]);
+    let mut p = Preset::throw_with(&[LabEffect::InertialTorque]);
     p.common.seed = 1;
     let out = p.simulate().expect("valid settings");
     let off = PipelineSettings {

@@ -143,11 +143,7 @@ fn the_default_tests_for_the_torque_on_short_records_only() {
         (answers, p.diagnostics().row_model.expect("rows"))
     };
     // A throw with the inertial torque alone: the default answers as `auto`.
-    let mut throw = Preset::throw_without(&[
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::Drag,
-    ]);
+    let mut throw = Preset::throw_with(&[LabEffect::InertialTorque]);
     throw.common.seed = 2;
     let out = throw.simulate().expect("simulation");
     let (default, rows) = run(&out.samples, None);

@@ -14,17 +14,11 @@ use nalgebra::{Matrix3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const ALL: [LabEffect; 4] = [
-    LabEffect::Vibration,
-    LabEffect::SpeedTelemetry,
-    LabEffect::InertialTorque,
-    LabEffect::Drag,
-];
+const ALL: [LabEffect; 4] = LabEffect::ALL;
 
 /// The throw with only the effects in `on`, every noise off.
 fn throw_with(on: &[LabEffect]) -> SimOutput {
-    let off: Vec<LabEffect> = ALL.iter().copied().filter(|e| !on.contains(e)).collect();
-    let mut p = Preset::throw_without(&off);
+    let mut p = Preset::throw_with(on);
     p.common.gyro_noise_deg_s_rthz = 0.0;
     p.common.disturbance_nm_rthz = 0.0;
     p.simulate().expect("valid settings")

@@ -21,14 +21,7 @@ fn rows() -> MomentumRowSettings {
 
 /// The throw with only the lab effects `on`, seed `seed`.
 fn throw(on: &[LabEffect], seed: u64) -> inertia::sim::SimOutput {
-    let all = [
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::InertialTorque,
-        LabEffect::Drag,
-    ];
-    let off: Vec<LabEffect> = all.into_iter().filter(|e| !on.contains(e)).collect();
-    let mut p = Preset::throw_without(&off);
+    let mut p = Preset::throw_with(on);
     p.common.seed = seed;
     p.simulate().expect("sim")
 }

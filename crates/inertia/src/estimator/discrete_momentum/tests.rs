@@ -528,14 +528,7 @@ fn rows() -> MomentumRowSettings {
 
 /// The throw with only the lab effects `on`, seed `seed`.
 fn throw(on: &[LabEffect], seed: u64) -> crate::sim::SimOutput {
-    let all = [
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::InertialTorque,
-        LabEffect::Drag,
-    ];
-    let off: Vec<LabEffect> = all.into_iter().filter(|e| !on.contains(e)).collect();
-    let mut p = Preset::throw_without(&off);
+    let mut p = Preset::throw_with(on);
     p.common.seed = seed;
     p.simulate().expect("sim")
 }
@@ -567,18 +560,6 @@ fn recursive_and_batch_time_block_jackknives_agree() {
     }
 }
 
-// From tests/integration/damping.rs.
-/// The throw with only air drag (and the gyro's noise) besides the ideal gyrostat.
-fn drag_only(seed: u64) -> crate::sim::SimOutput {
-    let mut p = Preset::throw_without(&[
-        LabEffect::Vibration,
-        LabEffect::SpeedTelemetry,
-        LabEffect::InertialTorque,
-    ]);
-    p.common.seed = seed;
-    p.simulate().expect("valid settings")
-}
-
 #[test]
 fn recursive_and_batch_agree_with_damping() {
     use crate::estimator::discrete_momentum::reduce_batch;
@@ -592,7 +573,7 @@ fn recursive_and_batch_agree_with_damping() {
         .expect("simulation");
     let mut gapped = slew.samples.clone();
     gapped.retain(|s| !(50.0..60.0).contains(&s.t_s));
-    let out = drag_only(3);
+    let out = throw(&[LabEffect::Drag], 3);
     for stencil in [Stencil::Plain, Stencil::Adaptive] {
         let rows = MomentumRowSettings {
             stencil,
