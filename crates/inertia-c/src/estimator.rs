@@ -96,6 +96,7 @@ impl InertiaEstimator {
             rho_nms: s.rho_nms,
             tau_nm: Some(s.tau_nm),
             w_rad_s: has_w.then_some(s.w_rad_s),
+            external: Default::default(),
         }) {
             Ok(sample) => sample,
             Err(e) => {
@@ -401,5 +402,9 @@ fn field_name(f: Field) -> &'static str {
         Field::Rho(k) => RHO.get(k).copied().unwrap_or("rho_nms"),
         Field::Tau(k) => TAU.get(k).copied().unwrap_or("tau_nm"),
         Field::Rate(k) => W.get(k).copied().unwrap_or("w_rad_s"),
+        // `InertiaSample` has no outside measurements: the gate never names them here.
+        Field::Position(_) | Field::MagneticField(_) | Field::Force(_) | Field::Dipole(_) => {
+            "(none)"
+        }
     }
 }

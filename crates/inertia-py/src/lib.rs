@@ -576,6 +576,7 @@ fn restore<'py>(
             rho_nms: r.rho.into(),
             tau_nm: r.tau.unwrap_or_default().into(),
             omega_rad_s: r.w.map(Into::into),
+            external: Default::default(),
         })
         .collect();
     let (rows_read, renormalised, sign_flips, min_step_s, max_step_s, attitude_from_gyro) = stats;

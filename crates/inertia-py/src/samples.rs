@@ -80,6 +80,9 @@ impl Naming {
             Field::Rho(k) => self.value(2, Some(k), i),
             Field::Tau(k) => self.value(3, Some(k), i),
             Field::Rate(k) => self.value(4, Some(k), i),
+            Field::Position(_) | Field::MagneticField(_) | Field::Force(_) | Field::Dipole(_) => {
+                format!("row {i}: {field:?}")
+            }
         }
     }
 }
@@ -118,6 +121,7 @@ impl Checker {
             rho_nms: row.rho,
             tau_nm: row.tau,
             w_rad_s: row.w,
+            external: Default::default(),
         };
         self.gate.check(&raw).map_err(|e| Failure::Data {
             message: match e {

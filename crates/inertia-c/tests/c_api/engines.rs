@@ -330,6 +330,7 @@ fn every_registered_estimator_by_id_is_the_pipelines() {
                     rho_nms: c.rho_nms,
                     tau_nm: Some(c.tau_nm),
                     w_rad_s: (c.has_w == 1).then_some(c.w_rad_s),
+                    external: Default::default(),
                 })
                 .unwrap();
             if let Some(e) = p.push(&gated).unwrap() {

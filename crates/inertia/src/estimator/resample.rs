@@ -103,7 +103,14 @@ fn interpolate(n: &[Sample; 4], t: &[f64; 4], x: f64) -> Sample {
     let mut rho = Vector3::zeros();
     let mut tau = Vector3::zeros();
     let mut omega = Some(Vector3::zeros());
+    let mut position = Some(Vector3::zeros());
+    let mut field = Some(Vector3::zeros());
+    let mut force = Some(Vector3::zeros());
     for i in 0..4 {
+        let e = &n[i].external;
+        position = position.zip(e.position_m).map(|(o, v)| o + v * w[i]);
+        field = field.zip(e.field_t).map(|(o, v)| o + v * w[i]);
+        force = force.zip(e.force_n).map(|(o, v)| o + v * w[i]);
         r += q_ref.conjugate().mul(&n[i].q).log() * w[i];
         rho += n[i].rho_nms * w[i];
         tau += n[i].tau_nm * w[i];
@@ -115,5 +122,10 @@ fn interpolate(n: &[Sample; 4], t: &[f64; 4], x: f64) -> Sample {
         rho_nms: rho,
         tau_nm: tau,
         omega_rad_s: omega,
+        external: crate::sample::External {
+            position_m: position,
+            field_t: field,
+            force_n: force,
+        },
     }
 }

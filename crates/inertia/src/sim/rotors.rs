@@ -114,6 +114,7 @@ speed_column = "s4"
             rho_nms: rho,
             tau_nm: Vector3::zeros(),
             omega_rad_s: None,
+            external: Default::default(),
         }
     }
 

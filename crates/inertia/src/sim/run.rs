@@ -135,6 +135,10 @@ pub fn simulate(
                     rho_nms: rho,
                     tau_nm: known_torque.eval(t_b, &x_b),
                     omega_rad_s: None,
+                    external: crate::sample::External {
+                        position_m: env.orbit.map(|o| o.position_m(t_b)),
+                        ..crate::sample::External::NONE
+                    },
                 },
                 None,
             ));

@@ -12,6 +12,10 @@
 //! | `rho_x,rho_y,rho_z` | total rotor angular momentum, N m s | yes |
 //! | `tau_x,tau_y,tau_z` | known external torque, N m | no (zero) |
 //! | `w_x,w_y,w_z` | gyro rate averaged over `[t_k, t_{k+1}]`, rad/s | for the finite-difference and momentum estimators |
+//! | `r_x,r_y,r_z` | position of the centre of mass in the attitude's inertial frame (the orbit), m | no: given, the gravity-gradient torque is modelled |
+//! | `b_x,b_y,b_z` | magnetic field, T, body axes | no: given, a residual magnetic dipole is estimated |
+//! | `dipole_x,dipole_y,dipole_z` | commanded magnetic dipole (magnetorquers), A m², body axes | no (needs `b_*`): its torque `m × B` is added to the known torque |
+//! | `f_x,f_y,f_z` | external force (thrusters), N, body axes | no: given, the centre of mass is estimated (`tau_*` then taken about the body frame's origin) |
 //!
 //! # Validation
 //!
@@ -44,7 +48,7 @@
 //! The reader is an iterator and holds one row at a time: memory does not grow with the
 //! file.
 
-use super::gate::{Field, Gate, GateOptions, RawSample};
+use super::gate::{Field, Gate, GateOptions, RawExternal, RawSample};
 pub use super::gate::{GyroUnit, QuaternionFormat, ReadStats, DEFAULT_UNIT_TOLERANCE};
 use super::line_cap::{LineCap, LineTooLong};
 use super::time_stamp::{Clock, StampError};
@@ -71,6 +75,14 @@ pub struct ColumnNames {
     pub tau: [String; 3],
     /// Gyro rate.
     pub w: [String; 3],
+    /// Inertial position.
+    pub r: [String; 3],
+    /// Magnetic field.
+    pub b: [String; 3],
+    /// External force.
+    pub f: [String; 3],
+    /// Commanded magnetic dipole.
+    pub dipole: [String; 3],
 }
 
 impl Default for ColumnNames {
@@ -85,6 +97,10 @@ impl Default for ColumnNames {
             rho: arr3(v("rho", &["x", "y", "z"])),
             tau: arr3(v("tau", &["x", "y", "z"])),
             w: arr3(v("w", &["x", "y", "z"])),
+            r: arr3(v("r", &["x", "y", "z"])),
+            b: arr3(v("b", &["x", "y", "z"])),
+            f: arr3(v("f", &["x", "y", "z"])),
+            dipole: arr3(v("dipole", &["x", "y", "z"])),
         }
     }
 }
@@ -104,6 +120,10 @@ impl ColumnNames {
             .chain(self.rho.iter_mut().zip(&d.rho))
             .chain(self.tau.iter_mut().zip(&d.tau))
             .chain(self.w.iter_mut().zip(&d.w))
+            .chain(self.r.iter_mut().zip(&d.r))
+            .chain(self.b.iter_mut().zip(&d.b))
+            .chain(self.f.iter_mut().zip(&d.f))
+            .chain(self.dipole.iter_mut().zip(&d.dipole))
         {
             if key == def {
                 *dst = name.into();
@@ -169,6 +189,8 @@ struct Indices {
     rho: Option<[usize; 3]>,
     tau: Option<[usize; 3]>,
     w: Option<[usize; 3]>,
+    /// Position, field, force, dipole ([`RawExternal`]'s order).
+    external: [Option<[usize; 3]>; 4],
     speeds: Vec<usize>,
 }
 
@@ -281,6 +303,12 @@ impl<R: Read> TelemetryReader<R> {
             },
             tau: optional3(&c.tau)?,
             w: optional3(&c.w)?,
+            external: [
+                optional3(&c.r)?,
+                optional3(&c.b)?,
+                optional3(&c.f)?,
+                optional3(&c.dipole)?,
+            ],
             speeds: options
                 .speed_columns
                 .iter()
@@ -404,6 +432,10 @@ impl<R: Read> TelemetryReader<R> {
             },
             Field::Tau(k) => self.idx.tau.map_or(self.idx.t, |c| c[k]),
             Field::Rate(k) => self.idx.w.map_or(self.idx.t, |c| c[k]),
+            Field::Position(k) => self.idx.external[0].map_or(self.idx.t, |c| c[k]),
+            Field::MagneticField(k) => self.idx.external[1].map_or(self.idx.t, |c| c[k]),
+            Field::Force(k) => self.idx.external[2].map_or(self.idx.t, |c| c[k]),
+            Field::Dipole(k) => self.idx.external[3].map_or(self.idx.t, |c| c[k]),
         };
         self.headers[i].clone()
     }
@@ -522,6 +554,20 @@ impl<R: Read> TelemetryReader<R> {
             w_rad_s: match self.idx.w {
                 Some(i) => self.vec3(line, &i)?,
                 None => None,
+            },
+            external: {
+                let mut v = [None; 4];
+                for (k, i) in self.idx.external.iter().enumerate() {
+                    if let Some(i) = i {
+                        v[k] = self.vec3(line, i)?;
+                    }
+                }
+                RawExternal {
+                    position_m: v[0],
+                    field_t: v[1],
+                    force_n: v[2],
+                    dipole_am2: v[3],
+                }
             },
         };
         self.gate

@@ -22,7 +22,7 @@
 
 use crate::attitude::Quaternion;
 use crate::error_kind::ErrorKind;
-use crate::sample::{check_value, Quantity, Sample};
+use crate::sample::{check_value, External, Quantity, Sample};
 use crate::text::Num;
 use nalgebra::Vector3;
 
@@ -81,6 +81,86 @@ pub struct RawSample {
     /// Gyro rate averaged over the step, in [`GateOptions::gyro_unit`] (rad/s by
     /// default; `None`: not measured).
     pub w_rad_s: Option<[f64; 3]>,
+    /// The measurements of outside effects, as stored ([`RawExternal`]; default none).
+    pub external: RawExternal,
+}
+
+/// The outside measurements of a [`RawSample`] ([`crate::sample::External`]), unchecked;
+/// each given for every sample or none.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RawExternal {
+    /// Inertial position, m.
+    pub position_m: Option<[f64; 3]>,
+    /// Magnetic field, T, body axes.
+    pub field_t: Option<[f64; 3]>,
+    /// External force, N, body axes.
+    pub force_n: Option<[f64; 3]>,
+    /// Commanded magnetic dipole (magnetorquers), A m², body axes: its torque
+    /// `m × B` is added to the known torque (needs the field).
+    pub dipole_am2: Option<[f64; 3]>,
+}
+
+/// Which outside measurement ([`RawExternal`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ExternalKind {
+    /// The position.
+    Position,
+    /// The magnetic field.
+    Field,
+    /// The force.
+    Force,
+    /// The commanded dipole.
+    Dipole,
+}
+
+impl ExternalKind {
+    const ALL: [ExternalKind; 4] = [
+        ExternalKind::Position,
+        ExternalKind::Field,
+        ExternalKind::Force,
+        ExternalKind::Dipole,
+    ];
+
+    /// Its value of `raw`.
+    fn of(self, raw: &RawExternal) -> Option<[f64; 3]> {
+        match self {
+            ExternalKind::Position => raw.position_m,
+            ExternalKind::Field => raw.field_t,
+            ExternalKind::Force => raw.force_n,
+            ExternalKind::Dipole => raw.dipole_am2,
+        }
+    }
+
+    /// Its field, axis `k`.
+    #[must_use]
+    pub fn field(self, k: usize) -> Field {
+        match self {
+            ExternalKind::Position => Field::Position(k),
+            ExternalKind::Field => Field::MagneticField(k),
+            ExternalKind::Force => Field::Force(k),
+            ExternalKind::Dipole => Field::Dipole(k),
+        }
+    }
+
+    fn quantity(self, k: usize) -> Quantity {
+        match self {
+            ExternalKind::Position => Quantity::Position(k),
+            ExternalKind::Field => Quantity::Field(k),
+            ExternalKind::Force => Quantity::Force(k),
+            ExternalKind::Dipole => Quantity::Dipole(k),
+        }
+    }
+
+    /// Name for messages.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            ExternalKind::Position => "positions (r_x,r_y,r_z)",
+            ExternalKind::Field => "magnetic fields (b_x,b_y,b_z)",
+            ExternalKind::Force => "forces (f_x,f_y,f_z)",
+            ExternalKind::Dipole => "commanded dipoles (dipole_x,dipole_y,dipole_z)",
+        }
+    }
 }
 
 /// A value of a sample: what a front end maps to its column, array element or C field.
@@ -98,6 +178,14 @@ pub enum Field {
     Tau(usize),
     /// Gyro rate, axis `0..3`.
     Rate(usize),
+    /// Inertial position, axis `0..3`.
+    Position(usize),
+    /// Magnetic field, axis `0..3`.
+    MagneticField(usize),
+    /// External force, axis `0..3`.
+    Force(usize),
+    /// Commanded magnetic dipole, axis `0..3`.
+    Dipole(usize),
 }
 
 /// Why the gate refused a sample.
@@ -160,6 +248,21 @@ pub enum SampleError {
         /// Whether this sample has them.
         given_here: bool,
     },
+    /// An outside measurement given for some samples and not for others.
+    #[error("{} {} here but {} for the earlier samples: give them for every sample or none", .what.name(), given(*.given_here), given(!*.given_here))]
+    ExternalChanged {
+        /// Which.
+        what: ExternalKind,
+        /// Whether this sample has it.
+        given_here: bool,
+    },
+    /// A commanded dipole without the magnetic field its torque needs.
+    #[error("commanded dipoles (dipole_x,dipole_y,dipole_z) need the magnetic field (b_x,b_y,b_z) for their torque m × B")]
+    DipoleWithoutField,
+    /// Positions with an attitude integrated from the gyro, whose inertial frame is the
+    /// first body frame, not the positions'.
+    #[error("positions (r_x,r_y,r_z) need the attitude in their inertial frame, and without quaternions it is integrated from the gyro in an arbitrary one")]
+    PositionWithoutAttitude,
 }
 
 fn given(yes: bool) -> &'static str {
@@ -181,6 +284,9 @@ impl SampleError {
                 Field::Time
             }
             SampleError::GyroChanged { .. } | SampleError::NoAttitude => Field::Rate(0),
+            SampleError::ExternalChanged { what, .. } => what.field(0),
+            SampleError::DipoleWithoutField => Field::Dipole(0),
+            SampleError::PositionWithoutAttitude => Field::Position(0),
         }
     }
 
@@ -195,6 +301,9 @@ impl SampleError {
             SampleError::NonUniformPeriod { .. } => ErrorKind::NonUniformPeriod,
             SampleError::GyroChanged { .. } => ErrorKind::GyroChanged,
             SampleError::NoAttitude => ErrorKind::NeedsGyro,
+            SampleError::ExternalChanged { .. }
+            | SampleError::DipoleWithoutField
+            | SampleError::PositionWithoutAttitude => ErrorKind::Columns,
         }
     }
 }
@@ -242,6 +351,8 @@ impl ReadStats {
 pub struct Order {
     last_t_s: Option<f64>,
     gyro: Option<bool>,
+    /// Which outside measurements the accepted samples have ([`ExternalKind::ALL`] order).
+    external: Option<[bool; 4]>,
 }
 
 impl Order {
@@ -262,10 +373,31 @@ impl Order {
         Ok(())
     }
 
+    /// Whether a sample with the outside measurements `given` (in [`ExternalKind::ALL`]
+    /// order) may follow the accepted ones.
+    pub(crate) fn check_external(&self, given: [bool; 4]) -> Result<(), SampleError> {
+        if let Some(before) = self.external {
+            for (k, what) in ExternalKind::ALL.into_iter().enumerate() {
+                if before[k] != given[k] {
+                    return Err(SampleError::ExternalChanged {
+                        what,
+                        given_here: given[k],
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Record an accepted sample.
     pub(crate) fn accept(&mut self, t_s: f64, has_gyro: bool) {
         self.last_t_s = Some(t_s);
         self.gyro = Some(has_gyro);
+    }
+
+    /// Record an accepted sample's outside measurements.
+    pub(crate) fn accept_external(&mut self, given: [bool; 4]) {
+        self.external = Some(given);
     }
 
     /// The time of the last accepted sample, s.
@@ -411,7 +543,14 @@ impl Gate {
         if self.options.attitude_from_gyro && w.is_none() {
             return Err(SampleError::NoAttitude);
         }
+        let (external, dipole_torque) = self.external(&raw.external)?;
+        let tau = tau + dipole_torque;
+        for k in 0..3 {
+            value(Field::Tau(k), Quantity::Tau(k), tau[k])?;
+        }
         self.order.check(t_s, w.is_some())?;
+        let given = ExternalKind::ALL.map(|what| what.of(&raw.external).is_some());
+        self.order.check_external(given)?;
         let q = match (self.options.attitude_from_gyro, self.prev_q, self.prev_w) {
             (true, Some(p), Some(pw)) => {
                 let h = t_s - self.order.last_t_s().unwrap_or(t_s);
@@ -420,7 +559,41 @@ impl Gate {
             }
             _ => q,
         };
-        self.accept(t_s, q, renormalised, rho, tau, w)
+        let mut sample = self.accept(t_s, q, renormalised, rho, tau, w)?;
+        self.order.accept_external(given);
+        sample.external = external;
+        Ok(sample)
+    }
+
+    /// The outside measurements checked, and the commanded dipole's torque `m × B`, N m.
+    fn external(&self, raw: &RawExternal) -> Result<(External, Vector3<f64>), SampleError> {
+        let mut v = [None; 4];
+        for (k, what) in ExternalKind::ALL.into_iter().enumerate() {
+            if let Some(x) = what.of(raw) {
+                let mut out = Vector3::zeros();
+                for i in 0..3 {
+                    out[i] = value(what.field(i), what.quantity(i), x[i])?;
+                }
+                v[k] = Some(out);
+            }
+        }
+        let [position_m, field_t, force_n, dipole] = v;
+        if position_m.is_some() && self.options.attitude_from_gyro {
+            return Err(SampleError::PositionWithoutAttitude);
+        }
+        let torque = match (dipole, field_t) {
+            (Some(m), Some(b)) => m.cross(&b),
+            (Some(_), None) => return Err(SampleError::DipoleWithoutField),
+            (None, _) => Vector3::zeros(),
+        };
+        Ok((
+            External {
+                position_m,
+                field_t,
+                force_n,
+            },
+            torque,
+        ))
     }
 
     /// The quaternion of `raw` in this library's convention, and whether it was
@@ -499,6 +672,7 @@ impl Gate {
             rho_nms: if self.options.negate_rho { -rho } else { rho },
             tau_nm: tau,
             omega_rad_s: w,
+            external: External::NONE,
         })
     }
 }

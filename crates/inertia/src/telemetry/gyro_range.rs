@@ -122,6 +122,7 @@ mod tests {
                 rho_nms: Vector3::zeros(),
                 tau_nm: Vector3::zeros(),
                 omega_rad_s: Some(Vector3::new(0.0, 0.0, read(rate))),
+                external: Default::default(),
             });
         }
         g

@@ -135,6 +135,7 @@ mod tests {
                 rho_nms: nalgebra::Vector3::new(k as f64, 0.5, -1.0),
                 tau_nm: nalgebra::Vector3::zeros(),
                 omega_rad_s: None,
+                external: Default::default(),
             })
             .collect()
     }

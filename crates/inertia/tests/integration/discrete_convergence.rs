@@ -156,6 +156,7 @@ mod errors {
             rho_nms: Vector3::zeros(),
             tau_nm: Vector3::zeros(),
             omega_rad_s: Some(Vector3::zeros()),
+            external: Default::default(),
         }
     }
 

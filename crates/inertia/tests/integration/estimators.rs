@@ -269,6 +269,7 @@ fn rotate_body(out: &SimOutput, c: &Matrix3<f64>) -> Vec<Sample> {
             rho_nms: c * s.rho_nms,
             tau_nm: c * s.tau_nm,
             omega_rad_s: s.omega_rad_s.map(|w| c * w),
+            external: Default::default(),
         })
         .collect()
 }

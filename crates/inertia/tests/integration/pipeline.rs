@@ -560,6 +560,7 @@ mod status {
                     rho_nms: nalgebra::Vector3::new(0.01 * t.sin(), 0.0, 0.1),
                     tau_nm: nalgebra::Vector3::zeros(),
                     omega_rad_s: Some(nalgebra::Vector3::new(0.0, 0.0, w)),
+                    external: Default::default(),
                 }
             })
             .collect();

@@ -37,6 +37,7 @@ fn the_shift_reads_rho_later_and_holds_it_at_the_ends() {
             rho_nms: Vector3::new(k as f64, -2.0 * k as f64, 0.5),
             tau_nm: Vector3::zeros(),
             omega_rad_s: None,
+            external: Default::default(),
         })
         .collect();
     shift_rho(&mut s, 0.025);
@@ -137,6 +138,7 @@ fn the_shift_does_not_read_across_a_gap() {
             rho_nms: Vector3::new(if t < 1.0 { 10.0 * t } else { -3.0 }, 0.0, 0.0),
             tau_nm: Vector3::zeros(),
             omega_rad_s: None,
+            external: Default::default(),
         })
         .collect();
     shift_rho(&mut s, 0.15);

@@ -2,6 +2,7 @@
 //! messages, leap seconds.
 
 use super::*;
+use nalgebra::Vector3;
 use std::io::Read;
 
 const HEADER: &str = "t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z";
@@ -125,4 +126,21 @@ fn iso_time_stamps_count_the_leap_second() {
     let text = format!("{HEADER}\n{}\n", row("2016-12-31T12:00:60Z"));
     let e = read(&text).unwrap_err();
     assert!(e.to_string().contains("23:59:60"), "{e}");
+}
+
+#[test]
+fn outside_columns_are_read_and_a_blank_one_is_named() {
+    let text = "t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z,r_x,r_y,r_z,b_x,b_y,b_z,f_x,f_y,f_z\n\
+                0,0,0,0,1,0,0,0,7e6,0,0,1e-5,2e-5,3e-5,0,0,1\n\
+                0.1,0,0,0,1,0,0,0,7e6,1,0,1e-5,2e-5,3e-5,0,0,0\n";
+    let s = read(text).unwrap();
+    assert_eq!(s[1].external.position_m, Some(Vector3::new(7e6, 1.0, 0.0)));
+    assert_eq!(s[0].external.field_t, Some(Vector3::new(1e-5, 2e-5, 3e-5)));
+    assert_eq!(s[0].external.force_n, Some(Vector3::new(0.0, 0.0, 1.0)));
+    let blank = "t,q_x,q_y,q_z,q_w,rho_x,rho_y,rho_z,f_x,f_y,f_z\n\
+                 0,0,0,0,1,0,0,0,0,0,1\n\
+                 0.1,0,0,0,1,0,0,0,,,\n";
+    let e = read(blank).unwrap_err().to_string();
+    assert!(e.contains("f.csv:3: column `f_x`"), "{e}");
+    assert!(e.contains("forces (f_x,f_y,f_z) missing here"), "{e}");
 }

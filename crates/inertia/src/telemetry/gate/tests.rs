@@ -7,6 +7,7 @@ fn raw(t_s: f64) -> RawSample {
         rho_nms: [0.1, 0.0, 0.0],
         tau_nm: None,
         w_rad_s: Some([0.0, 0.01, 0.0]),
+        external: Default::default(),
     }
 }
 
@@ -82,4 +83,45 @@ fn conventions_renormalisation_and_negated_rho() {
     assert_eq!((s.q.s, s.q.v.norm()), (1.0, 0.0));
     assert_eq!(s.rho_nms.x, -0.1);
     assert_eq!(g.stats().renormalised, 1);
+}
+
+#[test]
+fn outside_measurements_are_checked_all_or_none_and_a_dipole_adds_its_torque() {
+    let mut g = Gate::default();
+    let mut r = raw(0.0);
+    r.external.dipole_am2 = Some([1.0, 0.0, 0.0]);
+    assert_eq!(g.check(&r).unwrap_err(), SampleError::DipoleWithoutField);
+    r.external.field_t = Some([0.0, 2e-5, 0.0]);
+    r.tau_nm = Some([0.0, 0.0, 1e-6]);
+    let s = g.check(&r).unwrap();
+    // m × B = x̂ × 2e-5 ŷ = 2e-5 ẑ, added to the known torque.
+    assert!((s.tau_nm - Vector3::new(0.0, 0.0, 2.1e-5)).norm() < 1e-18);
+    assert_eq!(s.external.field_t, Some(Vector3::new(0.0, 2e-5, 0.0)));
+    assert_eq!(s.external.position_m, None);
+    let mut next = raw(0.1);
+    next.external.field_t = Some([0.0, 2e-5, 0.0]);
+    let e = g.check(&next).unwrap_err();
+    assert_eq!(
+        e,
+        SampleError::ExternalChanged {
+            what: ExternalKind::Dipole,
+            given_here: false
+        }
+    );
+    assert_eq!(e.field(), Field::Dipole(0));
+    assert_eq!(e.error_kind(), ErrorKind::Columns);
+    let mut far = raw(0.1);
+    far.external = r.external;
+    far.external.field_t = Some([0.0, 1.0, 0.0]);
+    assert_eq!(g.check(&far).unwrap_err().field(), Field::MagneticField(1));
+    let mut no_attitude = Gate::new(GateOptions {
+        attitude_from_gyro: true,
+        ..GateOptions::default()
+    });
+    let mut p = raw(0.0);
+    p.external.position_m = Some([7e6, 0.0, 0.0]);
+    assert_eq!(
+        no_attitude.check(&p).unwrap_err(),
+        SampleError::PositionWithoutAttitude
+    );
 }
