@@ -501,6 +501,24 @@ pub struct EstimateArgs {
     /// unknown D, N m s, reported; discrete-momentum estimator).
     #[arg(long)]
     pub damping: bool,
+    /// Do not model the gravity-gradient torque from the telemetry's positions
+    /// (r_x,r_y,r_z; modelled by default where given): for a known torque that already
+    /// holds it.
+    #[arg(long)]
+    pub no_gravity_gradient: bool,
+    /// The gravitational parameter μ of the gravity gradient, m³/s² [default: Earth's,
+    /// 3.986004418e14].
+    #[arg(long, value_name = "M3_S2")]
+    pub gravity_mu: Option<f64>,
+    /// Do not estimate a residual magnetic dipole from the telemetry's magnetic field
+    /// (b_x,b_y,b_z; estimated by default where given, reported with σ).
+    #[arg(long)]
+    pub no_residual_dipole: bool,
+    /// Do not estimate the centre of mass from the telemetry's force (f_x,f_y,f_z;
+    /// estimated by default where given, reported with σ, from the origin the known
+    /// torque is taken about).
+    #[arg(long)]
+    pub no_centre_of_mass: bool,
     /// The wheel-speed telemetry's time tag: the speeds are read δ later than their time
     /// stamps. `off` (default), the delay in seconds (e.g. `0.05`; negative: early), or
     /// `estimate` (the residuals' minimum over ±min(0.25 s, a tenth of the record), with

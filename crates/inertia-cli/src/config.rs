@@ -209,6 +209,19 @@ pub fn description(a: &EstimateArgs) -> Result<RunDescription, CliError> {
     options.torque_bias = a.no_torque_bias.then_some(false);
     options.inertial_torque = a.inertial_torque;
     options.damping = a.damping.then_some(true);
+    options.outside = (a.no_gravity_gradient
+        || a.gravity_mu.is_some()
+        || a.no_residual_dipole
+        || a.no_centre_of_mass)
+        .then(|| {
+            let d = inertia::estimator::momentum_rows::OutsideTorques::default();
+            inertia::estimator::momentum_rows::OutsideTorques {
+                gravity_gradient: !a.no_gravity_gradient,
+                gravity_mu_m3_s2: a.gravity_mu.unwrap_or(d.gravity_mu_m3_s2),
+                residual_dipole: !a.no_residual_dipole,
+                centre_of_mass: !a.no_centre_of_mass,
+            }
+        });
     options.wheel_delay = a
         .wheel_delay
         .as_deref()

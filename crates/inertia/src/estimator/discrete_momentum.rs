@@ -11,8 +11,11 @@
 
 use super::augmented_qr::AugmentedQr;
 use super::chain_clock::ChainClock;
+use super::external_torque::{Estimated3, OutsideEstimates};
 use super::jackknife::ChainGroups;
-use super::momentum_rows::{AugmentedRow, MomentumRowSettings, MomentumRows, DAMPING, TORQUE};
+use super::momentum_rows::{
+    AugmentedRow, MomentumRowSettings, MomentumRows, CENTRE_OF_MASS, DAMPING, DIPOLE, TORQUE,
+};
 
 use crate::tensor::InertiaVector;
 
@@ -189,6 +192,8 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     epoch: u64,
     /// Whether the chain in progress has had its initial momenta counted.
     chain_counted: bool,
+    /// Whether the residual dipole's and the centre of mass's unknowns are counted.
+    external_counted: [bool; 2],
     /// At the last solve, the torque test ([`torque_tested`]).
     torque_test: Option<TorqueTest>,
     last: Option<Estimate>,
@@ -228,6 +233,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             last_block_t_s: None,
             epoch: 0,
             chain_counted: false,
+            external_counted: [false; 2],
             torque_test: None,
             last: None,
         })
@@ -280,6 +286,8 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let (ea, eb) = (a.clock.epoch(source), b.clock.epoch(source));
         a.before_fold(ea, t_s);
         b.before_fold(eb, t_s);
+        a.count_external(row);
+        b.count_external(row);
         AugmentedQr::add_pair(
             (&mut a.qr, a.groups.as_mut().map(ChainGroups::chain_mut)),
             (&mut b.qr, b.groups.as_mut().map(ChainGroups::chain_mut)),
@@ -289,8 +297,24 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
 
     fn fold_row(&mut self, row: &AugmentedRow, epoch: u64, t_s: f64) {
         self.before_fold(epoch, t_s);
+        self.count_external(row);
         self.qr
             .add(row, self.groups.as_mut().map(ChainGroups::chain_mut));
+    }
+
+    /// The outside torques' unknowns count from the first row block that uses them
+    /// ([`super::external_torque`]).
+    fn count_external(&mut self, row: &AugmentedRow) {
+        for (counted, uses) in self
+            .external_counted
+            .iter_mut()
+            .zip(row.external_unknowns())
+        {
+            if uses && !*counted {
+                self.qr.add_nuisance(3);
+                *counted = true;
+            }
+        }
     }
 
     /// A new chain's bookkeeping and forgetting, before a row block at `t_s` is folded.
@@ -503,6 +527,67 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
                 (l, k) => l.or(k),
             };
             (self.qr.nuisance_at(j)[DAMPING], sigma)
+        })
+    }
+
+    /// The outside torques at the answer `e` (this estimator's or one made of its
+    /// rows): whether the gravity gradient entered this estimator's own rows, and the
+    /// residual dipole and centre of mass where the rows use them. Their σ: the larger of
+    /// the least-squares σ (every unknown free) and the jackknife σ, as [`Self::damping_at`]'s,
+    /// and, in quadrature, the part of `e`'s σ beyond its noise (discretisation bias,
+    /// model spread, consider parameters) carried through `∂x/∂j`: `x` is linear in `j`
+    /// at the least-squares optimum of the other unknowns. `None` without a `j`.
+    #[must_use]
+    pub(crate) fn outside_at(&self, e: &super::Estimate) -> Option<OutsideEstimates> {
+        let j = e.j()?;
+        let x = self.qr.nuisance_at(&j);
+        // The part of σ beyond the noise, per element of j.
+        let beyond: [f64; 6] = e.uncertainty.map_or([0.0; 6], |u| {
+            core::array::from_fn(|k| {
+                let (t, n) = (u.sigma_kg_m2[k], u.noise_kg_m2[k]);
+                crate::math::sqrt((t * t - n * n).max(0.0))
+            })
+        });
+        let sensitivity: [_; 6] = core::array::from_fn(|k| {
+            let mut jk = j;
+            jk[k] += 1.0;
+            self.qr.nuisance_at(&jk) - x
+        });
+        let [dipole, centre] = self.external_counted;
+        let block = |used: bool, column: usize| {
+            used.then(|| {
+                let shared = column - super::unknowns::FIRST_SHARED;
+                let sigma = [0, 1, 2].map(|i| {
+                        let ls = self.qr.shared().marginal_sigma(shared + i);
+                        let jackknife = self
+                            .groups
+                            .as_ref()
+                            .filter(|_| self.jackknife_in_sigma)
+                            .and_then(|g| g.nuisance_sigma(&self.constraints, shared + i));
+                        let noise = match (ls, jackknife) {
+                            (Some(l), Some(k)) => Some(l.max(k)),
+                            (l, k) => l.or(k),
+                        }?;
+                        let carried: f64 = (0..6)
+                            .map(|k| sensitivity[k][column + i] * beyond[k])
+                            .map(|v| v * v)
+                            .sum();
+                        Some(crate::math::sqrt(noise * noise + carried))
+                    });
+                let sigma = match sigma {
+                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+                    _ => None,
+                };
+                Estimated3 {
+                    value: [x[column], x[column + 1], x[column + 2]],
+                    sigma,
+                }
+            })
+        };
+        Some(OutsideEstimates {
+            gravity_gradient: self.source.gravity_gradient(),
+            residual_dipole_am2: block(dipole, DIPOLE),
+            centre_of_mass_m: block(centre, CENTRE_OF_MASS),
         })
     }
 

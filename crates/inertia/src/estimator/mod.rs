@@ -22,6 +22,7 @@ pub mod consistency;
 pub mod discrete_momentum;
 #[cfg(feature = "std")]
 pub mod excitation;
+pub mod external_torque;
 pub(crate) mod jackknife;
 pub mod momentum;
 pub mod momentum_rows;

@@ -75,6 +75,8 @@ use crate::discrete_momentum::IntervalMomentum;
 use crate::sample::{is_gap, Sample};
 use nalgebra::{Matrix3, Matrix3x6, SMatrix, Vector3};
 
+pub use super::external_torque::OutsideTorques;
+use super::external_torque::TorqueMaps;
 use super::unknowns::Block;
 pub(crate) use super::unknowns::UNKNOWNS;
 /// Column of the first initial-momentum unknown.
@@ -87,6 +89,10 @@ pub(crate) const TORQUE: usize = Block::BodyTorque.column();
 pub(crate) const KAPPA: usize = Block::Kappa.column();
 /// Column of the damping coefficient `D` ([`MomentumRowSettings::damping`]).
 pub(crate) const DAMPING: usize = Block::Damping.column();
+/// Column of the residual magnetic dipole `m` ([`MomentumRowSettings::residual_dipole`]).
+pub(crate) const DIPOLE: usize = Block::Dipole.column();
+/// Column of the centre of mass `c` ([`MomentumRowSettings::centre_of_mass`]).
+pub(crate) const CENTRE_OF_MASS: usize = Block::CentreOfMass.column();
 /// Column of `j`.
 pub(crate) const J: usize = Block::J.column();
 
@@ -204,6 +210,9 @@ pub struct MomentumRowSettings {
     /// Estimate a linear damping torque `−D ω` (air drag; module docs, "Damping";
     /// default `false`).
     pub damping: bool,
+    /// The torques of outside measurements the rows model where the samples give them
+    /// ([`super::external_torque`]; default: every one).
+    pub outside: OutsideTorques,
     /// Longest chain, s (the first `super::jackknife::MIN_GROUPS` chains a quarter of
     /// it): a chain is split (its initial momentum becomes a new unknown) once it spans
     /// this long, so that a slowly drifting attitude error (a gyro-propagated attitude's
@@ -221,6 +230,7 @@ impl Default for MomentumRowSettings {
             torque_bias: true,
             inertial_torque: false,
             damping: false,
+            outside: OutsideTorques::default(),
             max_chain_s: None,
         }
     }
@@ -303,7 +313,8 @@ impl MomentumRowSettings {
         self.anchors_per_chain() * (1 + usize::from(self.inertial_torque))
     }
 
-    /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`, `D`).
+    /// Unknowns besides `j` shared by every chain (`τ_b`, `κ`, `D`; the outside torques'
+    /// `m` and `c` count from the first row that uses them, [`AugmentedRow::external_unknowns`]).
     #[must_use]
     pub(crate) fn shared_nuisance(&self) -> usize {
         let torque = if self.torque_bias { 3 } else { 0 };
@@ -332,6 +343,16 @@ pub(crate) struct AugmentedRow {
     pub(crate) trend_s: f64,
 }
 
+impl AugmentedRow {
+    /// The outside torques' unknowns the block uses: `m` and `c` (3 each) where their
+    /// columns are not zero ([`super::external_torque`]).
+    #[must_use]
+    pub(crate) fn external_unknowns(&self) -> [bool; 2] {
+        let uses = |c: usize| (0..3).any(|i| (0..3).any(|k| self.a[(i, c + k)] != 0.0));
+        [uses(DIPOLE), uses(CENTRE_OF_MASS)]
+    }
+}
+
 /// A plain row's parts, kept for the Richardson combination.
 #[derive(Debug, Clone, Copy)]
 struct Plain {
@@ -345,6 +366,8 @@ struct Plain {
     si: f64,
     /// `W_k = Σ h̄_m C_m ω̂_m` to the same node: the damping's coefficient.
     w: Vector3<f64>,
+    /// The outside torques' impulse sums to the same node.
+    e: TorqueMaps,
 }
 
 /// A node as the rows need it.
@@ -359,6 +382,8 @@ struct Node {
     /// The body rate at the node from its two intervals' rotations, once it is interior
     /// (with [`MomentumRowSettings::damping`] only).
     omega_hat: Option<Vector3<f64>>,
+    /// The outside torques' maps at the node, inertial frame (`C P`), where any applies.
+    maps: Option<TorqueMaps>,
 }
 
 /// The row source.
@@ -384,16 +409,21 @@ pub(crate) struct MomentumRows {
     si: f64,
     /// `W` of the unit-step grid (the damping's impulse per N m s).
     w: Vector3<f64>,
+    /// The outside torques' impulse sums of the unit-step grid.
+    e: TorqueMaps,
     /// The same per parity of the stride-2 subgrid.
     s2: [Matrix3<f64>; 2],
     t2: [Vector3<f64>; 2],
     si2: [f64; 2],
     w2: [Vector3<f64>; 2],
+    e2: [TorqueMaps; 2],
     prev: Option<Plain>,
     /// The gyro's angle increment over the previous interval (coning term).
     alpha_prev: Option<Vector3<f64>>,
     epoch: u64,
     gaps: usize,
+    /// Whether a node had a gravity-gradient map.
+    gravity: bool,
 }
 
 #[cfg_attr(not(feature = "std"), allow(dead_code))]
@@ -412,14 +442,17 @@ impl MomentumRows {
             t: Vector3::zeros(),
             si: 0.0,
             w: Vector3::zeros(),
+            e: TorqueMaps::ZERO,
             s2: [Matrix3::zeros(); 2],
             t2: [Vector3::zeros(); 2],
             si2: [0.0; 2],
             w2: [Vector3::zeros(); 2],
+            e2: [TorqueMaps::ZERO; 2],
             prev: None,
             alpha_prev: None,
             epoch: 0,
             gaps: 0,
+            gravity: false,
         }
     }
 
@@ -442,6 +475,13 @@ impl MomentumRows {
         self.gaps
     }
 
+    /// Whether the gravity-gradient torque entered the rows (a sample with a position,
+    /// the torque on).
+    #[must_use]
+    pub(crate) fn gravity_gradient(&self) -> bool {
+        self.gravity
+    }
+
     /// Time of the chain's first node, s.
     #[must_use]
     pub(crate) fn chain_start_s(&self) -> f64 {
@@ -461,6 +501,7 @@ impl MomentumRows {
         *self = Self {
             epoch: self.epoch + u64::from(had_rows),
             gaps: self.gaps,
+            gravity: self.gravity,
             ..Self::new(self.settings)
         };
         if let Some(n) = first {
@@ -473,14 +514,16 @@ impl MomentumRows {
     /// Feed a sample; the row block it completes, if any.
     pub(crate) fn push(&mut self, s: &Sample) -> Result<Option<AugmentedRow>, RowError> {
         check_unit(&s.q, 2)?;
+        let c = s.q.to_matrix();
         let node = Node {
             t_s: s.t_s,
             q: s.q,
-            c: s.q.to_matrix(),
+            c,
             rho_nms: s.rho_nms,
             tau_nm: s.tau_nm,
             omega_rad_s: s.omega_rad_s,
             omega_hat: None,
+            maps: TorqueMaps::at(&c, &s.external, &self.settings.outside).map(|m| m.rotated(&c)),
         };
         let finite = |v: &Vector3<f64>| v.iter().all(|x| x.is_finite());
         if !finite(&node.rho_nms) {
@@ -493,6 +536,7 @@ impl MomentumRows {
                 what: "known torque",
             });
         }
+        self.gravity |= node.maps.is_some_and(|m| m.j != TorqueMaps::ZERO.j);
         let Some(b) = self.nodes[2] else {
             self.restart(Some(node));
             return Ok(None);
@@ -539,6 +583,9 @@ impl MomentumRows {
             self.s += b.c * hbar;
             self.t += b.c * b.tau_nm * hbar;
             self.si += hbar;
+            if let Some(maps) = &b.maps {
+                self.e = self.e.add_scaled(maps, hbar);
+            }
             if self.settings.damping {
                 // The rate at b interpolated between its two intervals' mean rates; a
                 // rotation vector is the same in both ends' body axes.
@@ -557,6 +604,7 @@ impl MomentumRows {
             s: self.s,
             si: self.si,
             w: self.w,
+            e: self.e,
         };
         let f_prev = self.f_last;
         self.t_older_s = [self.t_older_s[1], self.nodes[0].map(|n| n.t_s)];
@@ -568,7 +616,7 @@ impl MomentumRows {
             return Ok(Some(self.assemble(
                 &plain.m.a,
                 &plain.rhs,
-                (&plain.s, plain.si, &plain.w),
+                (&plain.s, plain.si, &plain.w, &plain.e),
                 ANCHOR0,
                 1.0 / h,
             )));
@@ -591,6 +639,9 @@ impl MomentumRows {
                 if let Some(omega) = cm1.omega_hat {
                     self.w2[parity] += cm1.c * omega * hbar2;
                 }
+                if let Some(maps) = &cm1.maps {
+                    self.e2[parity] = self.e2[parity].add_scaled(maps, hbar2);
+                }
             }
         }
         let h2 = node.t_s - cm1.t_s;
@@ -609,12 +660,16 @@ impl MomentumRows {
         let s = (prev.s + plain.s) * w - self.s2[parity] * v;
         let si = (prev.si + plain.si) * w - self.si2[parity] * v;
         let wd = (prev.w + plain.w) * w - self.w2[parity] * v;
+        let e = prev
+            .e
+            .add_scaled(&plain.e, 1.0)
+            .combine(w, &self.e2[parity], -v);
         let anchor = if parity == 0 { ANCHOR0 } else { ANCHOR1 };
         let (h0, h1) = (b.t_s - cm1.t_s, node.t_s - b.t_s);
         let c0 = 4.0 / (3.0 * h0) - 2.0 / (3.0 * h2);
         let c1 = 4.0 / (3.0 * h1) - 2.0 / (3.0 * h2);
         let noise_s = 0.25 * (c0 * c0 * h0 + c1 * c1 * h1);
-        let mut row = self.assemble(&a, &rhs, (&s, si, &wd), anchor, noise_s);
+        let mut row = self.assemble(&a, &rhs, (&s, si, &wd, &e), anchor, noise_s);
         if self.settings.stencil == Stencil::Adaptive {
             // Every ρ̄ of the stencil moves by κ Δ²ρ_c (h̄² times the second divided
             // difference at c): the κ column is minus the stencil's b for ρ̄ := Δ²ρ_c.
@@ -634,7 +689,7 @@ impl MomentumRows {
         &self,
         a: &Matrix3x6<f64>,
         rhs: &Vector3<f64>,
-        (s, si, wd): (&Matrix3<f64>, f64, &Vector3<f64>),
+        (s, si, wd, e): (&Matrix3<f64>, f64, &Vector3<f64>, &TorqueMaps),
         anchor: usize,
         noise_s: f64,
     ) -> AugmentedRow {
@@ -648,7 +703,12 @@ impl MomentumRows {
         if self.settings.damping {
             out.fixed_view_mut::<3, 1>(0, DAMPING).copy_from(wd);
         }
-        out.fixed_view_mut::<3, 6>(0, J).copy_from(a);
+        // The outside torques' impulses (module `external_torque`): zero where none applies.
+        out.fixed_view_mut::<3, 3>(0, DIPOLE)
+            .copy_from(&(-e.dipole));
+        out.fixed_view_mut::<3, 3>(0, CENTRE_OF_MASS)
+            .copy_from(&(-e.centre_of_mass));
+        out.fixed_view_mut::<3, 6>(0, J).copy_from(&(a - e.j));
         AugmentedRow {
             a: out,
             b: *rhs,

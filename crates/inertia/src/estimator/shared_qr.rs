@@ -1,5 +1,5 @@
 //! The least-squares state in the unknowns every chain of discrete momentum rows shares,
-//! `y = [τ_b; κ; D; j]` (`SHARED` = 11, [`super::momentum_rows`]), the chains' initial
+//! `y = [τ_b; κ; m; c; D; j]` (`SHARED` = 17, [`super::momentum_rows`]), the chains' initial
 //! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
 //! folded by Householder reflections, one per pivot for each 3-row block
 //! (the crate's `householder` module; the factor of paper eqs. 60–61 up to rounding).
@@ -115,13 +115,13 @@ impl SharedQr {
         let (mut a, mut beta) = block;
         // Unrolled: each reflection's loops get fixed lengths (4 % faster on the
         // 1M-sample run than the loop over pivots).
-        const _: () = assert!(SHARED == 11, "one literal per pivot below");
+        const _: () = assert!(SHARED == 17, "one literal per pivot below");
         macro_rules! one {
             ($($i:literal)*) => {$(
                 reflect(&mut self.rt, &mut self.z, &mut a, &mut beta, $i);
             )*};
         }
-        one!(0 1 2 3 4 5 6 7 8 9 10);
+        one!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16);
         self.count(y, &beta, noise_s);
     }
 
@@ -135,14 +135,14 @@ impl SharedQr {
         y: &[f64; 3],
         noise_s: f64,
     ) {
-        const _: () = assert!(SHARED == 11, "one literal per pivot below");
+        const _: () = assert!(SHARED == 17, "one literal per pivot below");
         macro_rules! both {
             ($($i:literal)*) => {$(
                 reflect(&mut s.rt, &mut s.z, &mut a, &mut beta, $i);
                 reflect(&mut o.rt, &mut o.z, &mut a2, &mut beta2, $i);
             )*};
         }
-        both!(0 1 2 3 4 5 6 7 8 9 10);
+        both!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16);
         s.count(y, &beta, noise_s);
         o.count(y, &beta2, noise_s);
     }

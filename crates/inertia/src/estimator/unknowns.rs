@@ -2,8 +2,8 @@
 //! blocks: the layout of `x` is this list, and every column index follows from it.
 //!
 //! ```text
-//! x = [ X₀ (3) │ X₁ (3) │ τ_b (3) │ κ (1) │ D (1) │ j (6) ]
-//!       ╰── per chain ──╯ ╰─────── shared by every chain ───────╯
+//! x = [ X₀ (3) │ X₁ (3) │ τ_b (3) │ κ (1) │ m (3) │ c (3) │ D (1) │ j (6) ]
+//!       ╰── per chain ──╯ ╰─────────────── shared by every chain ──────────────╯
 //! ```
 //!
 //! * **Per chain** ([`Scope::Chain`]): unknowns of one chain of rows, minimised out as the
@@ -13,7 +13,9 @@
 //!   factor is the reduced problem in `j` alone.
 //!
 //! A block a row model does not use keeps its columns at zero (the factor skips a zero
-//! pivot), and is not counted as an unknown ([`super::momentum_rows::MomentumRowSettings::shared_nuisance`]).
+//! pivot), and is not counted as an unknown ([`super::momentum_rows::MomentumRowSettings::shared_nuisance`];
+//! the outside torques' blocks `m` and `c` count from the first row that uses them,
+//! [`super::external_torque`]).
 //!
 //! Adding a physical unknown is one entry in [`Block::ALL`] with its width, scope and
 //! name; the rows that fill its columns ([`super::momentum_rows`]); the setting that
@@ -41,6 +43,11 @@ pub(crate) enum Block {
     BodyTorque,
     /// `κ`: the wheel-momentum curvature coefficient of the adaptive stencil.
     Kappa,
+    /// `m`: a residual magnetic dipole fixed in the body, A m² ([`super::external_torque`]).
+    Dipole,
+    /// `c`: the centre of mass from the known torque's origin, body axes, m
+    /// ([`super::external_torque`]).
+    CentreOfMass,
     /// `D`: the coefficient of a linear damping torque `−D ω` (air drag), N m s.
     Damping,
     /// `j = [J11, J22, J33, J12, J13, J23]`, kg m².
@@ -49,11 +56,13 @@ pub(crate) enum Block {
 
 impl Block {
     /// Every block, in column order: per-chain blocks first, `j` last.
-    pub(crate) const ALL: [Block; 6] = [
+    pub(crate) const ALL: [Block; 8] = [
         Block::Anchor0,
         Block::Anchor1,
         Block::BodyTorque,
         Block::Kappa,
+        Block::Dipole,
+        Block::CentreOfMass,
         Block::Damping,
         Block::J,
     ];
@@ -62,7 +71,11 @@ impl Block {
     #[must_use]
     pub(crate) const fn width(self) -> usize {
         match self {
-            Block::Anchor0 | Block::Anchor1 | Block::BodyTorque => 3,
+            Block::Anchor0
+            | Block::Anchor1
+            | Block::BodyTorque
+            | Block::Dipole
+            | Block::CentreOfMass => 3,
             Block::Kappa | Block::Damping => 1,
             Block::J => 6,
         }
@@ -73,7 +86,12 @@ impl Block {
     pub(crate) const fn scope(self) -> Scope {
         match self {
             Block::Anchor0 | Block::Anchor1 => Scope::Chain,
-            Block::BodyTorque | Block::Kappa | Block::Damping | Block::J => Scope::Shared,
+            Block::BodyTorque
+            | Block::Kappa
+            | Block::Dipole
+            | Block::CentreOfMass
+            | Block::Damping
+            | Block::J => Scope::Shared,
         }
     }
 
@@ -86,6 +104,8 @@ impl Block {
             Block::Anchor1 => "initial momentum (odd subgrid)",
             Block::BodyTorque => "body-frame torque",
             Block::Kappa => "wheel-momentum curvature",
+            Block::Dipole => "residual magnetic dipole",
+            Block::CentreOfMass => "centre of mass",
             Block::Damping => "damping",
             Block::J => "inertia",
         }

@@ -33,6 +33,7 @@ pub struct PipelineConfig {
     pub(crate) torque_bias: bool,
     pub(crate) inertial_torque: InertialTorque,
     pub(crate) damping: bool,
+    pub(crate) outside: crate::estimator::momentum_rows::OutsideTorques,
     pub(crate) max_chain_s: Option<f64>,
     pub(crate) attitude_drift_deg_rth: Option<f64>,
     pub(crate) glitches: GlitchPolicy,
@@ -116,6 +117,7 @@ impl PipelineConfig {
             InertialTorque::Off
         };
         self.damping = r.damping;
+        self.outside = r.outside;
         self.pinned_chain_s = Some(r.max_chain_s);
         self
     }

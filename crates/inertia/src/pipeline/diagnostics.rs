@@ -8,6 +8,7 @@
 use crate::estimator::consistency::Worst;
 use crate::estimator::discrete_momentum::TorqueTest;
 use crate::estimator::excitation::Excitation;
+use crate::estimator::external_torque::OutsideEstimates;
 use crate::estimator::momentum_rows::MomentumRowSettings;
 use nalgebra::Vector3;
 
@@ -27,6 +28,10 @@ pub struct Diagnostics {
     /// The estimated damping coefficient `D` of a torque `−D ω`, N m s, and its
     /// least-squares σ, where estimated ([`super::PipelineSettings::damping`]).
     pub damping_nms: Option<(f64, Option<f64>)>,
+    /// The torques of outside measurements: whether the gravity gradient was modelled,
+    /// the residual dipole and the centre of mass with their σ, where the rows model any
+    /// ([`crate::estimator::external_torque`]).
+    pub outside: Option<OutsideEstimates>,
     /// The test for a constant disturbance torque at the last solve, where made: whether
     /// the torque was held at zero for want of evidence
     /// ([`crate::estimator::discrete_momentum::torque_tested`]).

@@ -143,6 +143,11 @@ pub struct Report {
     /// Its least-squares σ, N m s (white-noise σ; only with `damping` on).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub damping_sigma_nms: Option<f64>,
+    /// The torques of outside measurements: whether the gravity gradient was modelled,
+    /// the residual magnetic dipole (A m²) and the centre of mass (m) with their σ (only
+    /// where the telemetry gives positions, the field or a force).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outside: Option<crate::estimator::external_torque::OutsideEstimates>,
     /// The test for that torque: `chi2`, and whether it was held at zero for want of
     /// evidence (`held_at_zero`; then `torque_bias_nm` is `null`).
     pub torque_test: Option<crate::estimator::discrete_momentum::TorqueTest>,
@@ -400,6 +405,7 @@ impl Report {
             torque_bias_nm: None,
             damping_nms: None,
             damping_sigma_nms: None,
+            outside: None,
             torque_test: None,
             active_bounds: estimate
                 .j()
@@ -614,6 +620,7 @@ impl Report {
         self.torque_bias_nm = d.torque_bias_nm.map(|t| [t.x, t.y, t.z]);
         self.damping_nms = d.damping_nms.map(|d| d.0);
         self.damping_sigma_nms = d.damping_nms.and_then(|d| d.1);
+        self.outside = d.outside;
         self.torque_test = d.torque_test;
         self.attitude_is_gyro_integral = d.attitude_is_gyro_integral;
         self.drift_weighted = d.drift_weighted;

@@ -5,7 +5,7 @@ use super::config::{InertialTorque, PipelineConfig};
 use super::error::PipelineError;
 use super::registry;
 use crate::constraints::ConstraintSet;
-use crate::estimator::momentum_rows::{RhoModel, RotationSource};
+use crate::estimator::momentum_rows::{OutsideTorques, RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
 use crate::estimator::wheel_delay::{self, WheelDelay};
 use crate::telemetry::glitch::GlitchPolicy;
@@ -67,6 +67,11 @@ pub struct PipelineSettings {
     /// momentum estimator; default `false`): one more shared unknown `D`, N m s
     /// ([`crate::estimator::momentum_rows`], "Damping").
     pub damping: bool,
+    /// The torques of outside measurements (positions, magnetic field, force) the
+    /// discrete momentum rows model where the telemetry gives them: gravity gradient,
+    /// a residual magnetic dipole, the centre of mass (default: each one;
+    /// [`crate::estimator::external_torque`]).
+    pub outside: OutsideTorques,
     /// Short momentum chain, s (discrete momentum estimator): bounds how far a
     /// drifting attitude error can rotate the conserved momentum
     /// ([`crate::estimator::momentum_rows::MomentumRowSettings::max_chain_s`]). Chains
@@ -121,6 +126,7 @@ impl Default for PipelineSettings {
             torque_bias: true,
             inertial_torque: InertialTorque::Short,
             damping: false,
+            outside: OutsideTorques::default(),
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
             glitches: GlitchPolicy::Stop,
@@ -249,6 +255,7 @@ impl PipelineSettings {
                     ),
                 ),
                 ("damping", self.damping != defaults.damping),
+                ("outside", self.outside != defaults.outside),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
                 (
                     "attitude_drift_deg_rth",
@@ -280,6 +287,13 @@ impl PipelineSettings {
                     expected: "a finite time tag within the search's ±MAX_HALF_RANGE_S (0.25 s)",
                 });
             }
+        }
+        if !self.outside.valid() {
+            return Err(PipelineError::InvalidSetting {
+                field: "outside.gravity_mu_m3_s2",
+                value: self.outside.gravity_mu_m3_s2,
+                expected: "finite and > 0",
+            });
         }
         let constraints = self.constraints.validate()?;
         // The observability thresholds are checked by the estimators' own settings.
@@ -315,6 +329,7 @@ impl PipelineSettings {
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
             damping: self.damping,
+            outside: self.outside,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift_deg_rth,
             glitches: self.glitches,

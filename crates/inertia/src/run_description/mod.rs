@@ -27,7 +27,7 @@ pub use file::RunFileError;
 pub use values::{Bounds, ElementBound, Fraction, InertiaInput, PriorSigma};
 
 use crate::constraints::{Consistency, ConstraintSet, ProductConvention};
-use crate::estimator::momentum_rows::{RhoModel, RotationSource};
+use crate::estimator::momentum_rows::{OutsideTorques, RhoModel, RotationSource};
 use crate::estimator::wheel_delay::WheelDelay;
 use crate::pipeline::{InertialTorque, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 use crate::telemetry::gate::{GyroUnit, QuaternionFormat};
@@ -136,6 +136,10 @@ description! {
         inertial_torque: InertialTorque,
         /// A linear damping torque −D ω as an unknown (`--damping`).
         damping: bool,
+        /// The torques of outside measurements modelled (a table: `gravity_gradient`,
+        /// `gravity_mu_m3_s2`, `residual_dipole`, `centre_of_mass`; `--no-gravity-gradient`,
+        /// `--gravity-mu`, `--no-residual-dipole`, `--no-centre-of-mass`).
+        outside: OutsideTorques,
         /// The wheel-speed time tag (`--wheel-delay`).
         #[serde(default, deserialize_with = "values::wheel_delay")]
         wheel_delay: WheelDelay,
@@ -233,6 +237,7 @@ impl RunDescription {
             torque_bias: self.torque_bias.unwrap_or(d.torque_bias),
             inertial_torque: self.inertial_torque.unwrap_or(d.inertial_torque),
             damping: self.damping.unwrap_or(d.damping),
+            outside: self.outside.unwrap_or(d.outside),
             max_chain_s: (chain != 0.0).then_some(chain),
             attitude_drift_deg_rth: self.attitude_drift,
             glitches: self.glitches.unwrap_or(d.glitches),

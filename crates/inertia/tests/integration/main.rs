@@ -21,6 +21,7 @@ mod gyro_range;
 mod inertial_torque;
 mod lab_realism;
 mod numeric_range;
+mod outside_torques;
 mod pipeline;
 mod prior;
 mod rotor_inertia;

@@ -7,6 +7,7 @@
 
 use super::*;
 use crate::estimator as est;
+use crate::estimator::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
 
 /// The batch reduction: the reduced problem in `j` and what goes with it.
 #[derive(Debug, Clone, PartialEq)]
@@ -155,6 +156,15 @@ pub(crate) fn reduce_batch(
     let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
     let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
     let mut nuisance = settings.shared_nuisance() as f64;
+    // The outside torques' unknowns, where the rows use them (as the recursive path).
+    for block in [DIPOLE, CENTRE_OF_MASS] {
+        if shared_columns
+            .iter()
+            .any(|k| (block..block + 3).contains(k))
+        {
+            nuisance += 3.0;
+        }
+    }
     for chain in &chains {
         nuisance += settings.nuisance_per_chain() as f64;
         let (block, (r, e, m)) = reduce_chain(&chain.iter().collect::<Vec<_>>());

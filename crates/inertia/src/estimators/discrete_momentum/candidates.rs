@@ -64,6 +64,7 @@ pub(super) fn candidates(c: &PipelineConfig, has_gyro: bool) -> Vec<MomentumRowS
                         torque_bias: c.torque_bias,
                         inertial_torque,
                         damping: c.damping,
+                        outside: c.outside,
                         max_chain_s,
                     });
                 }

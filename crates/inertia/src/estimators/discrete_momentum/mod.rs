@@ -51,6 +51,7 @@ use crate::estimator::attitude_drift::AttitudeDrift;
 use crate::estimator::consistency::{self, ResidualSegments};
 use crate::estimator::discrete_momentum::{DiscreteMomentumEstimator, MomentumEstimatorSettings};
 use crate::estimator::excitation::diagnose;
+use crate::estimator::external_torque::OutsideEstimates;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::{Estimate, EstimatorError};
@@ -118,6 +119,8 @@ struct DiscreteMomentum {
     density_ratio: Option<f64>,
     /// The damping at the last answer with its widened σ ([`finish`]).
     damping: Option<(f64, Option<f64>)>,
+    /// The outside torques at the last answer, with its σ carried.
+    outside: Option<OutsideEstimates>,
     /// Input samples so far.
     samples: usize,
     /// Samples that completed a row block (the cross-check's clock).
@@ -179,6 +182,7 @@ impl DiscreteMomentum {
             residuals: Vec::new(),
             density_ratio: None,
             damping: None,
+            outside: None,
             samples: 0,
             blocks: 0,
             first_t_s: None,
@@ -398,6 +402,7 @@ impl DiscreteMomentum {
             self.density_ratio = density_ratio;
             self.damping = damping;
         }
+        self.outside = self.candidates[self.chosen].outside_at(&e);
         Ok(Some(e))
     }
 
@@ -487,6 +492,14 @@ impl Estimator for DiscreteMomentum {
             row_model: chosen.map(|c| *c.row_settings()),
             torque_bias_nm: chosen.and_then(|c| c.torque_bias_nm()),
             damping_nms: g.damping,
+            outside: g
+                .outside
+                .map(|o| OutsideEstimates {
+                    // The rows' sources, which the candidates may share, saw the positions.
+                    gravity_gradient: self.sources.iter().any(|s| s.rows.gravity_gradient()),
+                    ..o
+                })
+                .filter(OutsideEstimates::any),
             torque_test: chosen.and_then(|c| c.torque_test()),
             residual_consistency: g.residuals.get(g.chosen).and_then(|r| r.worst()),
             gyro_density_ratio: g.density_ratio,

@@ -245,6 +245,9 @@ impl fmt::Display for ReportText<'_> {
                 None => writeln!(s, "unknown damping −D ω: D = {d:.3e} N m s")?,
             }
         }
+        if let Some(o) = &r.outside {
+            outside_lines(s, o)?;
+        }
         match r.drift_weighted {
             Some(true) => writeln!(
                 s,
@@ -304,4 +307,40 @@ impl fmt::Display for ReportText<'_> {
         }
         Ok(())
     }
+}
+
+/// The report's lines on the torques of outside measurements.
+fn outside_lines(
+    s: &mut fmt::Formatter<'_>,
+    o: &crate::estimator::external_torque::OutsideEstimates,
+) -> fmt::Result {
+    use crate::estimator::external_torque::Estimated3;
+    if o.gravity_gradient {
+        writeln!(
+            s,
+            "gravity gradient: modelled from the positions (r_x,r_y,r_z)"
+        )?;
+    }
+    let vector = |s: &mut fmt::Formatter<'_>, what: &str, e: &Estimated3, unit: &str| {
+        let [x, y, z] = e.value;
+        match e.sigma {
+            Some([a, b, c]) => writeln!(
+                s,
+                "{what} = [{x:.4e}, {y:.4e}, {z:.4e}] ± [{a:.1e}, {b:.1e}, {c:.1e}] {unit}"
+            ),
+            None => writeln!(s, "{what} = [{x:.4e}, {y:.4e}, {z:.4e}] {unit}"),
+        }
+    };
+    if let Some(m) = &o.residual_dipole_am2 {
+        vector(s, "residual magnetic dipole m (body axes)", m, "A m²")?;
+    }
+    if let Some(c) = &o.centre_of_mass_m {
+        vector(
+            s,
+            "centre of mass c (body axes, from the known torque's origin)",
+            c,
+            "m",
+        )?;
+    }
+    Ok(())
 }
