@@ -28,9 +28,9 @@ pub struct Cli {
 pub enum Command {
     /// Simulate telemetry of one of the paper's scenarios (§VI) into a CSV file, with the
     /// true inertia beside it (FILE.truth.json).
-    Simulate(SimulateArgs),
+    Simulate(Box<SimulateArgs>),
     /// Estimate the inertia from a telemetry CSV file.
-    Estimate(EstimateArgs),
+    Estimate(Box<EstimateArgs>),
     /// Reproduce the paper's numerical examples on built-in simulated data: figures 1-10
     /// (PNG and SVG), their data (CSV) and summary.md.
     Reproduce(ReproduceArgs),
@@ -277,6 +277,48 @@ pub struct SimulateArgs {
     /// Air drag: an unknown torque −D·ω with this D, N m s [default: 0, or the preset's].
     #[arg(long, value_name = "NMS")]
     pub drag_nms: Option<f64>,
+    /// A constant magnetic field fixed in the inertial frame, T, e.g. `2e-5:0:-3e-5`: the
+    /// field of the magnetic options (without it they need --gravity-gradient-altitude-km
+    /// and use Earth's centred dipole along the inertial z axis, B0 = 3.12e-5 T). With a
+    /// field the magnetometer's reading is written as extra columns b_x,b_y,b_z (T, body
+    /// axes).
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub magnetic_field_t: Option<String>,
+    /// Residual magnetic dipole, A m², body axes: an unknown torque m × B (not in tau_*).
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub residual_dipole_am2: Option<String>,
+    /// Magnetorquers: a commanded dipole of this amplitude, A m², on each body axis (sine
+    /// waves of periods 50, 70 and 90 s); its torque m × B with the measured field is added
+    /// to tau_*.
+    #[arg(long, value_name = "AM2", allow_hyphen_values = true)]
+    pub magnetorquer_am2: Option<f64>,
+    /// Magnetometer white noise, T per axis and sample [default: 1e-7].
+    #[arg(long, value_name = "T")]
+    pub magnetometer_noise_t: Option<f64>,
+    /// Magnetometer bias, T, body axes [default: 0].
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub magnetometer_bias_t: Option<String>,
+    /// Thrusters of this thrust, N: six in pairs at --thruster-arm-m from the origin
+    /// (torques ±arm·thrust about x, y, z in turn; forces along +z, +x, +y), firing one at
+    /// a time a smooth 4 s pulse every 10 s from 5 s. Their torque about the origin is
+    /// added to tau_*, the force written as extra columns f_x,f_y,f_z (N, body axes).
+    #[arg(long, value_name = "N")]
+    pub thrusters: Option<f64>,
+    /// The thrusters' distance from the origin, m.
+    #[arg(long, value_name = "M", default_value_t = 0.3, requires = "thrusters")]
+    pub thruster_arm_m: f64,
+    /// The true centre of mass, m, body axes, from the origin tau_* is taken about: the
+    /// thrusters' unknown torque −c × F [default: 0].
+    #[arg(
+        long,
+        value_name = "X:Y:Z",
+        allow_hyphen_values = true,
+        requires = "thrusters"
+    )]
+    pub centre_of_mass_m: Option<String>,
+    /// White noise of the written force, N per axis and sample [default: 0].
+    #[arg(long, value_name = "N", requires = "thrusters")]
+    pub force_noise_n: Option<f64>,
     /// Gyro vibration at the rotor frequency (rotor speed |ρ|/rotor spin inertia):
     /// amplitude per body axis, rad/s [default: 0, or the preset's].
     #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]

@@ -1,9 +1,13 @@
 //! `inertia simulate`.
 //!
 //! The paper's scenarios or a spacecraft preset, with the library's realism settings
-//! (`inertia::sim::Realism`) from the command line. With gravity gradient on, the CSV
-//! gets three extra columns `r_x,r_y,r_z`: the orbit position in the inertial frame, m,
-//! at each sample (ignored by `estimate`, which reads columns by name). With a spacecraft
+//! (`inertia::sim::Realism`) from the command line. The outside measurements go to
+//! extra columns (`inertia::telemetry::csv::ExternalColumns`), read back by the CSV
+//! reader: with gravity gradient on `r_x,r_y,r_z`, the orbit position in the inertial
+//! frame, m; with a magnetic field `b_x,b_y,b_z`, the magnetometer's reading, T, body
+//! axes (a magnetorquer's torque with that field is in `tau_*`); with thrusters
+//! `f_x,f_y,f_z`, their force, N, body axes (their torque about the origin is in
+//! `tau_*`). With a spacecraft
 //! file (`--spacecraft`), the rotors' speed columns replace `rho_*`
 //! (`inertia::sim::rotors`). With `--commands PLAN.csv` (an `inertia plan` profile) the
 //! spacecraft starts at rest and flies those wheel torque commands instead of the
@@ -22,8 +26,11 @@ use inertia::plan::CommandProfile;
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{AttitudeSource, CommandHold, Orbit, SimConfig, SimOutput, MAX_SAMPLES};
-use inertia::telemetry::csv::{write_samples, write_samples_with, write_samples_with_speeds};
+use inertia::sim::{
+    AttitudeSource, CommandHold, Environment, Magnetic, Magnetorquer, Orbit, SimConfig, SimOutput,
+    Thrusters, MAX_SAMPLES,
+};
+use inertia::telemetry::csv::{write_samples_external, write_samples_with_speeds, ExternalColumns};
 use inertia::text::Num;
 use nalgebra::Vector3;
 use std::io::Write;
@@ -267,6 +274,7 @@ fn settings(
     if let Some(d) = a.drag_nms {
         r.environment.damping_nms = d;
     }
+    magnetic_and_thrusters(a, &mut r.environment)?;
     if let Some(v) = vector("--gyro-vibration-rad-s", &a.gyro_vibration_rad_s)? {
         r.vibration.amplitude_rad_s = v;
     }
@@ -279,30 +287,63 @@ fn settings(
     Ok((sc, common))
 }
 
+/// The magnetic options and the thrusters' (after the orbit's).
+fn magnetic_and_thrusters(a: &SimulateArgs, env: &mut Environment) -> Result<(), CliError> {
+    let field = vector("--magnetic-field-t", &a.magnetic_field_t)?;
+    let residual = vector("--residual-dipole-am2", &a.residual_dipole_am2)?;
+    let bias = vector("--magnetometer-bias-t", &a.magnetometer_bias_t)?;
+    let any = field.is_some()
+        || residual.is_some()
+        || a.magnetorquer_am2.is_some()
+        || a.magnetometer_noise_t.is_some()
+        || bias.is_some();
+    if any {
+        let mut m = match field {
+            Some(b) => Magnetic::constant(b),
+            None if env.orbit.is_some() => Magnetic::dipole(),
+            None => {
+                return Err(input(
+                    "the magnetic options need a field: --gravity-gradient-altitude-km (Earth's dipole field on that orbit) or --magnetic-field-t",
+                ))
+            }
+        };
+        m.residual_dipole_am2 = residual.unwrap_or_default();
+        m.magnetorquer = a.magnetorquer_am2.map(Magnetorquer::sine);
+        if let Some(s) = a.magnetometer_noise_t {
+            m.magnetometer.noise_t = s;
+        }
+        if let Some(b) = bias {
+            m.magnetometer.bias_t = b;
+        }
+        env.magnetic = Some(m);
+    }
+    if let Some(thrust) = a.thrusters {
+        let mut t = Thrusters::cube_pairs(thrust, a.thruster_arm_m);
+        if let Some(c) = vector("--centre-of-mass-m", &a.centre_of_mass_m)? {
+            t.centre_of_mass_m = c;
+        }
+        if let Some(s) = a.force_noise_n {
+            t.force_noise_n = s;
+        }
+        env.thrusters = Some(t);
+    }
+    Ok(())
+}
+
 /// The rotors' speed columns and values of a spacecraft file.
 type Speeds = (Vec<String>, Vec<f64>);
 
-/// Write the telemetry CSV, with the orbit position columns when there is an orbit and the
-/// rotors' speed columns instead of `rho_*` when there is a spacecraft file.
+/// Write the telemetry CSV, with the outside measurements' columns (`r_*` with an orbit,
+/// `b_*` with a magnetic field, `f_*` with thrusters) and the rotors' speed columns
+/// instead of `rho_*` when there is a spacecraft file.
 fn write_csv(w: &mut dyn Write, out: &SimOutput, speeds: Option<&Speeds>) -> std::io::Result<()> {
-    let position = |s: &inertia::sample::Sample| -> Vec<f64> {
-        out.orbit
-            .map(|o| o.position_m(s.t_s).as_slice().to_vec())
-            .unwrap_or_default()
-    };
-    let orbit_columns: &[&str] = if out.orbit.is_some() {
-        &["r_x", "r_y", "r_z"]
-    } else {
-        &[]
-    };
-    match (speeds, out.orbit) {
-        (Some((names, values)), _) => {
-            write_samples_with_speeds(w, &out.samples, names, values, (orbit_columns, &position))
+    match speeds {
+        Some((names, values)) => {
+            let cols = ExternalColumns::of(&out.samples);
+            let values_of = |s: &inertia::sample::Sample| cols.values(s);
+            write_samples_with_speeds(w, &out.samples, names, values, (&cols.names(), &values_of))
         }
-        (None, None) => write_samples(w, &out.samples),
-        (None, Some(orbit)) => write_samples_with(w, &out.samples, ["r_x", "r_y", "r_z"], |s| {
-            orbit.position_m(s.t_s).into()
-        }),
+        None => write_samples_external(w, &out.samples),
     }
 }
 
@@ -425,6 +466,15 @@ fn option_of(field: &str) -> Option<&'static str> {
         "environment.constant_torque_nm" => "--constant-torque-nm",
         "environment.inertial_torque_nm" => "--inertial-torque-nm",
         "environment.damping_nms" => "--drag-nms",
+        "environment.magnetic.field" => "--magnetic-field-t",
+        "environment.magnetic.residual_dipole_am2" => "--residual-dipole-am2",
+        "environment.magnetic.magnetorquer.amplitude_am2" => "--magnetorquer-am2",
+        "environment.magnetic.magnetometer.noise_t" => "--magnetometer-noise-t",
+        "environment.magnetic.magnetometer.bias_t" => "--magnetometer-bias-t",
+        "environment.thrusters.units.thrust_n" => "--thrusters",
+        "environment.thrusters.units.position_m" => "--thruster-arm-m",
+        "environment.thrusters.centre_of_mass_m" => "--centre-of-mass-m",
+        "environment.thrusters.force_noise_n" => "--force-noise-n",
         "vibration.amplitude_rad_s" => "--gyro-vibration-rad-s",
         "vibration.rotor_spin_inertia_kg_m2" => "--rotor-spin-inertia-kg-m2",
         _ => return None,

@@ -6,6 +6,8 @@ mod bad_inputs;
 mod plan;
 #[path = "cli/settings_file.rs"]
 mod settings_file;
+#[path = "cli/simulate_effects.rs"]
+mod simulate_effects;
 #[path = "cli/simulate_options.rs"]
 mod simulate_options;
 #[path = "cli/spacecraft.rs"]

@@ -1,6 +1,8 @@
-//! Unknown environmental torques: gravity gradient on a circular orbit, a constant
-//! body-frame disturbance, a constant inertial-frame torque and linear air drag. None is
-//! written to `tau_nm` (the known torque); the orbit
+//! Environmental torques: gravity gradient on a circular orbit, a constant body-frame
+//! disturbance, a constant inertial-frame torque and linear air drag, all unknown; the
+//! magnetic field with the spacecraft's dipoles, and thrusters off the centre of mass,
+//! partly known (below). None of the first four is written to `tau_nm` (the known
+//! torque); the orbit
 //! is returned with the run ([`super::SimOutput::orbit`]) so that a user can compute the
 //! gravity-gradient torque.
 //!
@@ -33,7 +35,22 @@
 //! **Air drag** ([`Environment::damping_nms`]): a torque opposing the body rate,
 //! `τ_B = −D ω` (D in N m s per rad, the linear term of the drag of a tumbling body at
 //! low rates).
+//!
+//! **Magnetic torques** ([`Environment::magnetic`], [`super::magnetic`]): the residual
+//! dipole's `m_res × B_B` is unknown; the magnetorquers' `m_cmd × B` is reported in
+//! `tau_nm` with the measured field.
+//!
+//! **Thrusters** ([`Environment::thrusters`], [`super::thrusters`]): their torque about the
+//! origin `Σ r_i × F_i` is reported in `tau_nm`; the rest of their torque about the
+//! centre of mass, `−c × F`, is unknown.
+//!
+//! [`Environment::torque_nm`] is the unknown torque; [`Environment::actuator_torque_nm`]
+//! the actuators' torque that telemetry reports (with the true field), and
+//! [`Environment::total_torque_nm`] their sum, what acts on the body besides the
+//! scenario's known torque and the white disturbance.
 
+use super::magnetic::Magnetic;
+use super::thrusters::Thrusters;
 use super::SimError;
 use crate::attitude::Quaternion;
 use crate::sim::sensors::DEG;
@@ -153,7 +170,8 @@ pub fn gravity_gradient_torque_nm(
     rb.cross(&(j * rb)) * (3.0 * EARTH_MU_M3_S2 / (r * r * r))
 }
 
-/// Unknown environmental torques. `Default`: none.
+/// The environment: unknown torques, the magnetic field and the thrusters. `Default`:
+/// none.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Environment {
     /// The orbit; gravity gradient acts when set.
@@ -164,6 +182,11 @@ pub struct Environment {
     pub inertial_torque_nm: Vector3<f64>,
     /// Linear drag coefficient D of the torque `−D ω`, N m s (≥ 0; 0 = none).
     pub damping_nms: f64,
+    /// The magnetic field, the dipoles and the magnetometer (`None`: no field, no
+    /// `external.field_t`).
+    pub magnetic: Option<Magnetic>,
+    /// Thrusters and the centre of mass (`None`: none, no `external.force_n`).
+    pub thrusters: Option<Thrusters>,
 }
 
 impl Environment {
@@ -174,12 +197,74 @@ impl Environment {
             || self.constant_torque_nm != Vector3::zeros()
             || self.inertial_torque_nm != Vector3::zeros()
             || self.damping_nms != 0.0
+            || self.magnetic.is_some()
+            || self.thrusters.is_some()
     }
 
     /// The unknown torque at `t_s` on a body of inertia `j` at attitude `q` (body →
-    /// inertial) turning at `omega_rad_s` (body axes), N m, body axes.
+    /// inertial) turning at `omega_rad_s` (body axes), N m, body axes: gravity gradient,
+    /// the constant, inertial and drag torques, the residual dipole's `m_res × B_B` and
+    /// the thrusters' `−c × F`.
     #[must_use]
     pub fn torque_nm(
+        &self,
+        t_s: f64,
+        q: &Quaternion,
+        omega_rad_s: &Vector3<f64>,
+        j: &Matrix3<f64>,
+    ) -> Vector3<f64> {
+        let mut tau = self.classic_torque_nm(t_s, q, omega_rad_s, j);
+        if let Some(m) = &self.magnetic {
+            let b = m.field_body_t(self.orbit.as_ref(), t_s, q);
+            tau += m.residual_dipole_am2.cross(&b);
+        }
+        if let Some(th) = &self.thrusters {
+            tau -= th.centre_of_mass_m.cross(&th.force_n(t_s));
+        }
+        tau
+    }
+
+    /// The actuators' torque that telemetry reports, at `t_s` and attitude `q`, N m, body
+    /// axes: the magnetorquers' `m_cmd × B_B` with the **true** field (the telemetry uses
+    /// the measured one) and the thrusters' `Σ r_i × F_i` about the origin.
+    #[must_use]
+    pub fn actuator_torque_nm(&self, t_s: f64, q: &Quaternion) -> Vector3<f64> {
+        let mut tau = Vector3::zeros();
+        if let Some(m) = &self.magnetic {
+            let b = m.field_body_t(self.orbit.as_ref(), t_s, q);
+            tau += m.commanded_dipole_am2(t_s).cross(&b);
+        }
+        if let Some(th) = &self.thrusters {
+            tau += th.force_and_torque(t_s).1;
+        }
+        tau
+    }
+
+    /// Everything this environment applies to the body, N m, body axes:
+    /// [`Self::torque_nm`] + [`Self::actuator_torque_nm`] (the magnetic torque
+    /// `(m_res + m_cmd) × B_B`, the thrusters' torque about the centre of mass).
+    #[must_use]
+    pub fn total_torque_nm(
+        &self,
+        t_s: f64,
+        q: &Quaternion,
+        omega_rad_s: &Vector3<f64>,
+        j: &Matrix3<f64>,
+    ) -> Vector3<f64> {
+        let mut tau = self.classic_torque_nm(t_s, q, omega_rad_s, j);
+        if let Some(m) = &self.magnetic {
+            let b = m.field_body_t(self.orbit.as_ref(), t_s, q);
+            tau += (m.residual_dipole_am2 + m.commanded_dipole_am2(t_s)).cross(&b);
+        }
+        if let Some(th) = &self.thrusters {
+            tau += th.torque_about_com_nm(t_s);
+        }
+        tau
+    }
+
+    /// Gravity gradient, the constant and inertial torques and drag.
+    #[must_use]
+    fn classic_torque_nm(
         &self,
         t_s: f64,
         q: &Quaternion,
@@ -222,6 +307,12 @@ impl Environment {
                 value: self.damping_nms,
                 why: "must be finite and >= 0",
             });
+        }
+        if let Some(m) = &self.magnetic {
+            m.validate(self.orbit.as_ref())?;
+        }
+        if let Some(t) = &self.thrusters {
+            t.validate()?;
         }
         Ok(())
     }

@@ -21,19 +21,22 @@
 //! controller rate ([`commands`]); wheel telemetry skew, scale error, misalignment, noise
 //! and quantisation, wheel speeds held at their own rate ([`wheels`]); gyro vibration at
 //! the rotor frequency ([`vibration`]); gravity-gradient, constant body-frame and
-//! inertial-frame unknown torques and air drag ([`environment`]); telemetry decimation;
+//! inertial-frame unknown torques and air drag ([`environment`]); Earth's magnetic field
+//! with a residual and a commanded dipole and a magnetometer ([`magnetic`]); thrusters
+//! off the centre of mass ([`thrusters`]); telemetry decimation;
 //! spacecraft presets, among them a hand-thrown lab device ([`presets`]). The loop is in
 //! [`run`].
 //!
 //! Noise streams (ChaCha8 seeded with [`SimConfig::seed`]), one per source so that
 //! turning one effect on leaves the others' noise unchanged: 0 disturbance torque,
 //! 1 gyro angle random walk, 2 star tracker, 3 wheel telemetry noise, 4 gyro bias
-//! instability.
+//! instability, 5 magnetometer, 6 force sensor.
 
 pub mod commands;
 pub mod control;
 pub mod environment;
 pub mod gyro;
+pub mod magnetic;
 pub mod mekf;
 pub mod presets;
 pub mod realism;
@@ -42,16 +45,19 @@ pub mod run;
 pub mod scenario;
 pub mod sensors;
 pub mod star_tracker;
+pub mod thrusters;
 pub mod vibration;
 pub mod wheels;
 
 pub use commands::CommandHold;
 pub use environment::{Environment, Orbit};
 pub use gyro::GyroErrors;
+pub use magnetic::{FieldModel, Magnetic, Magnetometer, Magnetorquer};
 pub use mekf::MekfSettings;
 pub use realism::{AttitudeSource, Realism};
 pub use run::simulate;
 pub use star_tracker::StarTracker;
+pub use thrusters::{Firing, Thruster, Thrusters};
 pub use vibration::RotorVibration;
 pub use wheels::WheelTelemetry;
 

@@ -10,9 +10,11 @@
 
 use super::commands::Ticker;
 use super::gyro::Gyro;
+use super::magnetic::MagnetometerNoise;
 use super::mekf::Mekf;
 use super::sensors::{self, DEG};
 use super::star_tracker::StarTrackerNoise;
+use super::thrusters::ForceSensor;
 use super::vibration::RotorAngle;
 use super::wheels::{RhoHistory, RhoSpan, WheelSensor};
 use super::{
@@ -21,7 +23,7 @@ use super::{
 };
 use crate::attitude::Quaternion;
 use crate::dynamics::{rk4_step, GyrostatState};
-use crate::sample::Sample;
+use crate::sample::{External, Sample};
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -65,6 +67,12 @@ pub fn simulate(
     let skewed = skew != 0.0;
     let env = re.environment;
     let env_on = env.is_active();
+    let mut magnetometer = env
+        .magnetic
+        .map(|m| MagnetometerNoise::new(&m.magnetometer, cfg.seed));
+    let mut force_sensor = env
+        .thrusters
+        .map(|t| ForceSensor::new(t.force_noise_n, cfg.seed));
     let vibration = re.vibration;
     let vibrating = vibration.is_active();
     let mut rotor = RotorAngle::default();
@@ -128,17 +136,22 @@ pub fn simulate(
             } else {
                 x_b.rho_nms
             };
+            let (tau_nm, external) = node_telemetry(
+                &env,
+                t_b,
+                &x_b,
+                known_torque.eval(t_b, &x_b),
+                magnetometer.as_mut(),
+                force_sensor.as_mut(),
+            );
             open = Some((
                 Sample {
                     t_s: t_b,
                     q: q_tel,
                     rho_nms: rho,
-                    tau_nm: known_torque.eval(t_b, &x_b),
+                    tau_nm,
                     omega_rad_s: None,
-                    external: crate::sample::External {
-                        position_m: env.orbit.map(|o| o.position_m(t_b)),
-                        ..crate::sample::External::NONE
-                    },
+                    external,
                 },
                 None,
             ));
@@ -233,7 +246,10 @@ pub fn simulate(
                     };
                     let tau = known_torque.eval(tt, xx) + d - jdot * xx.omega_rad_s;
                     if env_on {
-                        (rd, tau + env.torque_nm(tt, &xx.q, &xx.omega_rad_s, &jm))
+                        (
+                            rd,
+                            tau + env.total_torque_nm(tt, &xx.q, &xx.omega_rad_s, &jm),
+                        )
                     } else {
                         (rd, tau)
                     }
@@ -353,6 +369,38 @@ pub fn simulate(
         orbit: env.orbit,
         filter,
     })
+}
+
+/// The known torque and the outside measurements of the telemetry node at `t_s` in the
+/// true state `x`, given the scenario's known torque `known_nm`: the magnetorquers'
+/// torque with the measured field and the thrusters' torque about the origin are added
+/// to it ([`super::magnetic`], [`super::thrusters`]).
+fn node_telemetry(
+    env: &super::Environment,
+    t_s: f64,
+    x: &GyrostatState,
+    known_nm: Vector3<f64>,
+    magnetometer: Option<&mut MagnetometerNoise>,
+    force_sensor: Option<&mut ForceSensor>,
+) -> (Vector3<f64>, External) {
+    let mut tau = known_nm;
+    let mut external = External {
+        position_m: env.orbit.map(|o| o.position_m(t_s)),
+        ..External::NONE
+    };
+    if let (Some(m), Some(sensor)) = (&env.magnetic, magnetometer) {
+        let measured = sensor.measure(&m.field_body_t(env.orbit.as_ref(), t_s, &x.q));
+        if let Some(torquer) = &m.magnetorquer {
+            tau += torquer.dipole_am2(t_s).cross(&measured);
+        }
+        external.field_t = Some(measured);
+    }
+    if let (Some(th), Some(sensor)) = (&env.thrusters, force_sensor) {
+        let (force, torque) = th.force_and_torque(t_s);
+        tau += torque;
+        external.force_n = Some(sensor.measure(&force));
+    }
+    (tau, external)
 }
 
 /// Fill the pending ρ requests with times up to `upto_s`.

@@ -668,4 +668,7 @@ mod write;
 
 pub use error::TelemetryError;
 
-pub use write::{write_samples, write_samples_with, write_samples_with_speeds, ExtraColumns};
+pub use write::{
+    write_samples, write_samples_external, write_samples_with, write_samples_with_speeds,
+    ExternalColumns, ExtraColumns,
+};

@@ -27,6 +27,7 @@ mod prior;
 mod rotor_inertia;
 mod rotor_scale;
 mod short_records;
+mod sim_effects;
 mod sim_realism;
 mod solver_agreement;
 mod solver_random;

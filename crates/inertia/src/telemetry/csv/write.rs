@@ -23,6 +23,73 @@ pub fn write_samples_with<W: std::io::Write, const N: usize>(
 /// Extra columns: their names, and their values for a sample.
 pub type ExtraColumns<'a> = (&'a [&'a str], &'a dyn Fn(&Sample) -> Vec<f64>);
 
+/// The outside measurements ([`crate::sample::External`]) that every sample of a record
+/// has, as the reader's columns: `r_x,r_y,r_z` (position), `b_x,b_y,b_z` (magnetic
+/// field), `f_x,f_y,f_z` (force), in that order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExternalColumns {
+    position: bool,
+    field: bool,
+    force: bool,
+}
+
+impl ExternalColumns {
+    /// The measurements every one of `samples` has (none for no samples).
+    #[must_use]
+    pub fn of(samples: &[Sample]) -> Self {
+        let all = |f: fn(&Sample) -> bool| !samples.is_empty() && samples.iter().all(f);
+        Self {
+            position: all(|s| s.external.position_m.is_some()),
+            field: all(|s| s.external.field_t.is_some()),
+            force: all(|s| s.external.force_n.is_some()),
+        }
+    }
+
+    /// The column names.
+    #[must_use]
+    pub fn names(&self) -> Vec<&'static str> {
+        let mut v = Vec::new();
+        for (on, names) in [
+            (self.position, ["r_x", "r_y", "r_z"]),
+            (self.field, ["b_x", "b_y", "b_z"]),
+            (self.force, ["f_x", "f_y", "f_z"]),
+        ] {
+            if on {
+                v.extend(names);
+            }
+        }
+        v
+    }
+
+    /// The values of `s` in the columns' order (zeros where `s` lacks one).
+    #[must_use]
+    pub fn values(&self, s: &Sample) -> Vec<f64> {
+        let e = &s.external;
+        let mut v = Vec::new();
+        for (on, x) in [
+            (self.position, e.position_m),
+            (self.field, e.field_t),
+            (self.force, e.force_n),
+        ] {
+            if on {
+                v.extend(x.unwrap_or_default().iter());
+            }
+        }
+        v
+    }
+}
+
+/// [`write_samples`] with the outside measurements every sample has as the extra columns
+/// of [`ExternalColumns`], so that the reader reads back what was written.
+pub fn write_samples_external<W: std::io::Write>(
+    out: W,
+    samples: &[Sample],
+) -> std::io::Result<()> {
+    let cols = ExternalColumns::of(samples);
+    let names = cols.names();
+    write_columns(out, samples, true, &names, |k| cols.values(&samples[k]))
+}
+
 /// [`write_samples_with`] for a spacecraft file's rotors: the rotors' speed columns
 /// `names` (valued `speeds`, one row of `names.len()` per sample, flat) instead of the
 /// `rho_*` columns, then the `extra` columns.
