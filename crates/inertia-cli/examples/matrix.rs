@@ -67,6 +67,11 @@
 //! the momentum RLS and the filtered equation-error baseline; their table follows the main
 //! one (cells whose label contains the filter; `throw` selects only them).
 //!
+//! **Outside-torque cells** (`matrix_outside/outside.rs`): gravity gradient, a residual
+//! magnetic dipole and thrusters with the centre of mass off the origin, each modelled
+//! (the samples carry the orbit position, the field, the force) and left out, beside the
+//! effect-free cell; their table follows (`outside` selects only them).
+//!
 //! The environment variable `CHAIN=S` sets the discrete momentum estimator's `--chain`
 //! (`0`: none) for experiments; unset, the default; `INERTIAL_TORQUE=off|on|auto|short` its
 //! `--inertial-torque` (unset: the default, `short`); `DAMPING=1` its `--damping`. `DIGITS=1` prints the medians with
@@ -92,6 +97,8 @@ use std::time::{Duration, Instant};
 
 #[path = "matrix_lab/lab.rs"]
 mod lab;
+#[path = "matrix_outside/outside.rs"]
+mod outside;
 
 /// The discrete momentum estimator's `--inertial-torque` from `INERTIAL_TORQUE`
 /// (unset or not a mode, or another estimator: the default).
@@ -666,12 +673,21 @@ fn main() {
                 .is_none_or(|f| c.label.to_lowercase().contains(f))
         })
         .count();
-    if cells.is_empty() && lab_cells == 0 {
+    let outside_cells = outside::cells()
+        .iter()
+        .filter(|c| {
+            filter
+                .as_deref()
+                .is_none_or(|f| c.label.to_lowercase().contains(f))
+        })
+        .count();
+    if cells.is_empty() && lab_cells == 0 && outside_cells == 0 {
         eprintln!("no cell label contains {:?}", filter.unwrap_or_default());
         std::process::exit(2);
     }
     if cells.is_empty() {
         lab::table(seeds, filter.as_deref());
+        outside::table(seeds, filter.as_deref());
         return;
     }
     eprintln!(
@@ -766,6 +782,7 @@ fn main() {
     }
     let busy: f64 = runs.iter().flat_map(|r| r.seconds).sum();
     lab::table(seeds, filter.as_deref());
+    outside::table(seeds, filter.as_deref());
     println!();
     println!(
         "{} cells × {seeds} seeds per cell; wall time {} on {} threads ({:.2} thread-s in the runs).",

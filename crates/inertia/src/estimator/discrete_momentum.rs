@@ -558,22 +558,22 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             used.then(|| {
                 let shared = column - super::unknowns::FIRST_SHARED;
                 let sigma = [0, 1, 2].map(|i| {
-                        let ls = self.qr.shared().marginal_sigma(shared + i);
-                        let jackknife = self
-                            .groups
-                            .as_ref()
-                            .filter(|_| self.jackknife_in_sigma)
-                            .and_then(|g| g.nuisance_sigma(&self.constraints, shared + i));
-                        let noise = match (ls, jackknife) {
-                            (Some(l), Some(k)) => Some(l.max(k)),
-                            (l, k) => l.or(k),
-                        }?;
-                        let carried: f64 = (0..6)
-                            .map(|k| sensitivity[k][column + i] * beyond[k])
-                            .map(|v| v * v)
-                            .sum();
-                        Some(crate::math::sqrt(noise * noise + carried))
-                    });
+                    let ls = self.qr.shared().marginal_sigma(shared + i);
+                    let jackknife = self
+                        .groups
+                        .as_ref()
+                        .filter(|_| self.jackknife_in_sigma)
+                        .and_then(|g| g.nuisance_sigma(&self.constraints, shared + i));
+                    let noise = match (ls, jackknife) {
+                        (Some(l), Some(k)) => Some(l.max(k)),
+                        (l, k) => l.or(k),
+                    }?;
+                    let carried: f64 = (0..6)
+                        .map(|k| sensitivity[k][column + i] * beyond[k])
+                        .map(|v| v * v)
+                        .sum();
+                    Some(crate::math::sqrt(noise * noise + carried))
+                });
                 let sigma = match sigma {
                     [Some(a), Some(b), Some(c)] => Some([a, b, c]),
                     _ => None,
