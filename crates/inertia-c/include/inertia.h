@@ -290,6 +290,51 @@ typedef struct InertiaSample {
   uint8_t has_w;
 } InertiaSample;
 
+// Measurements of what acts from outside at one sample (`inertia_estimator_push_external`):
+// each read only where its `has_` flag is non-zero, and then given for every sample.
+// With them the default estimator models the gravity gradient (`r_m`), estimates a
+// residual magnetic dipole (`b_t`) and the centre of mass (`f_n`; `tau_nm` then about
+// the body frame's origin), and adds a commanded dipole's torque `m × B` to the known
+// torque (`dipole_am2`, needs `b_t`).
+typedef struct InertiaExternal {
+  // Position of the centre of mass in the attitude's inertial frame (the orbit), m.
+  double r_m[3];
+  // Magnetic field, T, body axes.
+  double b_t[3];
+  // External force (thrusters), N, body axes.
+  double f_n[3];
+  // Commanded magnetic dipole, A m², body axes.
+  double dipole_am2[3];
+  // Non-zero when `r_m` holds a position.
+  uint8_t has_r;
+  // Non-zero when `b_t` holds a field.
+  uint8_t has_b;
+  // Non-zero when `f_n` holds a force.
+  uint8_t has_f;
+  // Non-zero when `dipole_am2` holds a commanded dipole.
+  uint8_t has_dipole;
+} InertiaExternal;
+
+// What the estimator made of the outside measurements at its last estimate
+// (`inertia_estimator_outside`): each vector with its σ per component, valid where its
+// `has_` flag is non-zero.
+typedef struct InertiaOutside {
+  // The residual magnetic dipole, A m², body axes.
+  double dipole_am2[3];
+  // Its σ, A m².
+  double dipole_sigma_am2[3];
+  // The centre of mass, m, body axes from the known torque's origin.
+  double centre_of_mass_m[3];
+  // Its σ, m.
+  double centre_of_mass_sigma_m[3];
+  // Non-zero when the gravity-gradient torque was modelled.
+  uint8_t gravity_gradient;
+  // Non-zero when the dipole (and its σ) were estimated.
+  uint8_t has_dipole;
+  // Non-zero when the centre of mass (and its σ) were estimated.
+  uint8_t has_centre_of_mass;
+} InertiaOutside;
+
 // The current estimate.
 typedef struct InertiaEstimate {
   // Status of the estimate.
@@ -374,6 +419,25 @@ enum InertiaStatus inertia_estimator_init(void *storage,
 // used concurrently; `sample` is NULL or points to an `InertiaSample`.
 enum InertiaStatus inertia_estimator_push(struct InertiaEstimator *est,
                                           const struct InertiaSample *sample);
+
+// `inertia_estimator_push` with the sample's outside measurements (`external` NULL: none,
+// as `inertia_estimator_push`). Each measurement is given for every sample or none; a
+// refused sample leaves the estimator as it was.
+//
+// # Safety
+// As `inertia_estimator_push`; `external` is NULL or points to an `InertiaExternal`.
+enum InertiaStatus inertia_estimator_push_external(struct InertiaEstimator *est,
+                                                   const struct InertiaSample *sample,
+                                                   const struct InertiaExternal *external);
+
+// Copy what the estimator made of the outside measurements into `*out` (all flags zero
+// before an estimate, or for estimators that do not model them).
+//
+// # Safety
+// `est` is NULL or a live estimator; `out` is NULL or points to writable storage for an
+// `InertiaOutside`.
+enum InertiaStatus inertia_estimator_outside(const struct InertiaEstimator *est,
+                                             struct InertiaOutside *out);
 
 // Copy the current estimate into `*out` (status `INERTIA_ESTIMATE_STATUS_NONE` before
 // the first).

@@ -113,6 +113,15 @@ impl Engine {
         Ok(())
     }
 
+    /// The outside torques at the last estimate (the pipeline's discrete momentum
+    /// estimator only).
+    pub(crate) fn outside(&self) -> Option<inertia::estimator::external_torque::OutsideEstimates> {
+        match self {
+            Engine::Pipeline { pipeline, .. } => pipeline.diagnostics().outside,
+            Engine::Variational(_) | Engine::FiniteDifference(_) => None,
+        }
+    }
+
     pub(crate) fn needs_gyro(&self) -> bool {
         match self {
             Engine::Pipeline { pipeline, .. } => {

@@ -13,7 +13,7 @@ use inertia::error_kind::ErrorKind;
 use inertia::estimator::Estimate;
 use inertia::fix::Fix;
 use inertia::pipeline::{check_first_step, Pipeline};
-use inertia::telemetry::gate::{Field, Gate, RawSample, SampleError};
+use inertia::telemetry::gate::{Field, Gate, RawExternal, RawSample, SampleError};
 
 /// One telemetry sample at time `t_s` (README "Estimating your own telemetry").
 #[repr(C)]
@@ -33,6 +33,45 @@ pub struct InertiaSample {
     pub w_rad_s: [f64; 3],
     /// Non-zero when `w_rad_s` holds a gyro rate. Use the same for every sample.
     pub has_w: u8,
+}
+
+/// Measurements of what acts from outside at one sample (`inertia_estimator_push_external`):
+/// each read only where its `has_` flag is non-zero, and then given for every sample.
+/// With them the default estimator models the gravity gradient (`r_m`), estimates a
+/// residual magnetic dipole (`b_t`) and the centre of mass (`f_n`; `tau_nm` then about
+/// the body frame's origin), and adds a commanded dipole's torque `m × B` to the known
+/// torque (`dipole_am2`, needs `b_t`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InertiaExternal {
+    /// Position of the centre of mass in the attitude's inertial frame (the orbit), m.
+    pub r_m: [f64; 3],
+    /// Magnetic field, T, body axes.
+    pub b_t: [f64; 3],
+    /// External force (thrusters), N, body axes.
+    pub f_n: [f64; 3],
+    /// Commanded magnetic dipole, A m², body axes.
+    pub dipole_am2: [f64; 3],
+    /// Non-zero when `r_m` holds a position.
+    pub has_r: u8,
+    /// Non-zero when `b_t` holds a field.
+    pub has_b: u8,
+    /// Non-zero when `f_n` holds a force.
+    pub has_f: u8,
+    /// Non-zero when `dipole_am2` holds a commanded dipole.
+    pub has_dipole: u8,
+}
+
+impl InertiaExternal {
+    fn raw(&self) -> RawExternal {
+        let given = |flag: u8, v: [f64; 3]| (flag != 0).then_some(v);
+        RawExternal {
+            position_m: given(self.has_r, self.r_m),
+            field_t: given(self.has_b, self.b_t),
+            force_n: given(self.has_f, self.f_n),
+            dipole_am2: given(self.has_dipole, self.dipole_am2),
+        }
+    }
 }
 
 /// An estimator (opaque).
@@ -69,7 +108,7 @@ impl InertiaEstimator {
         }
     }
 
-    fn push(&mut self, s: &InertiaSample) -> InertiaStatus {
+    fn push(&mut self, s: &InertiaSample, external: &InertiaExternal) -> InertiaStatus {
         if self.stopped {
             let status = fail(
                 InertiaStatus::Stopped,
@@ -96,7 +135,7 @@ impl InertiaEstimator {
             rho_nms: s.rho_nms,
             tau_nm: Some(s.tau_nm),
             w_rad_s: has_w.then_some(s.w_rad_s),
-            external: Default::default(),
+            external: external.raw(),
         }) {
             Ok(sample) => sample,
             Err(e) => {
@@ -288,12 +327,103 @@ pub unsafe extern "C" fn inertia_estimator_push(
     // SAFETY: non-null, points to an `InertiaSample` (contract); its fields accept any
     // bit pattern.
     let s = unsafe { sample.read() };
-    let status = guard(|| e.push(&s));
+    let status = guard(|| e.push(&s, &InertiaExternal::default()));
     if status == InertiaStatus::Panic {
         // A panic may have left the state half-updated: stopped until reset.
         e.stopped = true;
     }
     status
+}
+
+/// `inertia_estimator_push` with the sample's outside measurements (`external` NULL: none,
+/// as `inertia_estimator_push`). Each measurement is given for every sample or none; a
+/// refused sample leaves the estimator as it was.
+///
+/// # Safety
+/// As `inertia_estimator_push`; `external` is NULL or points to an `InertiaExternal`.
+#[no_mangle]
+pub unsafe extern "C" fn inertia_estimator_push_external(
+    est: *mut InertiaEstimator,
+    sample: *const InertiaSample,
+    external: *const InertiaExternal,
+) -> InertiaStatus {
+    // SAFETY: by the contract a non-null `est` is a live estimator used by no one else.
+    let Some(e) = (unsafe { est.as_mut() }) else {
+        return null("inertia_estimator_push_external: `est` must not be NULL");
+    };
+    if sample.is_null() {
+        return null("inertia_estimator_push_external: `sample` must not be NULL");
+    }
+    // SAFETY: non-null, points to an `InertiaSample` (contract); any bit pattern.
+    let s = unsafe { sample.read() };
+    // SAFETY: NULL or points to an `InertiaExternal` (contract); any bit pattern.
+    let x = unsafe { external.as_ref() }.copied().unwrap_or_default();
+    let status = guard(|| e.push(&s, &x));
+    if status == InertiaStatus::Panic {
+        e.stopped = true;
+    }
+    status
+}
+
+/// What the estimator made of the outside measurements at its last estimate
+/// (`inertia_estimator_outside`): each vector with its σ per component, valid where its
+/// `has_` flag is non-zero.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InertiaOutside {
+    /// The residual magnetic dipole, A m², body axes.
+    pub dipole_am2: [f64; 3],
+    /// Its σ, A m².
+    pub dipole_sigma_am2: [f64; 3],
+    /// The centre of mass, m, body axes from the known torque's origin.
+    pub centre_of_mass_m: [f64; 3],
+    /// Its σ, m.
+    pub centre_of_mass_sigma_m: [f64; 3],
+    /// Non-zero when the gravity-gradient torque was modelled.
+    pub gravity_gradient: u8,
+    /// Non-zero when the dipole (and its σ) were estimated.
+    pub has_dipole: u8,
+    /// Non-zero when the centre of mass (and its σ) were estimated.
+    pub has_centre_of_mass: u8,
+}
+
+/// Copy what the estimator made of the outside measurements into `*out` (all flags zero
+/// before an estimate, or for estimators that do not model them).
+///
+/// # Safety
+/// `est` is NULL or a live estimator; `out` is NULL or points to writable storage for an
+/// `InertiaOutside`.
+#[no_mangle]
+pub unsafe extern "C" fn inertia_estimator_outside(
+    est: *const InertiaEstimator,
+    out: *mut InertiaOutside,
+) -> InertiaStatus {
+    // SAFETY: a non-null `est` is a live estimator (contract).
+    let Some(e) = (unsafe { est.as_ref() }) else {
+        return null("inertia_estimator_outside: `est` must not be NULL");
+    };
+    if out.is_null() {
+        return null("inertia_estimator_outside: `out` must not be NULL");
+    }
+    guard(|| {
+        let mut o = InertiaOutside::default();
+        if let Some(x) = e.engine.outside() {
+            o.gravity_gradient = u8::from(x.gravity_gradient);
+            if let Some(v) = x.residual_dipole_am2.filter(|v| v.sigma.is_some()) {
+                o.has_dipole = 1;
+                o.dipole_am2 = v.value;
+                o.dipole_sigma_am2 = v.sigma.unwrap_or_default();
+            }
+            if let Some(v) = x.centre_of_mass_m.filter(|v| v.sigma.is_some()) {
+                o.has_centre_of_mass = 1;
+                o.centre_of_mass_m = v.value;
+                o.centre_of_mass_sigma_m = v.sigma.unwrap_or_default();
+            }
+        }
+        // SAFETY: `out` is non-null and valid for writes (contract).
+        unsafe { out.write(o) };
+        InertiaStatus::Ok
+    })
 }
 
 /// Copy the current estimate into `*out` (status `INERTIA_ESTIMATE_STATUS_NONE` before
@@ -395,6 +525,14 @@ fn field_name(f: Field) -> &'static str {
     const RHO: [&str; 3] = ["rho_nms[0]", "rho_nms[1]", "rho_nms[2]"];
     const TAU: [&str; 3] = ["tau_nm[0]", "tau_nm[1]", "tau_nm[2]"];
     const W: [&str; 3] = ["w_rad_s[0]", "w_rad_s[1]", "w_rad_s[2]"];
+    const R: [&str; 3] = ["external.r_m[0]", "external.r_m[1]", "external.r_m[2]"];
+    const B: [&str; 3] = ["external.b_t[0]", "external.b_t[1]", "external.b_t[2]"];
+    const F: [&str; 3] = ["external.f_n[0]", "external.f_n[1]", "external.f_n[2]"];
+    const DIPOLE: [&str; 3] = [
+        "external.dipole_am2[0]",
+        "external.dipole_am2[1]",
+        "external.dipole_am2[2]",
+    ];
     match f {
         Field::Time => "t_s",
         Field::Quaternion(k) => Q.get(k).copied().unwrap_or("q"),
@@ -402,9 +540,9 @@ fn field_name(f: Field) -> &'static str {
         Field::Rho(k) => RHO.get(k).copied().unwrap_or("rho_nms"),
         Field::Tau(k) => TAU.get(k).copied().unwrap_or("tau_nm"),
         Field::Rate(k) => W.get(k).copied().unwrap_or("w_rad_s"),
-        // `InertiaSample` has no outside measurements: the gate never names them here.
-        Field::Position(_) | Field::MagneticField(_) | Field::Force(_) | Field::Dipole(_) => {
-            "(none)"
-        }
+        Field::Position(k) => R.get(k).copied().unwrap_or("r_m"),
+        Field::MagneticField(k) => B.get(k).copied().unwrap_or("b_t"),
+        Field::Force(k) => F.get(k).copied().unwrap_or("f_n"),
+        Field::Dipole(k) => DIPOLE.get(k).copied().unwrap_or("dipole_am2"),
     }
 }

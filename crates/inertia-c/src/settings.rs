@@ -358,7 +358,7 @@ impl Plan {
             inertial_torque: self.inertial_torque,
             // Air drag: a laboratory effect, not in the C API.
             damping: false,
-            // `InertiaSample` carries no outside measurements: nothing to model.
+            // Every outside torque the samples' `InertiaExternal` gives is modelled.
             outside: Default::default(),
             rotor_scale_sigma: self.rotor_scale_sigma,
             // The filter's cutoff is the estimator's own default (`InertiaSettings` has

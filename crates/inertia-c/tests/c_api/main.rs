@@ -6,3 +6,4 @@ mod common;
 mod api;
 mod bad_inputs;
 mod engines;
+mod outside;
