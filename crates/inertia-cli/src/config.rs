@@ -327,5 +327,6 @@ pub fn csv_options(
 ) -> Result<CsvOptions, CliError> {
     let mut o = d.csv_options(&option).map_err(|e| input(e.message))?;
     o.speed_columns = spacecraft.map_or_else(Vec::new, |s| s.speed_columns());
+    o.thruster_columns = spacecraft.map_or_else(Vec::new, |s| s.thruster_columns());
     Ok(o)
 }

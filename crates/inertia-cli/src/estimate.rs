@@ -128,7 +128,7 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         }
         lines.push_back(reader.last_line());
         let n = run.input_samples();
-        run.push_with_speeds(&s, reader.last_speeds(), |e| {
+        run.push_with_actuators(&s, reader.last_speeds(), reader.last_throttles(), |e| {
             if let (Some(h), None) = (history.as_mut(), &write_error) {
                 write_error = h.write(e).err();
             }

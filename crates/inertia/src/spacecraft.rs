@@ -24,6 +24,19 @@
 //! max_momentum_nms = 0.046            # momentum limit: speed limit × spin inertia (same)
 //! ```
 //!
+//! Thrusters (optional; a file needs at least one rotor or one thruster) give the known
+//! torque about the origin and the force from their throttle columns, so that the centre
+//! of mass is estimated ([`thrusters`]):
+//!
+//! ```toml
+//! [[thruster]]
+//! name = "t1"
+//! position_m = [0.0, 0.3, 0.0]        # from the body frame's origin, body axes
+//! direction = [0.0, 0.0, 1.0]         # of the force on the body, unit
+//! thrust_n = 0.02                     # at a throttle of 1
+//! column = "t1_throttle"              # the telemetry column of its throttle (0–1)
+//! ```
+//!
 //! `inertia plan` ([`crate::plan`]) needs three more tables, optional otherwise:
 //!
 //! ```toml
@@ -225,6 +238,8 @@ pub struct Spacecraft {
     pub sensors: Option<Sensors>,
     /// Body rate limit, deg/s (`[limits] max_rate_deg_s`), if given.
     pub max_rate_deg_s: Option<f64>,
+    /// The thrusters (`[[thruster]]`, [`thrusters`]), in the file's order.
+    pub thrusters: Vec<Thruster>,
 }
 
 /// A spacecraft file that cannot be used: the file, the line (where the problem has
@@ -256,6 +271,8 @@ struct RawFile {
     sensors: Option<toml::Spanned<RawSensors>>,
     #[serde(default)]
     limits: Option<toml::Spanned<RawLimits>>,
+    #[serde(default, rename = "thruster")]
+    thrusters: Vec<toml::Spanned<thrusters::RawThruster>>,
 }
 
 #[cfg(feature = "spacecraft")]
@@ -363,11 +380,11 @@ impl Spacecraft {
                 }
             },
         };
-        if raw.rotors.is_empty() {
+        if raw.rotors.is_empty() && raw.thrusters.is_empty() {
             return Err(err(
                 None,
                 None,
-                "no rotor: list each wheel as a [[rotor]] table".into(),
+                "no rotor and no thruster: list each wheel as a [[rotor]] table, each thruster as a [[thruster]] table".into(),
             ));
         }
         if raw.rotors.len() > MAX_ROTORS {
@@ -604,12 +621,15 @@ impl Spacecraft {
             None => None,
             Some(r) => Some(positive(r, "limits.max_rate_deg_s", false)?),
         };
+        let columns: Vec<String> = rotors.iter().map(|r| r.speed_column.clone()).collect();
+        let thrusters = thrusters::parse(&raw.thrusters, &columns, &err)?;
         Ok(Spacecraft {
             rotors,
             rotor_errors,
             prior,
             sensors,
             max_rate_deg_s,
+            thrusters,
         })
     }
 
@@ -628,6 +648,12 @@ impl Spacecraft {
     #[must_use]
     pub fn speed_columns(&self) -> Vec<String> {
         self.rotors.iter().map(|r| r.speed_column.clone()).collect()
+    }
+
+    /// The thrusters' throttle columns, in the file's order.
+    #[must_use]
+    pub fn thruster_columns(&self) -> Vec<String> {
+        self.thrusters.iter().map(|t| t.column.clone()).collect()
     }
 
     /// Whether any rotor's spin inertia or axis carries an uncertainty (a consider term
@@ -661,6 +687,9 @@ impl Spacecraft {
         (inertia + tilts).sqrt()
     }
 }
+
+pub mod thrusters;
+pub use thrusters::Thruster;
 
 #[cfg(all(test, feature = "spacecraft"))]
 mod tests;

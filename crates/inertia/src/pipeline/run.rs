@@ -177,8 +177,41 @@ impl Run {
         speeds: &[f64],
         on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), RunError> {
+        self.push_with_actuators(s, speeds, &[], on_estimate)
+    }
+
+    /// [`Self::push_with_speeds`] with the spacecraft file's thrusters' throttles too
+    /// (in the file's order; [`crate::spacecraft::thrusters`]): their torque about the
+    /// origin joins the sample's known torque and their force is its force (the input
+    /// must then give none of its own).
+    pub fn push_with_actuators(
+        &mut self,
+        s: &Sample,
+        speeds: &[f64],
+        throttles: &[f64],
+        on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), RunError> {
         let index = self.input;
+        let thrusters = self.rotors.as_ref().map_or(&[][..], |r| &r.thrusters[..]);
+        if throttles.len() != thrusters.len() {
+            return Err(RunError::at(
+                index,
+                RunErrorKind::Throttles {
+                    expected: thrusters.len(),
+                    got: throttles.len(),
+                    names: thrusters
+                        .iter()
+                        .map(|t| t.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                },
+            ));
+        }
+        if !thrusters.is_empty() && s.external.force_n.is_some() {
+            return Err(RunError::at(index, RunErrorKind::ForceTwice));
+        }
         let expected = self.rotors.as_ref().map_or(0, |r| r.rotors.len());
+        let with_speeds = expected > 0;
         if speeds.len() != expected {
             let names = self
                 .rotors
@@ -203,6 +236,15 @@ impl Run {
             return self.push_sample(s, on_estimate);
         };
         let mut sample = *s;
+        if !rotors.thrusters.is_empty() {
+            let (force, torque) =
+                crate::spacecraft::thrusters::force_and_torque(&rotors.thrusters, throttles);
+            sample.tau_nm += torque;
+            sample.external.force_n = Some(force);
+        }
+        if !with_speeds {
+            return self.push_sample(&sample, on_estimate);
+        }
         sample.rho_nms = rotors.momentum_nms(speeds);
         if let Err(e) = crate::sample::check_range(&sample) {
             return Err(RunError::at(

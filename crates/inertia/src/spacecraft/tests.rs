@@ -194,3 +194,56 @@ fn bad_plan_keys_are_refused_with_line_and_key() {
     let e = Spacecraft::parse(&PLANNABLE.replace("[limits]", "[limitz]"), "sc.toml").unwrap_err();
     assert!(e.to_string().contains("limitz"), "{e}");
 }
+
+const THRUSTERS: &str = r#"
+[[thruster]]
+name = "t1"
+position_m = [0.0, 0.3, 0.0]
+direction = [0.0, 0.0, 1.0]
+thrust_n = 0.02
+column = "t1_throttle"
+
+[[thruster]]
+name = "t2"
+position_m = [0.3, 0.0, 0.0]
+direction = [0.0, 1.0, 0.0]
+thrust_n = 0.5
+column = "t2_throttle"
+"#;
+
+#[test]
+fn thrusters_alone_are_a_spacecraft_and_give_force_and_torque_about_the_origin() {
+    let s = Spacecraft::parse(THRUSTERS, "sc.toml").unwrap();
+    assert!(s.rotors.is_empty());
+    assert_eq!(s.thruster_columns(), ["t1_throttle", "t2_throttle"]);
+    let (f, tau) = thrusters::force_and_torque(&s.thrusters, &[0.5, 1.0]);
+    // t1: 0.01 N along z at 0.3 y → torque 0.003 about x; t2: 0.5 N along y at 0.3 x →
+    // 0.15 about z.
+    assert!((f - Vector3::new(0.0, 0.5, 0.01)).norm() < 1e-15, "{f}");
+    assert!(
+        (tau - Vector3::new(0.003, 0.0, 0.15)).norm() < 1e-15,
+        "{tau}"
+    );
+}
+
+#[test]
+fn a_bad_thruster_is_refused_with_its_line_and_key() {
+    let bad = THRUSTERS.replace("direction = [0.0, 1.0, 0.0]", "direction = [0.0, 2.0, 0.0]");
+    let e = Spacecraft::parse(&bad, "sc.toml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("sc.toml:12: `thruster[1].direction`: not a unit vector"),
+        "{e}"
+    );
+    let twice = THRUSTERS.replace("t2_throttle", "t1_throttle");
+    let e = Spacecraft::parse(&twice, "sc.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`thruster[1].column`: thruster[0] reads the same column"),
+        "{e}"
+    );
+    let e = Spacecraft::parse("rotor_errors = \"shared\"\n", "sc.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("no rotor and no thruster"), "{e}");
+}

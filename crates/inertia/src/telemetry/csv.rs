@@ -162,6 +162,10 @@ pub struct CsvOptions {
     /// the rotor momentum comes from them (the run computes it) and the file must not also
     /// have the `rho_*` columns. Default none.
     pub speed_columns: Vec<String>,
+    /// Columns of the thrusters' throttles (a spacecraft file's,
+    /// [`crate::spacecraft::thrusters`]), each required and read as a finite number
+    /// ([`TelemetryReader::last_throttles`]). Default none.
+    pub thruster_columns: Vec<String>,
 }
 
 impl Default for CsvOptions {
@@ -175,6 +179,7 @@ impl Default for CsvOptions {
             negate_rho: false,
             gyro_unit: GyroUnit::RadPerS,
             speed_columns: Vec::new(),
+            thruster_columns: Vec::new(),
         }
     }
 }
@@ -192,6 +197,7 @@ struct Indices {
     /// Position, field, force, dipole ([`RawExternal`]'s order).
     external: [Option<[usize; 3]>; 4],
     speeds: Vec<usize>,
+    thrusters: Vec<usize>,
 }
 
 /// A streaming, validating CSV telemetry reader.
@@ -212,6 +218,8 @@ pub struct TelemetryReader<R: Read> {
     failed: bool,
     /// The last row's rotor speeds, as stored (negated with `negate_rho`).
     speeds: Vec<f64>,
+    /// The last row's thruster throttles.
+    throttles: Vec<f64>,
     negate_speeds: bool,
 }
 
@@ -314,6 +322,11 @@ impl<R: Read> TelemetryReader<R> {
                 .iter()
                 .map(|n| need(n))
                 .collect::<Result<_, _>>()?,
+            thrusters: options
+                .thruster_columns
+                .iter()
+                .map(|n| need(n))
+                .collect::<Result<_, _>>()?,
         };
         let gate = Gate::new(GateOptions {
             quaternion: options.quaternion,
@@ -335,6 +348,7 @@ impl<R: Read> TelemetryReader<R> {
             failed: false,
             line: 0,
             speeds: Vec::with_capacity(options.speed_columns.len()),
+            throttles: Vec::with_capacity(options.thruster_columns.len()),
             negate_speeds: options.negate_rho,
         })
     }
@@ -362,6 +376,13 @@ impl<R: Read> TelemetryReader<R> {
     #[must_use]
     pub fn last_speeds(&self) -> &[f64] {
         &self.speeds
+    }
+
+    /// The last row's thruster throttles ([`CsvOptions::thruster_columns`], in their
+    /// order); empty without thruster columns.
+    #[must_use]
+    pub fn last_throttles(&self) -> &[f64] {
+        &self.throttles
     }
 
     /// Bytes consumed so far (for progress reporting).
@@ -438,6 +459,27 @@ impl<R: Read> TelemetryReader<R> {
             Field::Dipole(k) => self.idx.external[3].map_or(self.idx.t, |c| c[k]),
         };
         self.headers[i].clone()
+    }
+
+    /// The thrusters' throttles of this row into [`Self::throttles`]: finite numbers.
+    fn read_throttles(&mut self, line: u64) -> Result<(), TelemetryError> {
+        self.throttles.clear();
+        for k in 0..self.idx.thrusters.len() {
+            let i = self.idx.thrusters[k];
+            let v = self.field(line, i)?;
+            if !(v.is_finite() && v.abs() <= crate::spacecraft::thrusters::MAX_THROTTLE) {
+                return Err(TelemetryError::Parse {
+                    file: self.file.clone(),
+                    line,
+                    column: self.headers[i].clone(),
+                    value: self.record.get(i).unwrap_or("").trim().to_string(),
+                    hint:
+                        " (a throttle: a finite fraction of full thrust, at most 1.5 in magnitude)",
+                });
+            }
+            self.throttles.push(v);
+        }
+        Ok(())
     }
 
     /// The rotors' speeds of this row into [`Self::speeds`]: finite numbers.
@@ -521,6 +563,7 @@ impl<R: Read> TelemetryReader<R> {
                     .into(),
             });
         }
+        self.read_throttles(line)?;
         let raw = RawSample {
             t_s: self.time(line)?,
             q: match self.idx.q {

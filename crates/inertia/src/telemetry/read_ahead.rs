@@ -28,6 +28,8 @@ struct Item {
     byte_position: u64,
     /// The rotors' speeds ([`TelemetryReader::last_speeds`]; empty without them).
     speeds: Vec<f64>,
+    /// The thrusters' throttles ([`TelemetryReader::last_throttles`]).
+    throttles: Vec<f64>,
 }
 
 /// A [`TelemetryReader`] running on its own thread ([module docs](self)).
@@ -38,6 +40,7 @@ pub struct ReadAhead {
     last_line: u64,
     byte_position: u64,
     speeds: Vec<f64>,
+    throttles: Vec<f64>,
 }
 
 impl ReadAhead {
@@ -53,6 +56,7 @@ impl ReadAhead {
                     line: reader.last_line(),
                     byte_position: reader.byte_position(),
                     speeds: reader.last_speeds().to_vec(),
+                    throttles: reader.last_throttles().to_vec(),
                 });
                 if batch.len() == BATCH_SAMPLES {
                     let full = core::mem::replace(&mut batch, Vec::with_capacity(BATCH_SAMPLES));
@@ -74,6 +78,7 @@ impl ReadAhead {
             last_line: 0,
             byte_position: 0,
             speeds: Vec::new(),
+            throttles: Vec::new(),
         }
     }
 
@@ -88,6 +93,13 @@ impl ReadAhead {
     #[must_use]
     pub fn last_speeds(&self) -> &[f64] {
         &self.speeds
+    }
+
+    /// The thrusters' throttles of the last item returned, as
+    /// [`TelemetryReader::last_throttles`].
+    #[must_use]
+    pub fn last_throttles(&self) -> &[f64] {
+        &self.throttles
     }
 
     /// Bytes consumed up to the last item returned (for progress reporting).
@@ -118,6 +130,7 @@ impl Iterator for ReadAhead {
         self.last_line = item.line;
         self.byte_position = item.byte_position;
         self.speeds = item.speeds;
+        self.throttles = item.throttles;
         Some(item.sample)
     }
 }

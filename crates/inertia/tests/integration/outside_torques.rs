@@ -200,3 +200,110 @@ fn with_noise_the_centre_of_mass_is_within_a_millimetre_and_both_within_three_si
         }
     }
 }
+
+/// A spacecraft file's thrusters with throttle columns: the run computes the torque about
+/// the origin and the force, and gives the same answer as the force and torque given
+/// directly; the centre of mass within 1 mm and 3σ. Throttles for a file without
+/// thrusters, or a force given twice, are refused.
+#[test]
+fn the_spacecraft_files_thrusters_give_the_force_and_the_centre_of_mass() {
+    use inertia::pipeline::{Run, RunErrorKind};
+    use inertia::sim::Thrusters;
+    use inertia::spacecraft::Spacecraft;
+    let centre = Vector3::new(0.012, -0.01, 0.013);
+    let thrusters = Thrusters {
+        centre_of_mass_m: centre,
+        ..Thrusters::cube_pairs(0.02, 0.3)
+    };
+    let mut c = Common::paper();
+    c.realism.environment.thrusters = Some(thrusters);
+    let out = Scenario::slew().simulate(&c).expect("sim");
+    // The file: the simulator's thrusters, each with its throttle column.
+    let mut toml = String::new();
+    for (i, t) in thrusters.iter().enumerate() {
+        let v = |x: Vector3<f64>| format!("[{:e}, {:e}, {:e}]", x.x, x.y, x.z);
+        toml += &format!(
+            "[[thruster]]\nname = \"t{i}\"\nposition_m = {}\ndirection = {}\nthrust_n = {:e}\ncolumn = \"t{i}\"\n",
+            v(t.position_m),
+            v(t.direction),
+            t.thrust_n
+        );
+    }
+    let sc = Spacecraft::parse(&toml, "sc.toml").expect("spacecraft");
+    let config = PipelineSettings::default().validate().expect("valid");
+    let mut run = Run::new(config, false)
+        .expect("run")
+        .with_spacecraft(sc.clone());
+    let mut direct = Run::new(config, false).expect("run");
+    for s in &out.samples {
+        let throttles: Vec<f64> = thrusters
+            .thrusts_n(s.t_s)
+            .zip(thrusters.iter())
+            .map(|(f, t)| f / t.thrust_n)
+            .collect();
+        // The telemetry without the thrusters' torque and force: the file gives them.
+        let (f, tau) = inertia::spacecraft::thrusters::force_and_torque(&sc.thrusters, &throttles);
+        let bare = Sample {
+            tau_nm: s.tau_nm - tau,
+            external: Default::default(),
+            ..*s
+        };
+        run.push_with_actuators(&bare, &[], &throttles, |_| {})
+            .expect("push");
+        let given = Sample {
+            tau_nm: bare.tau_nm + tau,
+            external: inertia::sample::External {
+                force_n: Some(f),
+                ..Default::default()
+            },
+            ..*s
+        };
+        direct.push(&given, |_| {}).expect("push");
+    }
+    run.finish(|_| {}).expect("finish");
+    direct.finish(|_| {}).expect("finish");
+    let (a, b) = (
+        run.last().unwrap().j().unwrap(),
+        direct.last().unwrap().j().unwrap(),
+    );
+    for k in 0..6 {
+        assert!(
+            (a[k] - b[k]).abs() <= 1e-12 * a[k].abs().max(1.0),
+            "{a:?} vs {b:?}"
+        );
+    }
+    let o = run
+        .pipeline()
+        .expect("streaming")
+        .diagnostics()
+        .outside
+        .expect("outside");
+    let com = o.centre_of_mass_m.expect("centre of mass");
+    let sigma = com.sigma.expect("σ");
+    for i in 0..3 {
+        let d = (com.value[i] - centre[i]).abs();
+        assert!(d < 1e-3 && d <= 3.0 * sigma[i], "{com:?}");
+    }
+    // Refusals: throttles the file does not have; the force given twice.
+    let mut r = Run::new(config, false).expect("run").with_spacecraft(sc);
+    let e = r
+        .push_with_actuators(&out.samples[0], &[], &[1.0], |_| {})
+        .unwrap_err();
+    assert!(
+        matches!(
+            e.kind,
+            RunErrorKind::Throttles {
+                expected: 6,
+                got: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let mut forced = out.samples[0];
+    forced.external.force_n = Some(Vector3::zeros());
+    let e = r
+        .push_with_actuators(&forced, &[], &[0.0; 6], |_| {})
+        .unwrap_err();
+    assert!(matches!(e.kind, RunErrorKind::ForceTwice), "{e}");
+}

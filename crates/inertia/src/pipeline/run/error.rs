@@ -64,6 +64,19 @@ pub enum RunErrorKind {
         /// The rotors' names, comma-separated.
         names: std::string::String,
     },
+    /// Not one throttle per thruster of the spacecraft file.
+    #[error("expected {expected} thruster throttles (one per thruster of the spacecraft file: {names}), got {got}")]
+    Throttles {
+        /// Thrusters in the spacecraft file.
+        expected: usize,
+        /// Throttles given.
+        got: usize,
+        /// The thrusters' names, comma-separated.
+        names: std::string::String,
+    },
+    /// The input gives a force (`f_*`) and the spacecraft file's thrusters give one too.
+    #[error("the force is given twice: by the telemetry's force columns (f_x,f_y,f_z) and by the spacecraft file's thrusters; give one")]
+    ForceTwice,
     /// The rotor momentum the wheel speeds give is outside the supported range.
     #[error("the rotor momentum from the wheel speeds (columns {columns}) is {} N m s on one axis, outside the supported range (magnitude at most {} N m s): check the speeds' unit and the spin inertias", Num(*.value_nms), Num(*.limit_nms))]
     RotorMomentumOutOfRange {
@@ -164,7 +177,9 @@ impl RunError {
     pub fn error_kind(&self) -> ErrorKind {
         match &self.kind {
             RunErrorKind::NeedsGyro { .. } => ErrorKind::NeedsGyro,
-            RunErrorKind::RotorSpeeds { .. } => ErrorKind::Columns,
+            RunErrorKind::RotorSpeeds { .. }
+            | RunErrorKind::Throttles { .. }
+            | RunErrorKind::ForceTwice => ErrorKind::Columns,
             RunErrorKind::RotorMomentumOutOfRange { .. } => ErrorKind::OutOfRange,
             RunErrorKind::Sample(e) => e.error_kind(),
             RunErrorKind::MemoryShorterThanStep { .. } => ErrorKind::MemoryShorterThanStep,
