@@ -540,6 +540,13 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     #[must_use]
     pub(crate) fn outside_at(&self, e: &super::Estimate) -> Option<OutsideEstimates> {
         let j = e.j()?;
+        let [dipole, centre] = self.external_counted;
+        if !(dipole || centre) {
+            return Some(OutsideEstimates {
+                gravity_gradient: self.source.gravity_gradient(),
+                ..OutsideEstimates::default()
+            });
+        }
         let x = self.qr.nuisance_at(&j);
         // The part of σ beyond the noise, per element of j.
         let beyond: [f64; 6] = e.uncertainty.map_or([0.0; 6], |u| {
@@ -553,7 +560,6 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             jk[k] += 1.0;
             self.qr.nuisance_at(&jk) - x
         });
-        let [dipole, centre] = self.external_counted;
         let block = |used: bool, column: usize| {
             used.then(|| {
                 let shared = column - super::unknowns::FIRST_SHARED;

@@ -11,19 +11,16 @@
 //!   rows' `j` columns gain `−Σ h̄ C Γ`. It carries an absolute scale that the exchange
 //!   of momentum with the wheels lacks (it sees `J` itself, not only its action).
 //! * **Residual magnetic dipole** `m` (A m², fixed in the body), given the measured field
-//!   `B` (T, body axes): `τ = m × B = −[B]× m`; the block [`Block::Dipole`] of
-//!   columns `+Σ h̄ C [B]×`.
+//!   `B` (T, body axes): `τ = m × B = −[B]× m`; the column block `Dipole` (module
+//!   `unknowns`) of columns `+Σ h̄ C [B]×`.
 //! * **Centre of mass** `c` (m, body axes, from the origin about which the known torque
 //!   `τ_known` is given), given the external force `F` (N, body axes, e.g. the
 //!   thrusters'): the torque about the centre of mass is `τ_known − c × F =
-//!   τ_known + [F]× c`; the block [`Block::CentreOfMass`] of columns `−Σ h̄ C [F]×`.
+//!   τ_known + [F]× c`; the column block `CentreOfMass` of columns `−Σ h̄ C [F]×`.
 //!
 //! The row reads `A j − X₀ − S τ_b − E_j j − E_m m − E_c c = b + T`, each `E` the impulse
 //! sum of its torque's map. The sums follow the same quadrature (and, for Richardson
 //! rows, the same combination) as the known torque's.
-//!
-//! [`Block::Dipole`]: super::unknowns::Block::Dipole
-//! [`Block::CentreOfMass`]: super::unknowns::Block::CentreOfMass
 
 use crate::attitude::skew;
 use crate::discrete::g_matrix;

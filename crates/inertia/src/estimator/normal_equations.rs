@@ -62,10 +62,16 @@ impl NormalEquations {
     /// `noise_s` their errors-in-variables coefficient.
     pub(crate) fn add(&mut self, block: &SharedBlock, y: &[f64; 3], noise_s: f64) {
         let (a, beta) = block;
-        for k in 0..SHARED {
-            let col = &mut self.ata.as_mut_slice()[k * SHARED..k * SHARED + k + 1];
+        // Columns before the block's first non-zero one add nothing (the outside torques'
+        // leading columns where the samples have no such measurement): skipped.
+        let start = (0..SHARED)
+            .find(|&k| a.iter().any(|r| r[k] != 0.0))
+            .unwrap_or(SHARED);
+        for k in start..SHARED {
+            let col = &mut self.ata.as_mut_slice()[k * SHARED + start..k * SHARED + k + 1];
             let (a0, a1, a2) = (a[0][k], a[1][k], a[2][k]);
             for (i, m) in col.iter_mut().enumerate() {
+                let i = i + start;
                 *m += a[0][i] * a0 + a[1][i] * a1 + a[2][i] * a2;
             }
             self.atb[k] += a0 * beta[0] + a1 * beta[1] + a2 * beta[2];

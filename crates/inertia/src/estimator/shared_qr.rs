@@ -1,5 +1,5 @@
 //! The least-squares state in the unknowns every chain of discrete momentum rows shares,
-//! `y = [τ_b; κ; m; c; D; j]` (`SHARED` = 17, [`super::momentum_rows`]), the chains' initial
+//! `y = [m; c; τ_b; κ; D; j]` (`SHARED` = 17, [`super::momentum_rows`]), the chains' initial
 //! momenta already minimised out ([`super::augmented_qr`]): a fixed-size QR factor
 //! folded by Householder reflections, one per pivot for each 3-row block
 //! (the crate's `householder` module; the factor of paper eqs. 60–61 up to rounding).
@@ -296,28 +296,33 @@ impl SharedQr {
     }
 
     /// The reduced problem in `j` with the disturbance torque `τ_b` held at zero instead of
-    /// minimised out, and the growth of `ρ²` that costs. With `τ_b` first, `‖R y − z‖²`
-    /// at `τ_b = 0` is `‖R_τr r − z_τ‖² + ‖R_rr r − z_r‖²` in the other unknowns `r =
-    /// [κ; j]`: the three rows of `R` that hold `τ_b`, without its columns, folded into the
+    /// minimised out, and the growth of `ρ²` that costs. The unknowns before `τ_b` fit
+    /// their own rows exactly at any `τ_b`, so `‖R y − z‖²` at `τ_b = 0` is, up to them,
+    /// `‖R_τr r − z_τ‖² + ‖R_rr r − z_r‖²` in the unknowns after it `r = [κ; D; j]`: the
+    /// three rows of `R` that hold `τ_b`, without its columns, folded into the
     /// trailing factor (one Householder reflection per pivot, the crate's `householder`
     /// module). Their leftover is what `τ_b` explained.
     /// The three torque unknowns are no longer counted as nuisance. Without forgetting
     /// only (the count of the torque unknowns is not weighted).
     #[must_use]
     pub(crate) fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
-        const _: () = assert!(Block::BodyTorque.shared_column() == 0, "τ_b leads");
-        const REST: usize = SHARED - 3;
+        // The unknowns before τ_b (the outside torques' `m`, `c`) keep their rows: they
+        // fit them exactly whatever τ_b is (or the rows are zero where unused), so only the
+        // rows after τ_b hold the reduced problem.
+        const T0: usize = Block::BodyTorque.shared_column();
+        const AFTER: usize = T0 + 3;
+        const REST: usize = SHARED - AFTER;
         // Rᵀ of the trailing factor, and the torque's rows of R without its columns.
-        let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(i + 3, k + 3)]);
-        let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + 3]);
+        let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(i + AFTER, k + AFTER)]);
+        let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + AFTER]);
         let mut a: [SVector<f64, REST>; 3] =
-            core::array::from_fn(|t| SVector::from_fn(|k, _| self.rt[(k + 3, t)]));
-        let mut beta: [f64; 3] = core::array::from_fn(|t| self.z[t]);
+            core::array::from_fn(|t| SVector::from_fn(|k, _| self.rt[(k + AFTER, T0 + t)]));
+        let mut beta: [f64; 3] = core::array::from_fn(|t| self.z[T0 + t]);
         for i in 0..REST {
             reflect(&mut rt, &mut z, &mut a, &mut beta, i);
         }
         let growth: f64 = beta.iter().map(|b| b * b).sum();
-        let off = J_SHARED - 3;
+        let off = J_SHARED - AFTER;
         let reduced = RecursiveQr {
             r: Matrix6::from_fn(|i, k| rt[(off + k, off + i)]),
             z: Vector6::from_fn(|i, _| z[off + i]),

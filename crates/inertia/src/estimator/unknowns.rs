@@ -2,7 +2,7 @@
 //! blocks: the layout of `x` is this list, and every column index follows from it.
 //!
 //! ```text
-//! x = [ X₀ (3) │ X₁ (3) │ τ_b (3) │ κ (1) │ m (3) │ c (3) │ D (1) │ j (6) ]
+//! x = [ X₀ (3) │ X₁ (3) │ m (3) │ c (3) │ τ_b (3) │ κ (1) │ D (1) │ j (6) ]
 //!       ╰── per chain ──╯ ╰─────────────── shared by every chain ──────────────╯
 //! ```
 //!
@@ -59,10 +59,10 @@ impl Block {
     pub(crate) const ALL: [Block; 8] = [
         Block::Anchor0,
         Block::Anchor1,
-        Block::BodyTorque,
-        Block::Kappa,
         Block::Dipole,
         Block::CentreOfMass,
+        Block::BodyTorque,
+        Block::Kappa,
         Block::Damping,
         Block::J,
     ];
@@ -188,6 +188,6 @@ mod tests {
         }
         assert_eq!(next, UNKNOWNS);
         assert_eq!(Block::J.shared_column() + 6, SHARED);
-        assert_eq!(Block::BodyTorque.column(), FIRST_SHARED);
+        assert_eq!(Block::Dipole.column(), FIRST_SHARED);
     }
 }

@@ -110,7 +110,12 @@ pub(crate) fn reduce_batch(
     // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
     // initial momenta chain by chain (a short Richardson chain may use only X₀).
     let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
-    let shared_columns: Vec<usize> = (FIRST_SHARED..J)
+    // The torque's columns first (held at zero by dropping them, below), then the rest in
+    // order: the damping's last before j.
+    let torque_columns = TORQUE..TORQUE + 3;
+    let shared_columns: Vec<usize> = torque_columns
+        .clone()
+        .chain((FIRST_SHARED..J).filter(|k| !torque_columns.contains(k)))
         .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
         .chain(J..J + 6)
         .collect();
@@ -213,7 +218,10 @@ pub(crate) fn reduce_batch(
     // The torque's columns, when the rows use them: the same rows without them hold it
     // at zero ([`torque_tested`]), at the cost of the growth of ρ².
     let torque = if settings.torque_bias {
-        shared_columns.iter().filter(|&&k| k < TORQUE + 3).count()
+        shared_columns
+            .iter()
+            .filter(|k| torque_columns.contains(k))
+            .count()
     } else {
         0
     };
