@@ -11,7 +11,11 @@ use crate::Telemetry;
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{AttitudeSource, CommandHold, InertiaChange, Orbit, SimConfig, MAX_SAMPLES};
+use inertia::sim::{
+    AttitudeSource, CommandHold, Environment, InertiaChange, Magnetic, Magnetorquer, Orbit,
+    SimConfig, Thrusters, MAX_SAMPLES,
+};
+use inertia::telemetry::gate::RawExternal;
 use inertia::text::Num;
 use nalgebra::Vector3;
 use pyo3::prelude::*;
@@ -207,7 +211,71 @@ fn settings(kw: &Kwargs<'_>) -> PyResult<(Scenario, Common, &'static str)> {
     if let Some(v) = kw.vector("constant_torque_nm")? {
         r.environment.constant_torque_nm = Vector3::from(v);
     }
+    magnetic_and_thrusters(kw, &mut r.environment)?;
     Ok((sc, common, name))
+}
+
+/// The magnetic options and the thrusters' (after the orbit's), as the command line's.
+fn magnetic_and_thrusters(kw: &Kwargs<'_>, env: &mut Environment) -> PyResult<()> {
+    let field = kw.vector("magnetic_field_t")?;
+    let residual = kw.vector("residual_dipole_am2")?;
+    let magnetorquer = kw.finite("magnetorquer_am2")?;
+    let noise = kw.finite("magnetometer_noise_t")?;
+    let bias = kw.vector("magnetometer_bias_t")?;
+    if field.is_some()
+        || residual.is_some()
+        || magnetorquer.is_some()
+        || noise.is_some()
+        || bias.is_some()
+    {
+        let mut m = match field {
+            Some(b) => Magnetic::constant(Vector3::from(b)),
+            None if env.orbit.is_some() => Magnetic::dipole(),
+            None => {
+                return Err(value_error(
+                    "the magnetic options need a field: gravity_gradient_altitude_km (Earth's dipole field on that orbit) or magnetic_field_t",
+                ))
+            }
+        };
+        m.residual_dipole_am2 = residual.map(Vector3::from).unwrap_or_default();
+        m.magnetorquer = magnetorquer.map(Magnetorquer::sine);
+        if let Some(s) = noise {
+            m.magnetometer.noise_t = s;
+        }
+        if let Some(b) = bias {
+            m.magnetometer.bias_t = Vector3::from(b);
+        }
+        env.magnetic = Some(m);
+    }
+    let thrust = kw.finite("thrusters")?;
+    let arm = kw.finite("thruster_arm_m")?;
+    let centre = kw.vector("centre_of_mass_m")?;
+    let force_noise = kw.finite("force_noise_n")?;
+    match thrust {
+        Some(thrust) => {
+            let mut t = Thrusters::cube_pairs(thrust, arm.unwrap_or(0.3));
+            if let Some(c) = centre {
+                t.centre_of_mass_m = Vector3::from(c);
+            }
+            if let Some(s) = force_noise {
+                t.force_noise_n = s;
+            }
+            env.thrusters = Some(t);
+        }
+        None => {
+            if let Some(name) = [
+                (arm.is_some(), "thruster_arm_m"),
+                (centre.is_some(), "centre_of_mass_m"),
+                (force_noise.is_some(), "force_noise_n"),
+            ]
+            .into_iter()
+            .find_map(|(given, name)| given.then_some(name))
+            {
+                return Err(value_error(format!("{name}: needs thrusters")));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Simulate: `(telemetry, J at the end, J at the start, scenario name, orbit positions
@@ -240,6 +308,14 @@ pub fn simulate<'py>(
                         rho: s.rho_nms.into(),
                         tau: Some(s.tau_nm.into()),
                         w: s.omega_rad_s.map(Into::into),
+                        // As the file's `r_*`, `b_*`, `f_*` columns (a magnetorquer's
+                        // torque is in `tau` already).
+                        external: RawExternal {
+                            position_m: s.external.position_m.map(Into::into),
+                            field_t: s.external.field_t.map(Into::into),
+                            force_n: s.external.force_n.map(Into::into),
+                            dipole_am2: None,
+                        },
                     };
                     checker.sample(&row, i, &Naming::Arrays)
                 })
