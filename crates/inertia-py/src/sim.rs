@@ -278,6 +278,54 @@ fn magnetic_and_thrusters(kw: &Kwargs<'_>, env: &mut Environment) -> PyResult<()
     Ok(())
 }
 
+/// The keyword behind a simulator setting, so that its error names what the caller gave
+/// (`None`: a setting no keyword sets on its own), as the command line names its options.
+fn keyword_of(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "dt_s" => "dt",
+        "samples" => "duration (with dt)",
+        "telemetry_every" => "telemetry_dt",
+        "gyro_noise_deg_s_rthz" => "gyro_noise or gyro_arw_deg_rthr",
+        "disturbance_nm_rthz" => "disturbance",
+        "gyro.bias_deg_h" => "gyro_bias_deg_h",
+        "gyro.bias_instability_deg_h" => "gyro_bias_instability_deg_h",
+        "gyro.bias_correlation_s" => "gyro_bias_correlation_s",
+        "star_tracker.noise_arcsec" => "star_tracker_arcsec",
+        "star_tracker.boresight_body" => "star_tracker_boresight",
+        "star_tracker.rate_hz" => "star_tracker_hz",
+        "commands.rate_hz" => "controller_hz",
+        "commands.phase_s" => "command_phase",
+        "wheels.quantization_nms" => "wheel_quantization_nms",
+        "wheels.noise_nms" => "wheel_noise_nms",
+        "wheels.skew_s" => "wheel_skew_s",
+        "wheels.scale_error" => "wheel_scale_error",
+        "wheels.misalignment_deg" => "wheel_misalignment_deg",
+        "environment.orbit.altitude_m" => "gravity_gradient_altitude_km",
+        "environment.orbit.inclination_deg" => "orbit_inclination_deg",
+        "environment.constant_torque_nm" => "constant_torque_nm",
+        "environment.magnetic.field" => "magnetic_field_t",
+        "environment.magnetic.residual_dipole_am2" => "residual_dipole_am2",
+        "environment.magnetic.magnetorquer.amplitude_am2" => "magnetorquer_am2",
+        "environment.magnetic.magnetometer.noise_t" => "magnetometer_noise_t",
+        "environment.magnetic.magnetometer.bias_t" => "magnetometer_bias_t",
+        "environment.thrusters.units.thrust_n" => "thrusters",
+        "environment.thrusters.units.position_m" => "thruster_arm_m",
+        "environment.thrusters.centre_of_mass_m" => "centre_of_mass_m",
+        "environment.thrusters.force_noise_n" => "force_noise_n",
+        _ => return None,
+    })
+}
+
+/// A simulator error naming the keyword first, the setting (in the simulator's units)
+/// beside it.
+fn sim_error(e: inertia::sim::SimError) -> Failure {
+    let inertia::sim::SimError::InvalidSetting { field, .. } = &e;
+    Failure::Argument(match keyword_of(field) {
+        Some(k) => format!("{k}: {e}"),
+        None => e.to_string(),
+    })
+}
+
 /// Simulate: `(telemetry, J at the end, J at the start, scenario name, orbit positions
 /// (N, 3) m or None)`.
 #[pyfunction]
@@ -291,9 +339,7 @@ pub fn simulate<'py>(
     kw.finish()?;
     let (tel, end, start, positions) = py
         .allow_threads(|| -> Result<_, Failure> {
-            let out = sc
-                .simulate(&common)
-                .map_err(|e| Failure::Argument(e.to_string()))?;
+            let out = sc.simulate(&common).map_err(sim_error)?;
             // The samples as the CSV reader would read them back from `inertia simulate`'s
             // file (the file holds each value exactly; the reader renormalises).
             let mut checker = Checker::new(&Convention::default());

@@ -316,3 +316,14 @@ def test_bad_outside_settings_name_the_key(magnetic, outside, exc, message):
     with pytest.raises(exc) as e:
         inertia.estimate(*pos, **kw, outside=outside)
     assert message in str(e.value), str(e.value)
+
+
+def test_simulate_outside_options_are_checked():
+    with pytest.raises(ValueError, match=r"^the magnetic options need a field: gravity_gradient_altitude_km"):
+        inertia.simulate("slew", residual_dipole_am2=DIPOLE_AM2)
+    with pytest.raises(ValueError, match=r"^centre_of_mass_m: needs thrusters$"):
+        inertia.simulate("slew", centre_of_mass_m=CENTRE_OF_MASS_M)
+    with pytest.raises(ValueError, match=r"^magnetic_field_t: simulation setting `environment\.magnetic\.field`"):
+        inertia.simulate("slew", magnetic_field_t=(1.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match=r"^thrusters: simulation setting"):
+        inertia.simulate("slew", thrusters=-1.0)
