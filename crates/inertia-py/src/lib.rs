@@ -21,8 +21,9 @@ use inertia::estimator::Estimate;
 use inertia::pipeline::history::HEADER;
 use inertia::pipeline::report::Report;
 use inertia::run_description::RunDescription;
-use inertia::sample::Sample;
+use inertia::sample::{External, Sample};
 use inertia::telemetry::csv::{CsvOptions, TelemetryError, TelemetryReader};
+use inertia::telemetry::gate::RawExternal;
 use kwargs::Kwargs;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArrayDyn};
@@ -85,6 +86,25 @@ pub fn matrix3<'py>(
     matrix(py, (0..3).map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]]))
 }
 
+impl Telemetry {
+    /// One outside measurement of every sample as an (N, 3) array; None where the
+    /// samples lack it (the gate takes it for all samples or none).
+    fn external<'py>(
+        &self,
+        py: Python<'py>,
+        of: fn(&External) -> Option<nalgebra::Vector3<f64>>,
+    ) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        let v: Option<Vec<[f64; 3]>> = self
+            .samples
+            .iter()
+            .map(|s| of(&s.external).map(Into::into))
+            .collect();
+        v.filter(|v| !v.is_empty())
+            .map(|v| matrix(py, v.into_iter()))
+            .transpose()
+    }
+}
+
 #[pymethods]
 impl Telemetry {
     /// Time, s (N,).
@@ -102,7 +122,8 @@ impl Telemetry {
     fn rho<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         matrix(py, self.samples.iter().map(|s| s.rho_nms.into()))
     }
-    /// Known external torque, N m, body axes (N, 3) (zeros when none was given).
+    /// Known external torque, N m, body axes (N, 3) (zeros when none was given; with
+    /// commanded dipoles, their torque `m × B` included).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         matrix(py, self.samples.iter().map(|s| s.tau_nm.into()))
@@ -119,6 +140,21 @@ impl Telemetry {
             .filter(|r| !r.is_empty())
             .map(|r| matrix(py, r.into_iter()))
             .transpose()
+    }
+    /// Inertial position, m (N, 3), or None.
+    #[getter]
+    fn r<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.external(py, |e| e.position_m)
+    }
+    /// Magnetic field, T, body axes (N, 3), or None.
+    #[getter]
+    fn b<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.external(py, |e| e.field_t)
+    }
+    /// External force, N, body axes (N, 3), or None.
+    #[getter]
+    fn f<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+        self.external(py, |e| e.force_n)
     }
     /// The file's name, or None.
     #[getter]
@@ -385,6 +421,10 @@ fn read(
     })
 }
 
+/// The optional arrays of outside measurements, in [`samples::EXTERNAL_ARGUMENTS`]'
+/// order: `r`, `b`, `f`, `dipole`.
+pub type ExternalArrays<'a, 'py> = [Option<&'a PyReadonlyArrayDyn<'py, f64>>; 4];
+
 /// Rows of float64 arrays, checked for shape against `t`.
 pub fn rows(
     t: &PyReadonlyArrayDyn<'_, f64>,
@@ -392,6 +432,7 @@ pub fn rows(
     rho: &PyReadonlyArrayDyn<'_, f64>,
     tau: Option<&PyReadonlyArrayDyn<'_, f64>>,
     w: Option<&PyReadonlyArrayDyn<'_, f64>>,
+    external: ExternalArrays<'_, '_>,
 ) -> PyResult<Vec<Row>> {
     let t = t.as_array();
     if t.ndim() != 1 {
@@ -425,8 +466,17 @@ pub fn rows(
     if let Some(a) = &w {
         check("w", a, 3)?;
     }
+    let external = external.map(|a| a.map(|a| a.as_array()));
+    for (name, a) in samples::EXTERNAL_ARGUMENTS.iter().zip(&external) {
+        if let Some(a) = a {
+            check(name, a, 3)?;
+        }
+    }
     let three =
         |a: &numpy::ndarray::ArrayViewD<'_, f64>, i: usize| [a[[i, 0]], a[[i, 1]], a[[i, 2]]];
+    let [r, b, f, dipole] = &external;
+    let at =
+        |a: &Option<numpy::ndarray::ArrayViewD<'_, f64>>, i: usize| a.as_ref().map(|a| three(a, i));
     Ok((0..n)
         .map(|i| Row {
             t: t[[i]],
@@ -437,6 +487,12 @@ pub fn rows(
             rho: three(&rho, i),
             tau: tau.as_ref().map(|a| three(a, i)),
             w: w.as_ref().map(|a| three(a, i)),
+            external: RawExternal {
+                position_m: at(r, i),
+                field_t: at(b, i),
+                force_n: at(f, i),
+                dipole_am2: at(dipole, i),
+            },
         })
         .collect())
 }
@@ -458,7 +514,7 @@ fn check_rows(
 
 /// Estimate from arrays (or a table's columns, named by `frame_columns`).
 #[pyfunction]
-#[pyo3(signature = (t, q, rho, tau=None, w=None, kwargs=None, frame_columns=None, label=None))]
+#[pyo3(signature = (t, q, rho, tau=None, w=None, r=None, b=None, f=None, dipole=None, kwargs=None, frame_columns=None, label=None))]
 #[allow(clippy::too_many_arguments)]
 fn estimate_arrays<'py>(
     py: Python<'py>,
@@ -467,6 +523,10 @@ fn estimate_arrays<'py>(
     rho: PyReadonlyArrayDyn<'py, f64>,
     tau: Option<PyReadonlyArrayDyn<'py, f64>>,
     w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    r: Option<PyReadonlyArrayDyn<'py, f64>>,
+    b: Option<PyReadonlyArrayDyn<'py, f64>>,
+    f: Option<PyReadonlyArrayDyn<'py, f64>>,
+    dipole: Option<PyReadonlyArrayDyn<'py, f64>>,
     kwargs: Option<&Bound<'py, PyDict>>,
     frame_columns: Option<Vec<String>>,
     label: Option<String>,
@@ -478,10 +538,16 @@ fn estimate_arrays<'py>(
         conv = conv.without_quaternions()?;
     }
     let config = s.pipeline.validate().map_err(settings::settings_error)?;
-    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
+    let external = [r.as_ref(), b.as_ref(), f.as_ref(), dipole.as_ref()];
+    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref(), external)?;
     let naming = match frame_columns {
-        Some(c) if c.len() == 14 => Naming::Frame(c),
-        Some(_) => return Err(value_error("frame_columns: expected 14 names")),
+        Some(c) if c.len() == samples::FRAME_COLUMNS => Naming::Frame(c),
+        Some(_) => {
+            return Err(value_error(format!(
+                "frame_columns: expected {} names",
+                samples::FRAME_COLUMNS
+            )))
+        }
         None => Naming::Arrays,
     };
     let origin = Origin::Memory {
@@ -499,7 +565,8 @@ fn estimate_arrays<'py>(
 
 /// Telemetry from arrays, checked (quaternion convention applied, renormalised).
 #[pyfunction]
-#[pyo3(signature = (t, q, rho, tau=None, w=None, kwargs=None))]
+#[pyo3(signature = (t, q, rho, tau=None, w=None, r=None, b=None, f=None, dipole=None, kwargs=None))]
+#[allow(clippy::too_many_arguments)]
 fn samples_from_arrays<'py>(
     py: Python<'py>,
     t: PyReadonlyArrayDyn<'py, f64>,
@@ -507,6 +574,10 @@ fn samples_from_arrays<'py>(
     rho: PyReadonlyArrayDyn<'py, f64>,
     tau: Option<PyReadonlyArrayDyn<'py, f64>>,
     w: Option<PyReadonlyArrayDyn<'py, f64>>,
+    r: Option<PyReadonlyArrayDyn<'py, f64>>,
+    b: Option<PyReadonlyArrayDyn<'py, f64>>,
+    f: Option<PyReadonlyArrayDyn<'py, f64>>,
+    dipole: Option<PyReadonlyArrayDyn<'py, f64>>,
     kwargs: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Telemetry> {
     let kw = Kwargs::new(kwargs, py, "Telemetry")?;
@@ -516,7 +587,8 @@ fn samples_from_arrays<'py>(
     if q.is_none() {
         conv = conv.without_quaternions()?;
     }
-    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref())?;
+    let external = [r.as_ref(), b.as_ref(), f.as_ref(), dipole.as_ref()];
+    let rows = rows(&t, q.as_ref(), &rho, tau.as_ref(), w.as_ref(), external)?;
     let (samples, stats) = py
         .allow_threads(|| check_rows(&rows, &conv, &Naming::Arrays))
         .map_err(|f| f.into_py(py))?;
@@ -534,7 +606,7 @@ fn samples_from_arrays<'py>(
 /// Telemetry rebuilt from what a `Telemetry` held (unpickling): the values were
 /// checked when it was made, so they are taken as they are, bit for bit.
 #[pyfunction]
-#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label, rotors=None))]
+#[pyo3(signature = (t, q, rho, tau, w, file, lines, stats, q_columns, label, rotors=None, r=None, b=None, f=None))]
 #[allow(clippy::too_many_arguments)]
 fn restore<'py>(
     t: PyReadonlyArrayDyn<'py, f64>,
@@ -548,8 +620,13 @@ fn restore<'py>(
     q_columns: String,
     label: String,
     rotors: Option<(String, String, PyReadonlyArrayDyn<'py, f64>)>,
+    r: Option<PyReadonlyArrayDyn<'py, f64>>,
+    b: Option<PyReadonlyArrayDyn<'py, f64>>,
+    f: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Telemetry> {
-    let rows = rows(&t, Some(&q), &rho, Some(&tau), w.as_ref())?;
+    // The commanded dipoles' torque is in `tau` already.
+    let external = [r.as_ref(), b.as_ref(), f.as_ref(), None];
+    let rows = rows(&t, Some(&q), &rho, Some(&tau), w.as_ref(), external)?;
     let rotors = rotors
         .map(|(text, name, speeds)| -> PyResult<Rotors> {
             let spacecraft = inertia::spacecraft::Spacecraft::parse(&text, &name)
@@ -576,7 +653,11 @@ fn restore<'py>(
             rho_nms: r.rho.into(),
             tau_nm: r.tau.unwrap_or_default().into(),
             omega_rad_s: r.w.map(Into::into),
-            external: Default::default(),
+            external: External {
+                position_m: r.external.position_m.map(Into::into),
+                field_t: r.external.field_t.map(Into::into),
+                force_n: r.external.force_n.map(Into::into),
+            },
         })
         .collect();
     let (rows_read, renormalised, sign_flips, min_step_s, max_step_s, attitude_from_gyro) = stats;

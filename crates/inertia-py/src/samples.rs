@@ -2,13 +2,16 @@
 //! (`inertia::telemetry::gate`), the one the CSV reader and the C API use: finite values in
 //! the supported range, the quaternion convention applied, quaternions within the unit
 //! tolerance renormalised (and counted), sign flips counted, time increasing, gyro rates
-//! all-or-none, and the period uniform in strict mode. Here are only the names: the row
-//! (0-based) and the argument or column in place of the file's line and column.
+//! and each outside measurement (`r`, `b`, `f`, `dipole`) all-or-none, and the period
+//! uniform in strict mode. Here are only the names: the row (0-based) and the argument or
+//! column in place of the file's line and column.
 
 use crate::errors::Failure;
 use crate::settings::Convention;
 use inertia::sample::Sample;
-use inertia::telemetry::gate::{Field, Gate, GateOptions, RawSample, SampleError};
+use inertia::telemetry::gate::{
+    ExternalKind, Field, Gate, GateOptions, RawExternal, RawSample, SampleError,
+};
 /// One row of raw values, in storage order.
 #[derive(Debug, Clone, Copy)]
 pub struct Row {
@@ -17,19 +20,49 @@ pub struct Row {
     pub rho: [f64; 3],
     pub tau: Option<[f64; 3]>,
     pub w: Option<[f64; 3]>,
+    /// The outside measurements `r`, `b`, `f`, `dipole` (checked by the gate).
+    pub external: RawExternal,
 }
 
 /// How values are named in messages.
 #[derive(Debug, Clone)]
 pub enum Naming {
-    /// Arguments `t`, `q`, `rho`, `tau`, `w`: `q[12, 3]`.
+    /// Arguments `t`, `q`, `rho`, `tau`, `w`, `r`, `b`, `f`, `dipole`: `q[12, 3]`.
     Arrays,
-    /// A table's columns, in the order t, q (4), rho, tau, w (3 each): `row 12: column `q_w``.
+    /// A table's columns ([`FRAME_COLUMNS`] of them), in the order t, q (4), rho, tau, w,
+    /// r, b, f, dipole (3 each): `row 12: column `q_w``.
     Frame(Vec<String>),
 }
 
 /// Argument names and the offset of their first column in [`Naming::Frame`].
-const GROUPS: [(&str, usize); 5] = [("t", 0), ("q", 1), ("rho", 5), ("tau", 8), ("w", 11)];
+const GROUPS: [(&str, usize); 9] = [
+    ("t", 0),
+    ("q", 1),
+    ("rho", 5),
+    ("tau", 8),
+    ("w", 11),
+    ("r", 14),
+    ("b", 17),
+    ("f", 20),
+    ("dipole", 23),
+];
+
+/// How many columns [`Naming::Frame`] names.
+pub const FRAME_COLUMNS: usize = 26;
+
+/// The outside measurements' arguments, in [`RawExternal`]'s order (position, field,
+/// force, dipole).
+pub const EXTERNAL_ARGUMENTS: [&str; 4] = ["r", "b", "f", "dipole"];
+
+/// The group ([`GROUPS`] index) of an outside measurement.
+fn external_group(what: ExternalKind) -> usize {
+    match what {
+        ExternalKind::Position => 5,
+        ExternalKind::Field => 6,
+        ExternalKind::Force => 7,
+        ExternalKind::Dipole => 8,
+    }
+}
 
 impl Naming {
     /// Where a value is: group `g` (index into [`GROUPS`]), component `k`, row `i`.
@@ -80,9 +113,10 @@ impl Naming {
             Field::Rho(k) => self.value(2, Some(k), i),
             Field::Tau(k) => self.value(3, Some(k), i),
             Field::Rate(k) => self.value(4, Some(k), i),
-            Field::Position(_) | Field::MagneticField(_) | Field::Force(_) | Field::Dipole(_) => {
-                format!("row {i}: {field:?}")
-            }
+            Field::Position(k) => self.value(5, Some(k), i),
+            Field::MagneticField(k) => self.value(6, Some(k), i),
+            Field::Force(k) => self.value(7, Some(k), i),
+            Field::Dipole(k) => self.value(8, Some(k), i),
         }
     }
 }
@@ -121,12 +155,21 @@ impl Checker {
             rho_nms: row.rho,
             tau_nm: row.tau,
             w_rad_s: row.w,
-            external: Default::default(),
+            external: row.external,
         };
         self.gate.check(&raw).map_err(|e| Failure::Data {
             message: match e {
                 // The rates as a whole, not one axis.
                 SampleError::GyroChanged { .. } => format!("{}: {e}", naming.value(4, None, i)),
+                // A measurement as a whole: given for some rows only, a dipole without the
+                // field, positions without quaternions.
+                SampleError::ExternalChanged { what, .. } => {
+                    format!("{}: {e}", naming.value(external_group(what), None, i))
+                }
+                SampleError::DipoleWithoutField => format!("{}: {e}", naming.value(8, None, i)),
+                SampleError::PositionWithoutAttitude => {
+                    format!("{}: {e}", naming.value(5, None, i))
+                }
                 _ => format!("{}: {e}", naming.field(e.field(), i)),
             },
             line: None,

@@ -112,6 +112,8 @@ fn expected(what: &str) -> &str {
         "f64" | "f32" => "a number",
         "usize" | "u64" | "u32" | "i64" => "an integer",
         "a boolean" => "True or False",
+        // A table (`outside`).
+        s if s.starts_with("struct ") => "a dict",
         other => other,
     }
 }
@@ -129,9 +131,19 @@ fn shown(v: &Bound<'_, PyAny>) -> String {
     v.repr().map_or_else(|_| "?".into(), |r| r.to_string())
 }
 
+/// Whether `key` is a keyword of the run description (not a key nested in one's table).
+fn is_keyword(key: &str) -> bool {
+    RunDescription::SETTINGS_KEYS.contains(&key) || RunDescription::INPUT_KEYS.contains(&key)
+}
+
 /// The error of keyword `key` given `v`, in Python's words.
 fn keyword_error(function: &str, key: &str, v: &Bound<'_, PyAny>, e: DeserializerError) -> PyErr {
     match e {
+        // A key of a table's dict (`outside={"gravity": …}`).
+        DeserializerError::UnknownField(field, known) if is_keyword(key) => value_error(format!(
+            "{key}: unknown key {field:?} (known: {})",
+            known.join(", ")
+        )),
         DeserializerError::UnknownField(..) => type_error(format!(
             "{function}() got an unexpected keyword argument '{key}'"
         )),
@@ -153,6 +165,38 @@ fn keyword_error(function: &str, key: &str, v: &Bound<'_, PyAny>, e: Deserialize
     }
 }
 
+/// The error of the entry of a table keyword's dict (`outside={"residual_dipole": "no"}`)
+/// at fault, named `outside["residual_dipole"]`; `None` where the fault is not one
+/// entry's (an unknown key, a message of the table's own, an entry that needs others).
+fn entry_error(
+    function: &str,
+    key: &str,
+    d: &Bound<'_, PyDict>,
+    e: &DeserializerError,
+    one: &dyn Fn(Value) -> Value,
+) -> PyResult<Option<PyErr>> {
+    if matches!(
+        e,
+        DeserializerError::UnknownField(..) | DeserializerError::Custom(_)
+    ) {
+        return Ok(None);
+    }
+    for (k, x) in d.iter() {
+        let entry = Value::Map(BTreeMap::from([(tree(&k)?, tree(&x)?)]));
+        match RunDescription::deserialize(one(entry)) {
+            Err(DeserializerError::MissingField(_)) | Ok(_) => {}
+            Err(e) => {
+                let name = match k.extract::<String>() {
+                    Ok(s) => format!("{key}[{s:?}]"),
+                    Err(_) => format!("{key}[{}]", k.repr()?),
+                };
+                return Ok(Some(keyword_error(function, &name, &x, e)));
+            }
+        }
+    }
+    Ok(None)
+}
+
 /// The run description of the keyword arguments left in `kw` (all of them taken: what
 /// is not the description's is an unexpected keyword of `function`).
 pub fn describe(kw: &Kwargs<'_>, function: &str) -> PyResult<RunDescription> {
@@ -163,12 +207,17 @@ pub fn describe(kw: &Kwargs<'_>, function: &str) -> PyResult<RunDescription> {
         if matches!(value, Value::Option(None)) {
             continue;
         }
-        // One keyword at a time, so that an error names it.
-        let one = Value::Map(BTreeMap::from([(
-            Value::String(key.clone()),
-            value.clone(),
-        )]));
-        RunDescription::deserialize(one).map_err(|e| keyword_error(function, &key, &v, e))?;
+        // One keyword at a time, so that an error names it; in a table's dict
+        // (`outside={…}`), one key at a time, so that it names that key too.
+        let one = |value: Value| Value::Map(BTreeMap::from([(Value::String(key.clone()), value)]));
+        if let Err(e) = RunDescription::deserialize(one(value.clone())) {
+            if let Ok(d) = v.downcast::<PyDict>() {
+                if let Some(err) = entry_error(function, &key, d, &e, &one)? {
+                    return Err(err);
+                }
+            }
+            return Err(keyword_error(function, &key, &v, e));
+        }
         all.insert(Value::String(key), value);
     }
     kw.dict().clear();
@@ -229,10 +278,14 @@ pub fn run(kw: &Kwargs<'_>, function: &str) -> PyResult<(RunSettings, RunDescrip
 
 /// A settings error in the keyword arguments' words (`ValueError`).
 pub fn settings_error(e: PipelineError) -> PyErr {
-    let name = |field: &'static str| -> &'static str {
+    let name = |field: &'static str| -> String {
         match RunDescription::key_of(field) {
-            "constraints" => "constraints/bounds/nominal",
-            k => k,
+            "constraints" => "constraints/bounds/nominal".into(),
+            // A key of a table (`outside.gravity_mu_m3_s2`), as the dict gives it.
+            k => match k.split_once('.') {
+                Some((table, entry)) => format!("{table}[{entry:?}]"),
+                None => k.into(),
+            },
         }
     };
     match e {

@@ -11,7 +11,11 @@ use crate::Telemetry;
 use inertia::sim::gyro::arw_deg_rthr_to_deg_s_rthz;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{AttitudeSource, CommandHold, InertiaChange, Orbit, SimConfig, MAX_SAMPLES};
+use inertia::sim::{
+    AttitudeSource, CommandHold, Environment, InertiaChange, Magnetic, Magnetorquer, Orbit,
+    SimConfig, Thrusters, MAX_SAMPLES,
+};
+use inertia::telemetry::gate::RawExternal;
 use inertia::text::Num;
 use nalgebra::Vector3;
 use pyo3::prelude::*;
@@ -207,7 +211,119 @@ fn settings(kw: &Kwargs<'_>) -> PyResult<(Scenario, Common, &'static str)> {
     if let Some(v) = kw.vector("constant_torque_nm")? {
         r.environment.constant_torque_nm = Vector3::from(v);
     }
+    magnetic_and_thrusters(kw, &mut r.environment)?;
     Ok((sc, common, name))
+}
+
+/// The magnetic options and the thrusters' (after the orbit's), as the command line's.
+fn magnetic_and_thrusters(kw: &Kwargs<'_>, env: &mut Environment) -> PyResult<()> {
+    let field = kw.vector("magnetic_field_t")?;
+    let residual = kw.vector("residual_dipole_am2")?;
+    let magnetorquer = kw.finite("magnetorquer_am2")?;
+    let noise = kw.finite("magnetometer_noise_t")?;
+    let bias = kw.vector("magnetometer_bias_t")?;
+    if field.is_some()
+        || residual.is_some()
+        || magnetorquer.is_some()
+        || noise.is_some()
+        || bias.is_some()
+    {
+        let mut m = match field {
+            Some(b) => Magnetic::constant(Vector3::from(b)),
+            None if env.orbit.is_some() => Magnetic::dipole(),
+            None => {
+                return Err(value_error(
+                    "the magnetic options need a field: gravity_gradient_altitude_km (Earth's dipole field on that orbit) or magnetic_field_t",
+                ))
+            }
+        };
+        m.residual_dipole_am2 = residual.map(Vector3::from).unwrap_or_default();
+        m.magnetorquer = magnetorquer.map(Magnetorquer::sine);
+        if let Some(s) = noise {
+            m.magnetometer.noise_t = s;
+        }
+        if let Some(b) = bias {
+            m.magnetometer.bias_t = Vector3::from(b);
+        }
+        env.magnetic = Some(m);
+    }
+    let thrust = kw.finite("thrusters")?;
+    let arm = kw.finite("thruster_arm_m")?;
+    let centre = kw.vector("centre_of_mass_m")?;
+    let force_noise = kw.finite("force_noise_n")?;
+    match thrust {
+        Some(thrust) => {
+            let mut t = Thrusters::cube_pairs(thrust, arm.unwrap_or(0.3));
+            if let Some(c) = centre {
+                t.centre_of_mass_m = Vector3::from(c);
+            }
+            if let Some(s) = force_noise {
+                t.force_noise_n = s;
+            }
+            env.thrusters = Some(t);
+        }
+        None => {
+            if let Some(name) = [
+                (arm.is_some(), "thruster_arm_m"),
+                (centre.is_some(), "centre_of_mass_m"),
+                (force_noise.is_some(), "force_noise_n"),
+            ]
+            .into_iter()
+            .find_map(|(given, name)| given.then_some(name))
+            {
+                return Err(value_error(format!("{name}: needs thrusters")));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The keyword behind a simulator setting, so that its error names what the caller gave
+/// (`None`: a setting no keyword sets on its own), as the command line names its options.
+fn keyword_of(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "dt_s" => "dt",
+        "samples" => "duration (with dt)",
+        "telemetry_every" => "telemetry_dt",
+        "gyro_noise_deg_s_rthz" => "gyro_noise or gyro_arw_deg_rthr",
+        "disturbance_nm_rthz" => "disturbance",
+        "gyro.bias_deg_h" => "gyro_bias_deg_h",
+        "gyro.bias_instability_deg_h" => "gyro_bias_instability_deg_h",
+        "gyro.bias_correlation_s" => "gyro_bias_correlation_s",
+        "star_tracker.noise_arcsec" => "star_tracker_arcsec",
+        "star_tracker.boresight_body" => "star_tracker_boresight",
+        "star_tracker.rate_hz" => "star_tracker_hz",
+        "commands.rate_hz" => "controller_hz",
+        "commands.phase_s" => "command_phase",
+        "wheels.quantization_nms" => "wheel_quantization_nms",
+        "wheels.noise_nms" => "wheel_noise_nms",
+        "wheels.skew_s" => "wheel_skew_s",
+        "wheels.scale_error" => "wheel_scale_error",
+        "wheels.misalignment_deg" => "wheel_misalignment_deg",
+        "environment.orbit.altitude_m" => "gravity_gradient_altitude_km",
+        "environment.orbit.inclination_deg" => "orbit_inclination_deg",
+        "environment.constant_torque_nm" => "constant_torque_nm",
+        "environment.magnetic.field" => "magnetic_field_t",
+        "environment.magnetic.residual_dipole_am2" => "residual_dipole_am2",
+        "environment.magnetic.magnetorquer.amplitude_am2" => "magnetorquer_am2",
+        "environment.magnetic.magnetometer.noise_t" => "magnetometer_noise_t",
+        "environment.magnetic.magnetometer.bias_t" => "magnetometer_bias_t",
+        "environment.thrusters.units.thrust_n" => "thrusters",
+        "environment.thrusters.units.position_m" => "thruster_arm_m",
+        "environment.thrusters.centre_of_mass_m" => "centre_of_mass_m",
+        "environment.thrusters.force_noise_n" => "force_noise_n",
+        _ => return None,
+    })
+}
+
+/// A simulator error naming the keyword first, the setting (in the simulator's units)
+/// beside it.
+fn sim_error(e: inertia::sim::SimError) -> Failure {
+    let inertia::sim::SimError::InvalidSetting { field, .. } = &e;
+    Failure::Argument(match keyword_of(field) {
+        Some(k) => format!("{k}: {e}"),
+        None => e.to_string(),
+    })
 }
 
 /// Simulate: `(telemetry, J at the end, J at the start, scenario name, orbit positions
@@ -223,9 +339,7 @@ pub fn simulate<'py>(
     kw.finish()?;
     let (tel, end, start, positions) = py
         .allow_threads(|| -> Result<_, Failure> {
-            let out = sc
-                .simulate(&common)
-                .map_err(|e| Failure::Argument(e.to_string()))?;
+            let out = sc.simulate(&common).map_err(sim_error)?;
             // The samples as the CSV reader would read them back from `inertia simulate`'s
             // file (the file holds each value exactly; the reader renormalises).
             let mut checker = Checker::new(&Convention::default());
@@ -240,6 +354,14 @@ pub fn simulate<'py>(
                         rho: s.rho_nms.into(),
                         tau: Some(s.tau_nm.into()),
                         w: s.omega_rad_s.map(Into::into),
+                        // As the file's `r_*`, `b_*`, `f_*` columns (a magnetorquer's
+                        // torque is in `tau` already).
+                        external: RawExternal {
+                            position_m: s.external.position_m.map(Into::into),
+                            field_t: s.external.field_t.map(Into::into),
+                            force_n: s.external.force_n.map(Into::into),
+                            dipole_am2: None,
+                        },
                     };
                     checker.sample(&row, i, &Naming::Arrays)
                 })

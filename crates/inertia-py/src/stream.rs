@@ -8,6 +8,7 @@ use crate::samples::{Checker, Naming, Row};
 use crate::settings;
 use inertia::pipeline::report::Report;
 use inertia::pipeline::Run;
+use inertia::telemetry::gate::RawExternal;
 use numpy::PyReadonlyArrayDyn;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
@@ -81,7 +82,8 @@ impl Stream {
     }
 
     /// Push one sample; `True` when it produced an estimate.
-    #[pyo3(signature = (t, q, rho, tau=None, w=None))]
+    #[pyo3(signature = (t, q, rho, tau=None, w=None, r=None, b=None, f=None, dipole=None))]
+    #[allow(clippy::too_many_arguments)]
     fn push(
         &self,
         py: Python<'_>,
@@ -90,8 +92,24 @@ impl Stream {
         rho: [f64; 3],
         tau: Option<[f64; 3]>,
         w: Option<[f64; 3]>,
+        r: Option<[f64; 3]>,
+        b: Option<[f64; 3]>,
+        f: Option<[f64; 3]>,
+        dipole: Option<[f64; 3]>,
     ) -> PyResult<bool> {
-        let row = Row { t, q, rho, tau, w };
+        let row = Row {
+            t,
+            q,
+            rho,
+            tau,
+            w,
+            external: RawExternal {
+                position_m: r,
+                field_t: b,
+                force_n: f,
+                dipole_am2: dipole,
+            },
+        };
         let mut guard = self.lock()?;
         let st: &mut State = &mut guard;
         py.allow_threads(|| st.push(&row))
@@ -99,7 +117,8 @@ impl Stream {
     }
 
     /// Push a block of samples (arrays as for `estimate`); the number of estimates made.
-    #[pyo3(signature = (t, q, rho, tau=None, w=None))]
+    #[pyo3(signature = (t, q, rho, tau=None, w=None, r=None, b=None, f=None, dipole=None))]
+    #[allow(clippy::too_many_arguments)]
     fn push_many<'py>(
         &self,
         py: Python<'py>,
@@ -108,8 +127,13 @@ impl Stream {
         rho: PyReadonlyArrayDyn<'py, f64>,
         tau: Option<PyReadonlyArrayDyn<'py, f64>>,
         w: Option<PyReadonlyArrayDyn<'py, f64>>,
+        r: Option<PyReadonlyArrayDyn<'py, f64>>,
+        b: Option<PyReadonlyArrayDyn<'py, f64>>,
+        f: Option<PyReadonlyArrayDyn<'py, f64>>,
+        dipole: Option<PyReadonlyArrayDyn<'py, f64>>,
     ) -> PyResult<usize> {
-        let rows = crate::rows(&t, Some(&q), &rho, tau.as_ref(), w.as_ref())?;
+        let external = [r.as_ref(), b.as_ref(), f.as_ref(), dipole.as_ref()];
+        let rows = crate::rows(&t, Some(&q), &rho, tau.as_ref(), w.as_ref(), external)?;
         let mut guard = self.lock()?;
         let st: &mut State = &mut guard;
         py.allow_threads(|| {

@@ -75,6 +75,14 @@ CSV_COLUMNS: Tuple[str, ...] = (
     "tau_x", "tau_y", "tau_z", "w_x", "w_y", "w_z",
 )
 
+#: The optional columns of outside measurements, in the order r (inertial position, m),
+#: b (magnetic field, T, body axes), f (external force, N, body axes), dipole (commanded
+#: magnetic dipole, A m², body axes): the arguments ``r``, ``b``, ``f``, ``dipole``.
+OUTSIDE_COLUMNS: Tuple[str, ...] = (
+    "r_x", "r_y", "r_z", "b_x", "b_y", "b_z", "f_x", "f_y", "f_z",
+    "dipole_x", "dipole_y", "dipole_z",
+)
+
 
 def _pandas(what: str):
     try:
@@ -125,6 +133,11 @@ class Estimate:
         torque_bias_nm: estimated constant body-frame disturbance torque, N m (3,);
             ``None`` where it is not estimated or the data gave no evidence of one and it
             was held at zero (``report["torque_test"]``: ``chi2``, ``held_at_zero``).
+            The torques of outside measurements (``r``, ``b``, ``f``) are reported in
+            ``report["outside"]``: ``gravity_gradient`` (whether modelled),
+            ``residual_dipole_am2`` (A m²) and ``centre_of_mass_m`` (m), each
+            ``{"value": [3], "sigma": [3] or None}`` or ``None``; the report has no
+            ``outside`` key where none of them is modelled.
         warnings: every ``warning:`` line of the text report (the JSON's ``warnings``
             messages), none of which contradicts ``status``.
         report: the whole report as a dict (the ``inertia estimate --json`` schema).
@@ -212,8 +225,11 @@ class Telemetry:
     Made by :func:`read_csv`, :func:`simulate` or :meth:`Telemetry.from_arrays`.
     Attributes (numpy arrays, SI units, body axes): ``t`` (N,) s; ``q`` (N, 4)
     ``[x, y, z, w]`` Hamilton body → inertial, unit norm; ``rho`` (N, 3) N m s; ``tau``
-    (N, 3) N m; ``w`` (N, 3) rad/s or ``None``; ``file`` and ``lines`` (each sample's
-    line) for a file; ``stats``: what the reader counted.
+    (N, 3) N m (with commanded dipoles, their torque m × B included); ``w`` (N, 3) rad/s
+    or ``None``; the outside measurements ``r`` (N, 3) m (inertial position), ``b``
+    (N, 3) T (magnetic field) and ``f`` (N, 3) N (external force), each or ``None``;
+    ``file`` and ``lines`` (each sample's line) for a file; ``stats``: what the reader
+    counted.
     """
 
     __slots__ = ("_native",)
@@ -229,6 +245,10 @@ class Telemetry:
         rho: Any,
         tau: Any = None,
         w: Any = None,
+        r: Any = None,
+        b: Any = None,
+        f: Any = None,
+        dipole: Any = None,
         *,
         scalar_first: bool = False,
         jpl: bool = False,
@@ -238,8 +258,9 @@ class Telemetry:
         unit_tolerance: Optional[float] = None,
         period_tolerance: Optional[float] = None,
     ) -> "Telemetry":
-        """Check arrays (shapes as for :func:`estimate`) into telemetry."""
-        a = _arrays(t, q, rho, tau, w)
+        """Check arrays (shapes and meanings as for :func:`estimate`) into telemetry. A
+        commanded ``dipole`` is not kept: its torque m × B is added to ``tau``."""
+        a = _arrays(t, q, rho, tau, w, r, b, f, dipole)
         return cls(
             _inertia.samples_from_arrays(
                 *a,
@@ -260,6 +281,9 @@ class Telemetry:
     rho = property(lambda self: self._native.rho, doc="Rotor momentum, N m s (N, 3).")
     tau = property(lambda self: self._native.tau, doc="Known torque, N m (N, 3).")
     w = property(lambda self: self._native.w, doc="Gyro rates, rad/s (N, 3), or None.")
+    r = property(lambda self: self._native.r, doc="Inertial position, m (N, 3), or None.")
+    b = property(lambda self: self._native.b, doc="Magnetic field, T, body axes (N, 3), or None.")
+    f = property(lambda self: self._native.f, doc="External force, N, body axes (N, 3), or None.")
     file = property(lambda self: self._native.file, doc="The file's name, or None.")
     lines = property(lambda self: self._native.lines, doc="Each sample's line, or None.")
     stats = property(lambda self: self._native.stats, doc="What the reader counted.")
@@ -273,7 +297,8 @@ class Telemetry:
         return f"<inertia.Telemetry: {len(self)} samples{src}, {gyro} gyro rates>"
 
     def to_dataframe(self):
-        """A pandas DataFrame with the CSV column names (``w_*`` only with rates).
+        """A pandas DataFrame with the CSV column names (``w_*`` only with rates; ``r_*``,
+        ``b_*``, ``f_*`` only with those measurements; commanded dipoles are in ``tau_*``).
 
         ``rho`` is the rotor momentum as read; where a spacecraft file gave it from the
         wheel speeds, their σ do not travel with the frame (a warning says so: estimate
@@ -288,7 +313,9 @@ class Telemetry:
                 stacklevel=2,
             )
         cols: Dict[str, np.ndarray] = {"t": self.t}
-        for name, block in (("q", self.q), ("rho", self.rho), ("tau", self.tau), ("w", self.w)):
+        blocks = (("q", self.q), ("rho", self.rho), ("tau", self.tau), ("w", self.w),
+                  ("r", self.r), ("b", self.b), ("f", self.f))
+        for name, block in blocks:
             if block is None:
                 continue
             axes = "xyzw" if name == "q" else "xyz"
@@ -304,7 +331,8 @@ class Telemetry:
         return (
             _restore_telemetry,
             (self.t, self.q, self.rho, self.tau, self.w, self.file, lines, state,
-             self._native.q_columns, self._native.label, self._native.rotors_state()),
+             self._native.q_columns, self._native.label, self._native.rotors_state(),
+             self.r, self.b, self.f),
         )
 
 
@@ -329,7 +357,10 @@ def read_csv(
 
     Columns (matched by name, extra ones ignored): ``t`` (s, or ISO-8601 UTC time
     stamps), ``q_x,q_y,q_z,q_w``, ``rho_x,rho_y,rho_z`` (N m s), optional
-    ``tau_x,tau_y,tau_z`` (N m) and ``w_x,w_y,w_z`` (rad/s).
+    ``tau_x,tau_y,tau_z`` (N m) and ``w_x,w_y,w_z`` (rad/s), and the optional outside
+    measurements (:data:`OUTSIDE_COLUMNS`): ``r_x,r_y,r_z`` (inertial position, m),
+    ``b_x,b_y,b_z`` (magnetic field, T), ``f_x,f_y,f_z`` (force, N) and
+    ``dipole_x,dipole_y,dipole_z`` (commanded dipole, A m², needs ``b_*``).
 
     Args:
         path: the file.
@@ -388,13 +419,20 @@ def _float_array(name: str, x: Any, shape: str) -> np.ndarray:
     return np.ascontiguousarray(a, dtype=np.float64)
 
 
-def _arrays(t, q, rho, tau, w):
+def _arrays(t, q, rho, tau, w, r=None, b=None, f=None, dipole=None):
+    def optional(name: str, x: Any) -> Optional[np.ndarray]:
+        return None if x is None else _float_array(name, x, "(N, 3)")
+
     return (
         _float_array("t", t, "(N,)"),
         None if q is None else _float_array("q", q, "(N, 4)"),
         _float_array("rho", rho, "(N, 3)"),
-        None if tau is None else _float_array("tau", tau, "(N, 3)"),
-        None if w is None else _float_array("w", w, "(N, 3)"),
+        optional("tau", tau),
+        optional("w", w),
+        optional("r", r),
+        optional("b", b),
+        optional("f", f),
+        optional("dipole", dipole),
     )
 
 
@@ -403,13 +441,15 @@ def _is_frame(x: Any) -> bool:
 
 
 def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
-    names = list(CSV_COLUMNS)
+    known = CSV_COLUMNS + OUTSIDE_COLUMNS
+    names = list(known)
     for k, v in (columns or {}).items():
-        if k not in CSV_COLUMNS:
+        if k not in known:
             raise ValueError(
-                f"columns: unknown column {k!r} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, w_*)"
+                f"columns: unknown column {k!r} (known: t, q_x, q_y, q_z, q_w, rho_*, tau_*, "
+                "w_*, r_*, b_*, f_*, dipole_*)"
             )
-        names[CSV_COLUMNS.index(k)] = v
+        names[known.index(k)] = v
     present = [str(c) for c in df.columns]
     if len(set(present)) != len(present):
         dup = next(c for c in present if present.count(c) > 1)
@@ -442,7 +482,8 @@ def _frame_arrays(df: Any, columns: Optional[Mapping[str, str]]):
     )
     q = None if gyro_only else np.column_stack([_float_array(n, need(n), "(N,)") for n in names[1:5]])
     rho = np.column_stack([_float_array(n, need(n), "(N,)") for n in names[5:8]])
-    return names, (t, q, rho, optional(names[8:11]), optional(names[11:14]))
+    blocks = [optional(names[k:k + 3]) for k in range(8, len(names), 3)]
+    return names, (t, q, rho, *blocks)
 
 
 #: The estimation settings and the input conventions, as :func:`estimate` and
@@ -474,6 +515,10 @@ def estimate(
     *,
     tau: Any = None,
     w: Any = None,
+    r: Any = None,
+    b: Any = None,
+    f: Any = None,
+    dipole: Any = None,
     estimator: str = DEFAULT_ESTIMATOR,
     constraints: str = "physical",
     bounds: Union[None, str, Sequence[str], Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
@@ -493,6 +538,7 @@ def estimate(
     torque_bias: bool = True,
     inertial_torque: str = "short",
     damping: bool = False,
+    outside: Optional[Mapping[str, Any]] = None,
     rotor_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
     chain: float = 30.0,
@@ -520,8 +566,16 @@ def estimate(
     * arrays ``t`` (N,) s, ``q`` (N, 4), ``rho`` (N, 3) N m s, and optionally
       ``tau=`` (N, 3) N m (known external torque) and ``w=`` (N, 3) rad/s (gyro rate
       averaged over [t_k, t_{k+1}]); ``q=None`` with ``w=``: the attitude is integrated
-      from the gyro rates (as for a file without quaternion columns);
-    * a pandas DataFrame with the CSV column names (``t``, ``q_x`` …, renamed by
+      from the gyro rates (as for a file without quaternion columns). Optional outside
+      measurements, each (N, 3), for every sample: ``r=`` the position of the centre of
+      mass in the attitude's inertial frame, m (the gravity-gradient torque is modelled;
+      needs ``q``), ``b=`` the magnetic field, T, body axes (a residual magnetic dipole
+      is estimated), ``f=`` the external force, N, body axes (the centre of mass is
+      estimated, ``tau`` then taken about the body frame's origin), ``dipole=`` the
+      commanded magnetic dipole, A m², body axes (needs ``b``; its torque m × B is
+      added to ``tau``);
+    * a pandas DataFrame with the CSV column names (``t``, ``q_x`` …, the outside
+      measurements' ``r_x`` … ``dipole_z`` of :data:`OUTSIDE_COLUMNS`, renamed by
       ``columns=``), as the only positional argument;
     * a :class:`Telemetry` (from :func:`read_csv` or :func:`simulate`);
     * a path: the file is read with :func:`read_csv` first. Unlike the CLI, which
@@ -563,6 +617,13 @@ def estimate(
             ``"off"``, ``"on"`` or ``"auto"`` (a nested χ² test decides;
             ``report["row_model"]``).
             damping: estimate a linear damping torque −D ω (air drag; ``report["damping_nms"]``).
+            outside: which torques of the outside measurements are modelled, a dict
+            (``--no-gravity-gradient``, ``--gravity-mu``, ``--no-residual-dipole``,
+            ``--no-centre-of-mass``): ``gravity_gradient`` (default ``True``),
+            ``gravity_mu_m3_s2`` (default Earth's, 3.986004418e14), ``residual_dipole``
+            (``True``), ``centre_of_mass`` (``True``), e.g.
+            ``outside={"centre_of_mass": False}``. The estimates are in
+            ``report["outside"]`` (see :class:`Estimate`).
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
             filter_cutoff_hz: the equation-error baseline's low-pass cutoff, Hz.
@@ -589,11 +650,12 @@ def estimate(
     arguments = locals()
     settings = _settings(arguments, (*_SETTINGS, "history", "truth"))
     conventions = _settings(arguments, _CONVENTIONS)
-    single = q is None and rho is None and tau is None and w is None
+    single = all(x is None for x in (q, rho, tau, w, r, b, f, dipole))
     if isinstance(t, Telemetry) or isinstance(t, (str, os.PathLike)) or _is_frame(t):
         if not single:
             raise TypeError(
-                "estimate(data): q, rho, tau and w are given only with arrays (t, q, rho)"
+                "estimate(data): q, rho, tau, w, r, b, f and dipole are given only with arrays "
+                "(t, q, rho)"
             )
     if spacecraft is not None and not isinstance(t, (str, os.PathLike)):
         raise TypeError(
@@ -623,7 +685,9 @@ def estimate(
             "(q=None: the attitude is integrated from the gyro rates)"
         )
     return Estimate._from_native(
-        _inertia.estimate_arrays(*_arrays(t, q, rho, tau, w), kwargs={**settings, **conventions})
+        _inertia.estimate_arrays(
+            *_arrays(t, q, rho, tau, w, r, b, f, dipole), kwargs={**settings, **conventions}
+        )
     )
 
 
@@ -672,6 +736,7 @@ class Estimator:
         torque_bias: bool = True,
         inertial_torque: str = "short",
         damping: bool = False,
+        outside: Optional[Mapping[str, Any]] = None,
         rotor_scale_sigma: Optional[float] = None,
         filter_cutoff_hz: Optional[float] = None,
         chain: float = 30.0,
@@ -688,22 +753,31 @@ class Estimator:
     ) -> None:
         self._native = _inertia.Stream(kwargs=_settings(locals(), (*_SETTINGS, *_CONVENTIONS)))
 
-    def push(self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
+    def push(
+        self, t: float, q: Any, rho: Any, tau: Any = None, w: Any = None,
+        r: Any = None, b: Any = None, f: Any = None, dipole: Any = None,
+    ) -> Optional[Estimate]:
         """Push one sample: ``t`` s, ``q`` (4,), ``rho`` (3,) N m s, ``tau`` (3,) N m,
-        ``w`` (3,) rad/s. Returns the estimate it produced, or ``None``."""
+        ``w`` (3,) rad/s, and the outside measurements ``r`` (3,) m, ``b`` (3,) T, ``f``
+        (3,) N, ``dipole`` (3,) A m² (as for :func:`estimate`; each for every sample or
+        none). Returns the estimate it produced, or ``None``."""
         try:
             t = float(t)
         except (TypeError, ValueError) as e:
             raise TypeError(f"t: expected a number (s), got {type(t).__name__}") from e
         produced = self._native.push(
-            t, _vector("q", q, 4), _vector("rho", rho, 3), _vector("tau", tau, 3), _vector("w", w, 3)
+            t, _vector("q", q, 4), _vector("rho", rho, 3), _vector("tau", tau, 3), _vector("w", w, 3),
+            _vector("r", r, 3), _vector("b", b, 3), _vector("f", f, 3), _vector("dipole", dipole, 3),
         )
         return self.estimate if produced else None
 
-    def push_many(self, t: Any, q: Any, rho: Any, tau: Any = None, w: Any = None) -> Optional[Estimate]:
+    def push_many(
+        self, t: Any, q: Any, rho: Any, tau: Any = None, w: Any = None,
+        r: Any = None, b: Any = None, f: Any = None, dipole: Any = None,
+    ) -> Optional[Estimate]:
         """Push a block of samples (arrays as for :func:`estimate`). Returns the newest
         estimate after the block, or ``None`` when the block produced none."""
-        n = self._native.push_many(*_arrays(t, q, rho, tau, w))
+        n = self._native.push_many(*_arrays(t, q, rho, tau, w, r, b, f, dipole))
         return self.estimate if n else None
 
     @property
@@ -732,7 +806,8 @@ class Simulation:
         inertia_initial: the true J at the start, kg m².
         scenario: the scenario's or preset's name.
         positions: the inertial orbit position at each sample, m (N, 3), with gravity
-            gradient (the CLI's ``r_x,r_y,r_z`` columns), else ``None``.
+            gradient (the CLI's ``r_x,r_y,r_z`` columns, also ``telemetry.r``), else
+            ``None``.
     """
 
     telemetry: Telemetry
@@ -761,12 +836,17 @@ def simulate(scenario: Optional[str] = None, **options: Any) -> Simulation:
     ``wheel_quantization_nms``, ``wheel_noise_nms``, ``wheel_skew_s``,
     ``wheel_scale_error``, ``wheel_misalignment_deg`` (deg),
     ``gravity_gradient_altitude_km``, ``orbit_inclination_deg``,
+    ``magnetic_field_t`` (T), ``residual_dipole_am2``, ``magnetorquer_am2``,
+    ``magnetometer_noise_t``, ``magnetometer_bias_t``, ``thrusters`` (N),
+    ``thruster_arm_m``, ``centre_of_mass_m``, ``force_noise_n``,
     ``constant_torque_nm`` (N m), ``inertia_step`` ``(T, SCALE)``, ``inertia_ramp``
     ``(T0, T1, SCALE)``, ``paper_inertia`` (the paper's J exactly, which breaks
     J1 + J2 ≥ J3 by 4.9e-5 kg m²; by default the scenarios' truth is the paper's J +
     1e-4 I).
 
-    The same settings and seed give the same samples as the CLI's file, bit for bit.
+    The same settings and seed give the same samples as the CLI's file, bit for bit,
+    with the outside measurements of its ``r_*``, ``b_*``, ``f_*`` columns in
+    ``telemetry.r``, ``.b``, ``.f`` (a magnetorquer's torque is in ``tau``).
     """
     kwargs = dict(options)
     if scenario is not None:

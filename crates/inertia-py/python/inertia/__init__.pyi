@@ -10,6 +10,7 @@ __version__: str
 DEFAULT_ESTIMATOR: str
 HISTORY_COLUMNS: Tuple[str, ...]
 CSV_COLUMNS: Tuple[str, ...]
+OUTSIDE_COLUMNS: Tuple[str, ...]
 
 ArrayLike = npt.ArrayLike
 Bounds = Union[None, str, Sequence[str], Mapping[str, Tuple[Optional[float], Optional[float]]]]
@@ -55,6 +56,10 @@ class Telemetry:
         rho: ArrayLike,
         tau: Optional[ArrayLike] = ...,
         w: Optional[ArrayLike] = ...,
+        r: Optional[ArrayLike] = ...,
+        b: Optional[ArrayLike] = ...,
+        f: Optional[ArrayLike] = ...,
+        dipole: Optional[ArrayLike] = ...,
         *,
         scalar_first: bool = ...,
         jpl: bool = ...,
@@ -74,6 +79,12 @@ class Telemetry:
     def tau(self) -> np.ndarray: ...  # (N, 3) N m
     @property
     def w(self) -> Optional[np.ndarray]: ...  # (N, 3) rad/s
+    @property
+    def r(self) -> Optional[np.ndarray]: ...  # (N, 3) m, inertial position
+    @property
+    def b(self) -> Optional[np.ndarray]: ...  # (N, 3) T, magnetic field
+    @property
+    def f(self) -> Optional[np.ndarray]: ...  # (N, 3) N, external force
     @property
     def file(self) -> Optional[str]: ...
     @property
@@ -104,6 +115,10 @@ def estimate(
     *,
     tau: Optional[ArrayLike] = ...,
     w: Optional[ArrayLike] = ...,
+    r: Optional[ArrayLike] = ...,
+    b: Optional[ArrayLike] = ...,
+    f: Optional[ArrayLike] = ...,
+    dipole: Optional[ArrayLike] = ...,
     estimator: str = ...,
     constraints: str = ...,
     bounds: Bounds = ...,
@@ -123,6 +138,7 @@ def estimate(
     torque_bias: bool = ...,
     inertial_torque: str = ...,
     damping: bool = ...,
+    outside: Optional[Mapping[str, Any]] = ...,
     rotor_scale_sigma: Optional[float] = ...,
     filter_cutoff_hz: Optional[float] = ...,
     chain: float = ...,
@@ -167,6 +183,7 @@ class Estimator:
         torque_bias: bool = ...,
         inertial_torque: str = ...,
         damping: bool = ...,
+        outside: Optional[Mapping[str, Any]] = ...,
         rotor_scale_sigma: Optional[float] = ...,
         filter_cutoff_hz: Optional[float] = ...,
         chain: float = ...,
@@ -188,6 +205,10 @@ class Estimator:
         rho: ArrayLike,
         tau: Optional[ArrayLike] = ...,
         w: Optional[ArrayLike] = ...,
+        r: Optional[ArrayLike] = ...,
+        b: Optional[ArrayLike] = ...,
+        f: Optional[ArrayLike] = ...,
+        dipole: Optional[ArrayLike] = ...,
     ) -> Optional[Estimate]: ...
     def push_many(
         self,
@@ -196,6 +217,10 @@ class Estimator:
         rho: ArrayLike,
         tau: Optional[ArrayLike] = ...,
         w: Optional[ArrayLike] = ...,
+        r: Optional[ArrayLike] = ...,
+        b: Optional[ArrayLike] = ...,
+        f: Optional[ArrayLike] = ...,
+        dipole: Optional[ArrayLike] = ...,
     ) -> Optional[Estimate]: ...
     @property
     def estimate(self) -> Optional[Estimate]: ...

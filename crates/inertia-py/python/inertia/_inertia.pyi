@@ -19,6 +19,9 @@ class Telemetry:
     rho: np.ndarray
     tau: np.ndarray
     w: Optional[np.ndarray]
+    r: Optional[np.ndarray]
+    b: Optional[np.ndarray]
+    f: Optional[np.ndarray]
     file: Optional[str]
     lines: Optional[np.ndarray]
     stats: Dict[str, Any]
@@ -30,8 +33,14 @@ class Telemetry:
 
 class Stream:
     def __init__(self, kwargs: Optional[Dict[str, Any]] = ...) -> None: ...
-    def push(self, t: float, q: Any, rho: Any, tau: Any = ..., w: Any = ...) -> bool: ...
-    def push_many(self, t: Any, q: Any, rho: Any, tau: Any = ..., w: Any = ...) -> int: ...
+    def push(
+        self, t: float, q: Any, rho: Any, tau: Any = ..., w: Any = ...,
+        r: Any = ..., b: Any = ..., f: Any = ..., dipole: Any = ...,
+    ) -> bool: ...
+    def push_many(
+        self, t: Any, q: Any, rho: Any, tau: Any = ..., w: Any = ...,
+        r: Any = ..., b: Any = ..., f: Any = ..., dipole: Any = ...,
+    ) -> int: ...
     def report(self) -> Optional[Tuple[str, str]]: ...
     samples: int
     estimator: str
@@ -43,6 +52,10 @@ def estimate_arrays(
     rho: np.ndarray,
     tau: Optional[np.ndarray] = ...,
     w: Optional[np.ndarray] = ...,
+    r: Optional[np.ndarray] = ...,
+    b: Optional[np.ndarray] = ...,
+    f: Optional[np.ndarray] = ...,
+    dipole: Optional[np.ndarray] = ...,
     kwargs: Optional[Dict[str, Any]] = ...,
     frame_columns: Optional[List[str]] = ...,
     label: Optional[str] = ...,
@@ -53,6 +66,10 @@ def samples_from_arrays(
     rho: np.ndarray,
     tau: Optional[np.ndarray] = ...,
     w: Optional[np.ndarray] = ...,
+    r: Optional[np.ndarray] = ...,
+    b: Optional[np.ndarray] = ...,
+    f: Optional[np.ndarray] = ...,
+    dipole: Optional[np.ndarray] = ...,
     kwargs: Optional[Dict[str, Any]] = ...,
 ) -> Telemetry: ...
 def restore(*state: Any) -> Telemetry: ...
