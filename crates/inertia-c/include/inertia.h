@@ -321,18 +321,28 @@ typedef struct InertiaExternal {
 typedef struct InertiaOutside {
   // The residual magnetic dipole, A m², body axes.
   double dipole_am2[3];
-  // Its σ, A m².
+  // Its σ, A m² (NaN for a component the data never separated).
   double dipole_sigma_am2[3];
+  // A direction (unit, body axes) along which the data do not determine the dipole,
+  // where `dipole_undetermined` is non-zero.
+  double dipole_undetermined_direction[3];
   // The centre of mass, m, body axes from the known torque's origin.
   double centre_of_mass_m[3];
-  // Its σ, m.
+  // Its σ, m (NaN for a component the data never separated).
   double centre_of_mass_sigma_m[3];
+  // A direction along which the data do not determine the centre of mass, where
+  // `centre_of_mass_undetermined` is non-zero.
+  double centre_of_mass_undetermined_direction[3];
   // Non-zero when the gravity-gradient torque was modelled.
   uint8_t gravity_gradient;
   // Non-zero when the dipole (and its σ) were estimated.
   uint8_t has_dipole;
   // Non-zero when the centre of mass (and its σ) were estimated.
   uint8_t has_centre_of_mass;
+  // Non-zero when a direction of the dipole is not determined.
+  uint8_t dipole_undetermined;
+  // Non-zero when a direction of the centre of mass is not determined.
+  uint8_t centre_of_mass_undetermined;
 } InertiaOutside;
 
 // The current estimate.

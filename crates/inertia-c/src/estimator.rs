@@ -373,18 +373,28 @@ pub unsafe extern "C" fn inertia_estimator_push_external(
 pub struct InertiaOutside {
     /// The residual magnetic dipole, A m², body axes.
     pub dipole_am2: [f64; 3],
-    /// Its σ, A m².
+    /// Its σ, A m² (NaN for a component the data never separated).
     pub dipole_sigma_am2: [f64; 3],
+    /// A direction (unit, body axes) along which the data do not determine the dipole,
+    /// where `dipole_undetermined` is non-zero.
+    pub dipole_undetermined_direction: [f64; 3],
     /// The centre of mass, m, body axes from the known torque's origin.
     pub centre_of_mass_m: [f64; 3],
-    /// Its σ, m.
+    /// Its σ, m (NaN for a component the data never separated).
     pub centre_of_mass_sigma_m: [f64; 3],
+    /// A direction along which the data do not determine the centre of mass, where
+    /// `centre_of_mass_undetermined` is non-zero.
+    pub centre_of_mass_undetermined_direction: [f64; 3],
     /// Non-zero when the gravity-gradient torque was modelled.
     pub gravity_gradient: u8,
     /// Non-zero when the dipole (and its σ) were estimated.
     pub has_dipole: u8,
     /// Non-zero when the centre of mass (and its σ) were estimated.
     pub has_centre_of_mass: u8,
+    /// Non-zero when a direction of the dipole is not determined.
+    pub dipole_undetermined: u8,
+    /// Non-zero when a direction of the centre of mass is not determined.
+    pub centre_of_mass_undetermined: u8,
 }
 
 /// Copy what the estimator made of the outside measurements into `*out` (all flags zero
@@ -409,15 +419,29 @@ pub unsafe extern "C" fn inertia_estimator_outside(
         let mut o = InertiaOutside::default();
         if let Some(x) = e.engine.outside() {
             o.gravity_gradient = u8::from(x.gravity_gradient);
-            if let Some(v) = x.residual_dipole_am2.filter(|v| v.sigma.is_some()) {
+            let sigma = |v: &inertia::estimator::external_torque::Estimated3| {
+                v.sigma.map(|s| s.unwrap_or(f64::NAN))
+            };
+            let direction = |v: &inertia::estimator::external_torque::Estimated3| {
+                (
+                    u8::from(v.undetermined_direction.is_some()),
+                    v.undetermined_direction.unwrap_or_default(),
+                )
+            };
+            if let Some(v) = x.residual_dipole_am2 {
                 o.has_dipole = 1;
                 o.dipole_am2 = v.value;
-                o.dipole_sigma_am2 = v.sigma.unwrap_or_default();
+                o.dipole_sigma_am2 = sigma(&v);
+                (o.dipole_undetermined, o.dipole_undetermined_direction) = direction(&v);
             }
-            if let Some(v) = x.centre_of_mass_m.filter(|v| v.sigma.is_some()) {
+            if let Some(v) = x.centre_of_mass_m {
                 o.has_centre_of_mass = 1;
                 o.centre_of_mass_m = v.value;
-                o.centre_of_mass_sigma_m = v.sigma.unwrap_or_default();
+                o.centre_of_mass_sigma_m = sigma(&v);
+                (
+                    o.centre_of_mass_undetermined,
+                    o.centre_of_mass_undetermined_direction,
+                ) = direction(&v);
             }
         }
         // SAFETY: `out` is non-null and valid for writes (contract).

@@ -103,6 +103,7 @@ fn prefix(s: &str, max_chars: usize) -> (&str, bool) {
 /// User text in double quotes with escapes (like `{:?}`), cut after
 /// [`MAX_QUOTED_CHARS`] characters: `"abc…" (12345 bytes)`.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by the CSV reader's messages
 pub(crate) struct Quoted<'a>(pub &'a str);
 
 impl fmt::Display for Quoted<'_> {

@@ -267,7 +267,7 @@ pub fn table(seeds: u64, filter: Option<&str>) {
                     .collect();
                 let (mut inside, mut n) = (0, 0);
                 for e in &v {
-                    if let Some(s) = e.sigma {
+                    if let Some(s) = e.sigma_all() {
                         for i in 0..3 {
                             n += 1;
                             inside += usize::from((e.value[i] - t[i]).abs() <= 3.0 * s[i]);

@@ -580,13 +580,12 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
                         .sum();
                     Some(crate::math::sqrt(noise * noise + carried))
                 });
-                let sigma = match sigma {
-                    [Some(a), Some(b), Some(c)] => Some([a, b, c]),
-                    _ => None,
-                };
                 Estimated3 {
                     value: [x[column], x[column + 1], x[column + 2]],
                     sigma,
+                    undetermined_direction: super::external_torque::undetermined(
+                        &self.qr.shared().block_covariance(shared),
+                    ),
                 }
             })
         };

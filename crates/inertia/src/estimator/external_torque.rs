@@ -77,8 +77,55 @@ impl OutsideTorques {
 pub struct Estimated3 {
     /// The value.
     pub value: [f64; 3],
-    /// Its σ per component.
-    pub sigma: Option<[f64; 3]>,
+    /// Its σ per component (`None` for a component the rows never separated from the
+    /// others, or without residual degrees of freedom).
+    pub sigma: [Option<f64>; 3],
+    /// A direction (unit, body axes) along which the data do not determine it: the
+    /// least-squares σ along it exceeds [`UNDETERMINED_RATIO`] times the σ across it (a
+    /// dipole along a field that keeps its direction in the body, a centre of mass along a
+    /// force that does, give no torque). Its component along it is then not an estimate.
+    pub undetermined_direction: Option<[f64; 3]>,
+}
+
+impl Estimated3 {
+    /// Its σ where every component has one.
+    #[must_use]
+    pub fn sigma_all(&self) -> Option<[f64; 3]> {
+        match self.sigma {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            _ => None,
+        }
+    }
+}
+
+/// The ratio of the largest to the smallest least-squares σ of a 3-vector unknown's
+/// principal directions beyond which the largest is not determined by the data
+/// ([`Estimated3::undetermined_direction`]): a direction the rows cannot see shows as a
+/// pivot of rounding size, 10⁸ or more below the others.
+pub const UNDETERMINED_RATIO: f64 = 1e6;
+
+/// The direction of `covariance` (a 3×3 least-squares covariance, infinite on the axis
+/// of an unknown never separated) along which the σ exceeds [`UNDETERMINED_RATIO`] times
+/// the smallest, if any.
+#[must_use]
+pub(crate) fn undetermined(covariance: &Matrix3<f64>) -> Option<[f64; 3]> {
+    for i in 0..3 {
+        if !covariance[(i, i)].is_finite() {
+            return Some(Vector3::ith(i, 1.0).into());
+        }
+    }
+    let (values, vectors) = crate::eigen3::symmetric_eigen3(covariance);
+    let (mut lo, mut hi) = (0, 0);
+    for i in 1..3 {
+        if values[i] < values[lo] {
+            lo = i;
+        }
+        if values[i] > values[hi] {
+            hi = i;
+        }
+    }
+    let ratio2 = UNDETERMINED_RATIO * UNDETERMINED_RATIO;
+    (!(values[hi] <= ratio2 * values[lo].max(0.0))).then(|| vectors[hi].into())
 }
 
 /// What the rows made of the outside measurements at the last answer.

@@ -16,7 +16,7 @@ pub(crate) use super::unknowns::SHARED;
 use crate::givens::{rotate_transposed as rotate, wavefront};
 use crate::householder::reflect_transposed as reflect;
 use crate::math::sqrt;
-use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
+use nalgebra::{Matrix3, Matrix6, SMatrix, SVector, Vector6};
 
 /// Position of `j` among the shared unknowns.
 pub(crate) const J_SHARED: usize = Block::J.shared_column();
@@ -293,6 +293,42 @@ impl SharedQr {
             u[i] = v / d;
         }
         Some(sqrt(s2 * u.norm_squared()))
+    }
+
+    /// The unscaled covariance `(RᵀR)⁻¹` of the three shared unknowns from `column` on,
+    /// every other unknown free (times the residual variance, their least-squares
+    /// covariance): `UᵀU` with `Rᵀ U = [e_c e_{c+1} e_{c+2}]`. A zero pivot (an unknown
+    /// the rows never separated from the ones before it) gives an infinite variance on
+    /// its own axis.
+    #[must_use]
+    pub(crate) fn block_covariance(&self, column: usize) -> Matrix3<f64> {
+        let mut u = [SVector::<f64, SHARED>::zeros(); 3];
+        let mut cov = Matrix3::zeros();
+        for (b, u) in u.iter_mut().enumerate() {
+            if self.rt[(column + b, column + b)] == 0.0 {
+                cov[(b, b)] = f64::INFINITY;
+                continue;
+            }
+            for i in column..SHARED {
+                let d = self.rt[(i, i)];
+                if d == 0.0 {
+                    continue;
+                }
+                let mut v = if i == column + b { 1.0 } else { 0.0 };
+                for k in column..i {
+                    v -= self.rt[(i, k)] * u[k];
+                }
+                u[i] = v / d;
+            }
+        }
+        for a in 0..3 {
+            for b in 0..3 {
+                if cov[(a, a)].is_finite() && cov[(b, b)].is_finite() {
+                    cov[(a, b)] = u[a].dot(&u[b]);
+                }
+            }
+        }
+        cov
     }
 
     /// The reduced problem in `j` with the disturbance torque `τ_b` held at zero instead of

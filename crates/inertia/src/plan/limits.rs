@@ -182,6 +182,7 @@ impl Limits {
 
     /// The same check on a flown trajectory: the true wheel momenta `ρ` and body rates `ω`
     /// at the telemetry nodes (for the flight checks; torque is checked on the commands).
+    #[cfg_attr(not(feature = "sim"), allow(dead_code))] // used by the rehearsal (feature `sim`)
     pub(crate) fn use_of_flight(
         &self,
         rho_nms: &[Vector3<f64>],

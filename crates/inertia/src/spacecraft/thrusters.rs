@@ -18,6 +18,7 @@
 //! the sample (for pulses shorter than the telemetry step, the step's duty cycle is the
 //! closest a node value can come).
 
+#[cfg(feature = "spacecraft")]
 use super::SpacecraftError;
 use nalgebra::Vector3;
 #[cfg(feature = "spacecraft")]
@@ -25,6 +26,7 @@ use serde::Deserialize;
 use std::string::String;
 #[cfg(feature = "spacecraft")]
 use std::string::ToString;
+#[cfg(feature = "spacecraft")]
 use std::vec::Vec;
 
 /// The most thrusters a spacecraft file may list.

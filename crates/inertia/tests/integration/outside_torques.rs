@@ -190,7 +190,7 @@ fn with_noise_the_centre_of_mass_is_within_a_millimetre_and_both_within_three_si
         let p = run(&out.samples, OutsideTorques::default());
         let o = outside(&p);
         let (m, c) = (o.residual_dipole_am2.unwrap(), o.centre_of_mass_m.unwrap());
-        let (sm, sc) = (m.sigma.expect("σ"), c.sigma.expect("σ"));
+        let (sm, sc) = (m.sigma_all().expect("σ"), c.sigma_all().expect("σ"));
         for i in 0..3 {
             let dc = (c.value[i] - CENTRE_M[i]).abs();
             assert!(dc < 1e-3, "seed {seed}: c {c:?}");
@@ -279,7 +279,7 @@ fn the_spacecraft_files_thrusters_give_the_force_and_the_centre_of_mass() {
         .outside
         .expect("outside");
     let com = o.centre_of_mass_m.expect("centre of mass");
-    let sigma = com.sigma.expect("σ");
+    let sigma = com.sigma_all().expect("σ");
     for i in 0..3 {
         let d = (com.value[i] - centre[i]).abs();
         assert!(d < 1e-3 && d <= 3.0 * sigma[i], "{com:?}");
@@ -306,4 +306,47 @@ fn the_spacecraft_files_thrusters_give_the_force_and_the_centre_of_mass() {
         .push_with_actuators(&forced, &[], &[0.0; 6], |_| {})
         .unwrap_err();
     assert!(matches!(e.kind, RunErrorKind::ForceTwice), "{e}");
+}
+
+/// A force that keeps its direction in the body (one thruster) gives no torque for the
+/// centre of mass along it: that direction is reported as not determined, and the
+/// components across it are still within 3σ. With forces in every direction nothing is.
+#[test]
+fn a_centre_of_mass_along_a_fixed_force_is_reported_as_not_determined() {
+    let c = common(true, 1);
+    let scenario = Scenario::slew();
+    let Scenario::Slew(plan) = &scenario else {
+        unreachable!()
+    };
+    let cfg = scenario.config(&c);
+    let control = SlewController::new(
+        plan.nominal_inertia_kg_m2,
+        cfg.initial.q,
+        plan.slews.clone(),
+        plan.natural_freq_rad_s,
+        plan.damping,
+    )
+    .expect("controller");
+    let com = Vector3::from(CENTRE_M);
+    let along_z = |t_s: f64| Vector3::new(0.0, 0.0, 0.02 * (1.0 + (0.05 * t_s).sin()));
+    let torque = move |t_s: f64, _: &inertia::dynamics::GyrostatState| along_z(t_s).cross(&com);
+    let mut out = simulate(&cfg, &control, &torque).expect("sim");
+    for s in &mut out.samples {
+        s.tau_nm = Vector3::zeros();
+        s.external.force_n = Some(along_z(s.t_s));
+    }
+    let p = run(&out.samples, OutsideTorques::default());
+    let e = outside(&p).centre_of_mass_m.expect("centre of mass");
+    let d = Vector3::from(
+        e.undetermined_direction
+            .expect("a direction not determined"),
+    );
+    assert!(d.z.abs() > 0.999, "{e:?}");
+    for ((value, truth), sigma) in e.value.iter().zip(CENTRE_M).zip(e.sigma).take(2) {
+        let sigma = sigma.expect("σ across the force");
+        assert!((value - truth).abs() <= 3.0 * sigma, "{e:?}");
+    }
+    let full = spin_with(false, true, true, 1);
+    let o = outside(&run(&full.samples, OutsideTorques::default()));
+    assert_eq!(o.centre_of_mass_m.expect("c").undetermined_direction, None);
 }

@@ -323,13 +323,21 @@ fn outside_lines(
     }
     let vector = |s: &mut fmt::Formatter<'_>, what: &str, e: &Estimated3, unit: &str| {
         let [x, y, z] = e.value;
-        match e.sigma {
-            Some([a, b, c]) => writeln!(
+        let sigma = e
+            .sigma
+            .map(|v| v.map_or_else(|| "—".into(), |v| format!("{v:.1e}")));
+        writeln!(
+            s,
+            "{what} = [{x:.4e}, {y:.4e}, {z:.4e}] ± [{}] {unit}",
+            sigma.join(", ")
+        )?;
+        if let Some([x, y, z]) = e.undetermined_direction {
+            writeln!(
                 s,
-                "{what} = [{x:.4e}, {y:.4e}, {z:.4e}] ± [{a:.1e}, {b:.1e}, {c:.1e}] {unit}"
-            ),
-            None => writeln!(s, "{what} = [{x:.4e}, {y:.4e}, {z:.4e}] {unit}"),
+                "  not determined along [{x:.3}, {y:.3}, {z:.3}] (body axes): that component gives no torque in these data, and its value is not an estimate"
+            )?;
         }
+        Ok(())
     };
     if let Some(m) = &o.residual_dipole_am2 {
         vector(s, "residual magnetic dipole m (body axes)", m, "A m²")?;
