@@ -354,6 +354,9 @@ fn read_csv(
     options.speed_columns = spacecraft
         .as_ref()
         .map_or_else(Vec::new, |s| s.0.speed_columns());
+    options.thruster_columns = spacecraft
+        .as_ref()
+        .map_or_else(Vec::new, |s| s.0.thruster_columns());
     py.allow_threads(|| read(&path, options, spacecraft))
         .map_err(|f| f.into_py(py))
 }
@@ -399,8 +402,32 @@ fn read(
         let mut s = item.map_err(telemetry_failure)?;
         if let Some((sc, _)) = &spacecraft {
             // The rotor momentum as the run computes it (for `.rho`; the run recomputes).
-            s.rho_nms = sc.momentum_nms(reader.last_speeds());
-            speeds.extend_from_slice(reader.last_speeds());
+            if !sc.rotors.is_empty() {
+                s.rho_nms = sc.momentum_nms(reader.last_speeds());
+                speeds.extend_from_slice(reader.last_speeds());
+            }
+            // The thrusters' torque about the origin and force, as the run computes them
+            // (the run is then given the file without its thrusters).
+            if !sc.thrusters.is_empty() {
+                if s.external.force_n.is_some() {
+                    return Err(Failure::Data {
+                        line: Some(reader.last_line()),
+                        kind: Some(inertia::error_kind::ErrorKind::Columns),
+                        sample: Some(samples.len()),
+                        message: format!(
+                            "{}:{}: the force is given twice: by the file's f_x,f_y,f_z and by the spacecraft file's thrusters; give one",
+                            reader.file(),
+                            reader.last_line()
+                        ),
+                    });
+                }
+                let (force, torque) = inertia::spacecraft::thrusters::force_and_torque(
+                    &sc.thrusters,
+                    reader.last_throttles(),
+                );
+                s.tau_nm += torque;
+                s.external.force_n = Some(force);
+            }
         }
         samples.push(s);
         lines.push(reader.last_line());
@@ -634,6 +661,11 @@ fn restore<'py>(
             let speeds: Vec<f64> = speeds.as_array().iter().copied().collect();
             if speeds.len() != rows.len() * spacecraft.rotors.len() {
                 return Err(value_error("rotors: one speed per rotor and sample"));
+            }
+            if !spacecraft.thrusters.is_empty() {
+                return Err(value_error(
+                    "rotors: the spacecraft file's thrusters need their throttle columns: read the file with read_csv(path, spacecraft=…), or give the force as f= and its torque in tau=",
+                ));
             }
             Ok(Rotors {
                 spacecraft,

@@ -172,9 +172,13 @@ pub fn run(
     };
     match rotors {
         Some(r) => {
-            run = run.with_spacecraft(r.spacecraft.clone());
+            // The thrusters' torque and force are in the samples already (`read_csv`).
+            let mut spacecraft = r.spacecraft.clone();
+            spacecraft.thrusters.clear();
+            run = run.with_spacecraft(spacecraft);
             let m = r.spacecraft.rotors.len();
-            for (s, w) in samples.iter().zip(r.speeds.chunks_exact(m)) {
+            for (k, s) in samples.iter().enumerate() {
+                let w = r.speeds.get(k * m..(k + 1) * m).unwrap_or(&[]);
                 run.push_with_speeds(s, w, &mut keep)
                     .map_err(|e| origin.run_error(&e))?;
             }

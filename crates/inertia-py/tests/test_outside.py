@@ -327,3 +327,34 @@ def test_simulate_outside_options_are_checked():
         inertia.simulate("slew", magnetic_field_t=(1.0, 0.0, 0.0))
     with pytest.raises(ValueError, match=r"^thrusters: simulation setting"):
         inertia.simulate("slew", thrusters=-1.0)
+
+
+#: Three unit thrusters at the origin along the body axes: their throttles are the force's
+#: components and their torque about the origin is zero.
+UNIT_THRUSTERS = "".join(
+    f'[[thruster]]\nname = "t{a}"\nposition_m = [0.0, 0.0, 0.0]\ndirection = {d}\n'
+    f'thrust_n = 1.0\ncolumn = "t_{a}"\n\n'
+    for a, d in (("x", "[1.0, 0.0, 0.0]"), ("y", "[0.0, 1.0, 0.0]"), ("z", "[0.0, 0.0, 1.0]"))
+)
+
+
+def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path):
+    """A spacecraft file's thrusters with throttle columns (`read_csv(spacecraft=…)`):
+    the same report as the force columns they replace, by Python and by the CLI, and the
+    Telemetry's force is the file's."""
+    src = outside_files["thrusters"]
+    c = load(src)
+    names = [n for n in c if not n.startswith("f_")]
+    data = np.column_stack([c[n] for n in names] + [c[f"f_{a}"] for a in "xyz"])
+    path = tmp_path / "throttles.csv"
+    np.savetxt(path, data, delimiter=",", header=",".join(names + ["t_x", "t_y", "t_z"]),
+               comments="", fmt="%.17g")
+    sc = tmp_path / "thrusters.toml"
+    sc.write_text(UNIT_THRUSTERS)
+    expected = inertia.estimate(str(src)).to_dict()
+    got = inertia.estimate(str(path), spacecraft=str(sc)).to_dict()
+    agree(expected, got)
+    assert got["outside"]["centre_of_mass_m"] == expected["outside"]["centre_of_mass_m"]
+    agree(expected, cli_estimate(cli, path, "--spacecraft", sc))
+    t = inertia.read_csv(str(path), spacecraft=str(sc))
+    np.testing.assert_array_equal(t.f, block(c, "f"))
