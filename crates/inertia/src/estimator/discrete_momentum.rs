@@ -530,6 +530,19 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         })
     }
 
+    /// The residual dipole and the centre of mass that fit best at `j`, where the rows use
+    /// them (their values only: [`Self::outside_at`] gives them with σ).
+    #[must_use]
+    pub(crate) fn outside_values_at(&self, j: &InertiaVector) -> [Option<[f64; 3]>; 2] {
+        let [dipole, centre] = self.external_counted;
+        if !(dipole || centre) {
+            return [None, None];
+        }
+        let x = self.qr.nuisance_at(j);
+        let v = |c: usize| [x[c], x[c + 1], x[c + 2]];
+        [dipole.then(|| v(DIPOLE)), centre.then(|| v(CENTRE_OF_MASS))]
+    }
+
     /// The outside torques at the answer `e` (this estimator's or one made of its
     /// rows): whether the gravity gradient entered this estimator's own rows, and the
     /// residual dipole and centre of mass where the rows use them. Their σ: the larger of

@@ -66,7 +66,10 @@ use candidates::{candidates, chained_siblings, settings, shared_sources, Candida
 use cross_check::CrossCheck;
 use finish::{finish, Evidence, Finished};
 use select::{alternatives_from_s, in_running, pick, test_inertial_torque};
-use sigma::{candidate_noise_sigma, discretisation_bias, double_step, model_spread, own_answer};
+use sigma::{
+    candidate_noise_sigma, discretisation_bias, double_step, model_spread, outside_spread,
+    own_answer,
+};
 use standing::{Standing, RULE_OUT_AFTER};
 use std::boxed::Box;
 use std::vec::Vec;
@@ -402,8 +405,49 @@ impl DiscreteMomentum {
             self.density_ratio = density_ratio;
             self.damping = damping;
         }
-        self.outside = self.candidates[self.chosen].outside_at(&e);
+        self.outside = self.candidates[self.chosen]
+            .outside_at(&e)
+            .map(|o| self.widened_by_model_spread(o));
         Ok(Some(e))
+    }
+
+    /// The outside torques' σ with their model spread in quadrature ([`outside_spread`]),
+    /// over the candidates [`Evidence::model_spread`] takes for `j`.
+    fn widened_by_model_spread(&self, mut o: OutsideEstimates) -> OutsideEstimates {
+        let others = self
+            .candidates
+            .iter()
+            .enumerate()
+            .filter(|&(i, c)| {
+                i != self.chosen
+                    && self.standing.live(i)
+                    && self.fits.get(i).is_some_and(|f| f.0.is_finite())
+                    && in_running(c.row_settings(), self.from_s)
+            })
+            .map(|(_, c)| c);
+        let (gyro, constraints) = (self.config.gyro_noise_rad_s_rthz, &self.config.constraints);
+        let mut spread = outside_spread(&self.candidates[self.chosen], others, gyro, constraints);
+        // The discretisation bias, as j's: the first candidate's against its half-rate
+        // shadow, |x(h) − x(2h)|/3.
+        if let (Some(first), Some(shadow)) = (self.candidates.first(), self.shadow.as_deref()) {
+            let half = outside_spread(first, core::iter::once(shadow), gyro, constraints);
+            for (s, h) in spread.iter_mut().zip(half) {
+                for (s, h) in s.iter_mut().zip(h) {
+                    *s = libm::sqrt(*s * *s + h * h / 9.0);
+                }
+            }
+        }
+        for (e, s) in [&mut o.residual_dipole_am2, &mut o.centre_of_mass_m]
+            .into_iter()
+            .zip(spread)
+        {
+            if let Some(e) = e.as_mut() {
+                for (sigma, s) in e.sigma.iter_mut().zip(s) {
+                    *sigma = sigma.map(|v| libm::sqrt(v * v + s * s));
+                }
+            }
+        }
+        o
     }
 
     /// Rule out the candidates the data have ruled out ([`standing`]). The first

@@ -75,6 +75,52 @@ pub(super) fn model_spread(
     out
 }
 
+/// The model-uncertainty part of the outside torques' σ ([`crate::estimator::external_torque`]),
+/// as [`model_spread`]'s for `j`: per component, the largest difference between the
+/// chosen candidate's residual dipole and centre of mass and those of every other
+/// candidate whose residual variance is comparable, each at its own unconstrained answer.
+pub(super) fn outside_spread<'a>(
+    best: &Candidate,
+    others: impl Iterator<Item = &'a Candidate>,
+    gyro: Option<f64>,
+    constraints: &Constraints,
+) -> [[f64; 3]; 2] {
+    let mut out = [[0.0; 3]; 2];
+    let reduced = best.qr().reduced();
+    let dof = reduced.residual_dof();
+    let Some(j) = (dof > 0.0)
+        .then(|| own_solution(&reduced, gyro, constraints))
+        .flatten()
+    else {
+        return out;
+    };
+    let mine = best.outside_values_at(&j);
+    if mine.iter().all(Option::is_none) {
+        return out;
+    }
+    let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
+    for c in others {
+        let qr = c.qr().reduced();
+        if !(qr.residual_variance() <= ratio * reduced.residual_variance()) {
+            continue;
+        }
+        let Some(jc) = own_solution(&qr, gyro, constraints) else {
+            continue;
+        };
+        for (o, (a, b)) in out
+            .iter_mut()
+            .zip(c.outside_values_at(&jc).iter().zip(&mine))
+        {
+            if let (Some(a), Some(b)) = (a, b) {
+                for i in 0..3 {
+                    o[i] = o[i].max((a[i] - b[i]).abs());
+                }
+            }
+        }
+    }
+    out
+}
+
 /// The discretisation-bias part of σ: the same rows on every other sample (step 2h) are
 /// biased `2^p` times as much as on every sample for a method of order `p`, so
 /// `|ĵ(h) − ĵ(2h)|/(2^p − 1)` measures the bias of `ĵ(h)` from the data (Richardson's
