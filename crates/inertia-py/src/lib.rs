@@ -662,11 +662,8 @@ fn restore<'py>(
             if speeds.len() != rows.len() * spacecraft.rotors.len() {
                 return Err(value_error("rotors: one speed per rotor and sample"));
             }
-            if !spacecraft.thrusters.is_empty() {
-                return Err(value_error(
-                    "rotors: the spacecraft file's thrusters need their throttle columns: read the file with read_csv(path, spacecraft=…), or give the force as f= and its torque in tau=",
-                ));
-            }
+            // A thruster file's torque and force are in the pickled samples already (as
+            // `read_csv` put them); the run is given the file without its thrusters.
             Ok(Rotors {
                 spacecraft,
                 source: (text, name),

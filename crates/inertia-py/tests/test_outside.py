@@ -358,3 +358,20 @@ def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path)
     agree(expected, cli_estimate(cli, path, "--spacecraft", sc))
     t = inertia.read_csv(str(path), spacecraft=str(sc))
     np.testing.assert_array_equal(t.f, block(c, "f"))
+
+
+def test_a_thruster_telemetry_survives_pickling(outside_files, tmp_path):
+    """`read_csv(spacecraft=…)` with thrusters, pickled and restored: the same estimate."""
+    src = outside_files["thrusters"]
+    c = load(src)
+    names = [n for n in c if not n.startswith("f_")]
+    data = np.column_stack([c[n] for n in names] + [c[f"f_{a}"] for a in "xyz"])
+    path = tmp_path / "throttles.csv"
+    np.savetxt(path, data, delimiter=",", header=",".join(names + ["t_x", "t_y", "t_z"]),
+               comments="", fmt="%.17g")
+    sc = tmp_path / "thrusters.toml"
+    sc.write_text(UNIT_THRUSTERS)
+    t = inertia.read_csv(str(path), spacecraft=str(sc))
+    back = pickle.loads(pickle.dumps(t))
+    np.testing.assert_array_equal(back.f, t.f)
+    agree(inertia.estimate(t).to_dict(), inertia.estimate(back).to_dict())

@@ -161,6 +161,12 @@ pub struct MomentumEstimatorSettings {
 impl MomentumEstimatorSettings {
     /// Check the settings.
     pub fn validate(&self) -> Result<(), EstimatorError> {
+        if !self.rows.outside.valid() {
+            return Err(EstimatorError::InvalidSetting {
+                field: "rows.outside.gravity_mu_m3_s2",
+                why: "must be finite and > 0",
+            });
+        }
         self.recursive.validate()
     }
 }

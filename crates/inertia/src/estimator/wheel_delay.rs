@@ -45,7 +45,7 @@
 //! The samples' times must increase strictly (the run's sample gate checks that). Cost:
 //! about 90 fits of the record's rows, and some 0.3 KB per sample while it runs.
 
-use super::momentum_rows::{MomentumRowSettings, MomentumRows, Stencil, J, TORQUE};
+use super::momentum_rows::{MomentumRowSettings, MomentumRows, OutsideTorques, Stencil, J, TORQUE};
 use super::plain_fit::{fit, residuals, rhs, Fit, Rows};
 use crate::sample::Sample;
 use nalgebra::Vector3;
@@ -209,7 +209,7 @@ fn interpolate_from(t: &[f64], rho: &[Vector3<f64>], k: usize, x: f64) -> (Vecto
 /// the stretch between gaps that holds it ([`segments`]).
 type Window = (usize, usize, usize, usize);
 
-fn rows(samples: &[Sample], windows: &[Window], delay_s: f64) -> Rows {
+fn rows(samples: &[Sample], windows: &[Window], delay_s: f64, outside: &OutsideTorques) -> Rows {
     let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
     let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
     let mut out = Rows {
@@ -222,6 +222,7 @@ fn rows(samples: &[Sample], windows: &[Window], delay_s: f64) -> Rows {
         stencil: Stencil::Plain,
         torque_bias: true,
         inertial_torque: true,
+        outside: *outside,
         ..MomentumRowSettings::default()
     });
     let mut epoch = None;
@@ -264,8 +265,13 @@ fn rows(samples: &[Sample], windows: &[Window], delay_s: f64) -> Rows {
 }
 
 /// `RSS(δ)` and `ĵ(δ)`, or `None` where the fit is singular.
-fn profile(samples: &[Sample], windows: &[Window], delay_s: f64) -> Option<(f64, Fit)> {
-    let r = rows(samples, windows, delay_s);
+fn profile(
+    samples: &[Sample],
+    windows: &[Window],
+    delay_s: f64,
+    outside: &OutsideTorques,
+) -> Option<(f64, Fit)> {
+    let r = rows(samples, windows, delay_s, outside);
     let f = fit(&r, &rhs(&r))?;
     Some((f.rss, f))
 }
@@ -290,11 +296,25 @@ fn parabola_vertex(p: &[(f64, f64)]) -> Option<f64> {
     (c[2] > 0.0 && x >= lo && x <= hi).then_some(x)
 }
 
-/// Estimate the wheel-speed telemetry's time tag from `samples` ([module docs](self)).
-pub(crate) fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
+/// Estimate the wheel-speed telemetry's time tag from `samples` ([module docs](self)),
+/// the rows modelling the gravity gradient as the run's `outside` says.
+pub(crate) fn estimate(
+    samples: &[Sample],
+    outside: &OutsideTorques,
+) -> Result<DelayFit, DelayError> {
     let n = samples.len();
     if n < 8 {
         return Err(DelayError::NotEstimable("too few samples"));
+    }
+    // The profile's small fit has no residual dipole or centre of mass: refused rather
+    // than biased by their torque.
+    if samples.iter().any(|s| {
+        (outside.residual_dipole && s.external.field_t.is_some())
+            || (outside.centre_of_mass && s.external.force_n.is_some())
+    }) {
+        return Err(DelayError::NotEstimable(
+            "its profile does not model a residual magnetic dipole or the centre of mass (the input has a magnetic field or a force): give the time tag in seconds, or leave it off",
+        ));
     }
     let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
     // The stretches between gaps (records), and the shortest of them that matter.
@@ -335,7 +355,7 @@ pub(crate) fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
             "the rotor momentum does not change",
         ));
     }
-    let eval = |d: f64| profile(samples, windows, d).map_or(f64::INFINITY, |p| p.0);
+    let eval = |d: f64| profile(samples, windows, d, outside).map_or(f64::INFINITY, |p| p.0);
     let grid: Vec<(f64, f64)> = (0..=2 * GRID)
         .map(|i| {
             let d = -half + step * i as f64;
@@ -368,14 +388,14 @@ pub(crate) fn estimate(samples: &[Sample]) -> Result<DelayFit, DelayError> {
         .filter(|p| p.1.is_finite())
         .collect();
     let delay = d_best + step * parabola_vertex(&fine).unwrap_or(0.0);
-    let r = rows(samples, windows, delay);
+    let r = rows(samples, windows, delay, outside);
     let y = rhs(&r);
     let f = fit(&r, &y).ok_or(DelayError::NotEstimable("singular fit"))?;
     // ∂r/∂δ at fixed unknowns, then residualised on the regressors (the same fit).
     let eps = step;
     // The rows a step either side, one at a time: their right-hand sides and answers.
     let side = |d: f64| {
-        let r = rows(samples, windows, d);
+        let r = rows(samples, windows, d, outside);
         let y = rhs(&r);
         let j = fit(&r, &y).map(|f| f.theta);
         (y, j)

@@ -246,7 +246,14 @@ impl Run {
             return self.push_sample(&sample, on_estimate);
         }
         sample.rho_nms = rotors.momentum_nms(speeds);
-        if let Err(e) = crate::sample::check_range(&sample) {
+        // The speeds' momentum only: another value out of range (a thruster torque) is the
+        // sample gate's to name, in `push_sample`.
+        let rho_only = Sample {
+            tau_nm: nalgebra::Vector3::zeros(),
+            external: Default::default(),
+            ..sample
+        };
+        if let Err(e) = crate::sample::check_range(&rho_only) {
             return Err(RunError::at(
                 index,
                 RunErrorKind::RotorMomentumOutOfRange {
@@ -462,7 +469,7 @@ impl Run {
         let fit = match self.config.wheel_delay {
             WheelDelay::Off => return,
             WheelDelay::KnownS(d) => Ok(DelayFit::known(d)),
-            WheelDelay::Estimate => wheel_delay::estimate(samples),
+            WheelDelay::Estimate => wheel_delay::estimate(samples, &self.config.outside),
         };
         if let Ok(f) = &fit {
             wheel_delay::shift_rho(samples, f.delay_s);

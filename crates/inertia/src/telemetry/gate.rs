@@ -259,6 +259,12 @@ pub enum SampleError {
     /// A commanded dipole without the magnetic field its torque needs.
     #[error("commanded dipoles (dipole_x,dipole_y,dipole_z) need the magnetic field (b_x,b_y,b_z) for their torque m × B")]
     DipoleWithoutField,
+    /// A position at the centre of the attracting body, where the gravity gradient has
+    /// no direction.
+    #[error(
+        "position (r_x,r_y,r_z) zero: the position is from the centre of the attracting body, in m"
+    )]
+    PositionAtCentre,
     /// Positions with an attitude integrated from the gyro, whose inertial frame is the
     /// first body frame, not the positions'.
     #[error("positions (r_x,r_y,r_z) need the attitude in their inertial frame, and without quaternions it is integrated from the gyro in an arbitrary one")]
@@ -286,7 +292,9 @@ impl SampleError {
             SampleError::GyroChanged { .. } | SampleError::NoAttitude => Field::Rate(0),
             SampleError::ExternalChanged { what, .. } => what.field(0),
             SampleError::DipoleWithoutField => Field::Dipole(0),
-            SampleError::PositionWithoutAttitude => Field::Position(0),
+            SampleError::PositionWithoutAttitude | SampleError::PositionAtCentre => {
+                Field::Position(0)
+            }
         }
     }
 
@@ -304,6 +312,7 @@ impl SampleError {
             SampleError::ExternalChanged { .. }
             | SampleError::DipoleWithoutField
             | SampleError::PositionWithoutAttitude => ErrorKind::Columns,
+            SampleError::PositionAtCentre => ErrorKind::OutOfRange,
         }
     }
 }
@@ -580,6 +589,9 @@ impl Gate {
         let [position_m, field_t, force_n, dipole] = v;
         if position_m.is_some() && self.options.attitude_from_gyro {
             return Err(SampleError::PositionWithoutAttitude);
+        }
+        if position_m.is_some_and(|r| r == Vector3::zeros()) {
+            return Err(SampleError::PositionAtCentre);
         }
         let torque = match (dipole, field_t) {
             (Some(m), Some(b)) => m.cross(&b),

@@ -56,7 +56,7 @@ fn the_shift_reads_rho_later_and_holds_it_at_the_ends() {
 #[test]
 fn recovers_a_known_late_time_tag_on_the_slew() {
     for seed in 1..=3 {
-        let f = estimate(&slew(0.05, seed)).expect("estimable");
+        let f = estimate(&slew(0.05, seed), &OutsideTorques::default()).expect("estimable");
         assert!(f.estimated);
         let z = (f.delay_s - 0.05) / f.sigma_s;
         assert!(
@@ -73,7 +73,7 @@ fn recovers_a_known_late_time_tag_on_the_slew() {
 fn finds_no_time_tag_where_there_is_none() {
     let covered = (1..=10)
         .filter(|&seed| {
-            let f = estimate(&slew(0.0, seed)).expect("estimable");
+            let f = estimate(&slew(0.0, seed), &OutsideTorques::default()).expect("estimable");
             (f.delay_s / f.sigma_s).abs() <= 3.0
         })
         .count();
@@ -92,7 +92,7 @@ fn finds_the_mean_lag_of_held_speed_telemetry() {
         ]);
         p.common.seed = seed;
         let out = p.simulate().expect("valid settings");
-        let f = estimate(&out.samples).expect("estimable");
+        let f = estimate(&out.samples, &OutsideTorques::default()).expect("estimable");
         let off = f.delay_s - 4.875e-3;
         assert!(
             off.abs() < 3e-4 && off.abs() < 3.0 * f.sigma_s,
@@ -110,8 +110,11 @@ fn refuses_a_record_whose_rotor_momentum_does_not_change() {
             ..s
         })
         .collect();
-    assert!(estimate(&s).is_err());
-    assert!(estimate(&s[..5]).is_err(), "too short");
+    assert!(estimate(&s, &OutsideTorques::default()).is_err());
+    assert!(
+        estimate(&s[..5], &OutsideTorques::default()).is_err(),
+        "too short"
+    );
 }
 
 #[test]
@@ -154,4 +157,22 @@ fn the_shift_does_not_read_across_a_gap() {
         (x + 3.0).abs() < 1e-12,
         "held at the stretch's start, not read before it: {x}"
     );
+}
+
+/// With a magnetic field or a force the profile's fit would leave their unknowns out:
+/// the time tag is refused with the reason, not biased; without the residual dipole on,
+/// the field alone is no reason.
+#[test]
+fn a_field_or_a_force_is_refused_with_the_reason() {
+    let mut s = slew(0.05, 1);
+    for x in &mut s {
+        x.external.field_t = Some(Vector3::new(2e-5, 0.0, 1e-5));
+    }
+    let e = estimate(&s, &OutsideTorques::default()).unwrap_err();
+    assert!(e.to_string().contains("residual magnetic dipole"), "{e}");
+    let off = OutsideTorques {
+        residual_dipole: false,
+        ..OutsideTorques::default()
+    };
+    assert!(estimate(&s, &off).is_ok());
 }

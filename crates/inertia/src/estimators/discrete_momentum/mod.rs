@@ -426,11 +426,16 @@ impl DiscreteMomentum {
             })
             .map(|(_, c)| c);
         let (gyro, constraints) = (self.config.gyro_noise_rad_s_rthz, &self.config.constraints);
-        let mut spread = outside_spread(&self.candidates[self.chosen], others, gyro, constraints);
+        let mut spread = outside_spread(
+            &self.candidates[self.chosen],
+            others,
+            (gyro, constraints),
+            true,
+        );
         // The discretisation bias, as j's: the first candidate's against its half-rate
         // shadow, |x(h) − x(2h)|/3.
         if let (Some(first), Some(shadow)) = (self.candidates.first(), self.shadow.as_deref()) {
-            let half = outside_spread(first, core::iter::once(shadow), gyro, constraints);
+            let half = outside_spread(first, core::iter::once(shadow), (gyro, constraints), false);
             for (s, h) in spread.iter_mut().zip(half) {
                 for (s, h) in s.iter_mut().zip(h) {
                     *s = libm::sqrt(*s * *s + h * h / 9.0);

@@ -78,12 +78,14 @@ pub(super) fn model_spread(
 /// The model-uncertainty part of the outside torques' σ ([`crate::estimator::external_torque`]),
 /// as [`model_spread`]'s for `j`: per component, the largest difference between the
 /// chosen candidate's residual dipole and centre of mass and those of every other
-/// candidate whose residual variance is comparable, each at its own unconstrained answer.
+/// candidate whose residual variance is comparable (every one given, without
+/// `comparable_only`: the half-rate shadow of the discretisation bias, whose rows are
+/// noisier by design), each at its own unconstrained answer.
 pub(super) fn outside_spread<'a>(
     best: &Candidate,
     others: impl Iterator<Item = &'a Candidate>,
-    gyro: Option<f64>,
-    constraints: &Constraints,
+    (gyro, constraints): (Option<f64>, &Constraints),
+    comparable_only: bool,
 ) -> [[f64; 3]; 2] {
     let mut out = [[0.0; 3]; 2];
     let reduced = best.qr().reduced();
@@ -101,7 +103,7 @@ pub(super) fn outside_spread<'a>(
     let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
     for c in others {
         let qr = c.qr().reduced();
-        if !(qr.residual_variance() <= ratio * reduced.residual_variance()) {
+        if comparable_only && !(qr.residual_variance() <= ratio * reduced.residual_variance()) {
             continue;
         }
         let Some(jc) = own_solution(&qr, gyro, constraints) else {

@@ -125,3 +125,16 @@ fn outside_measurements_are_checked_all_or_none_and_a_dipole_adds_its_torque() {
         SampleError::PositionWithoutAttitude
     );
 }
+
+#[test]
+fn a_position_at_the_centre_is_refused() {
+    let mut g = Gate::default();
+    let mut r = raw(0.0);
+    r.external.position_m = Some([0.0; 3]);
+    let e = g.check(&r).unwrap_err();
+    assert_eq!(e, SampleError::PositionAtCentre);
+    assert_eq!(
+        (e.field(), e.error_kind()),
+        (Field::Position(0), ErrorKind::OutOfRange)
+    );
+}
