@@ -350,3 +350,33 @@ fn a_centre_of_mass_along_a_fixed_force_is_reported_as_not_determined() {
     let o = outside(&run(&full.samples, OutsideTorques::default()));
     assert_eq!(o.centre_of_mass_m.expect("c").undetermined_direction, None);
 }
+
+/// The batch run (an independent path: dense QR per chain and once over the shared
+/// unknowns) reports the dipole and the centre of mass too, within the streaming run's
+/// σ of its values and within 3σ of the truth.
+#[test]
+fn the_batch_run_reports_the_dipole_and_the_centre_of_mass_as_the_streaming_run() {
+    let out = spin_with(true, true, true, 2);
+    let streaming = outside(&run(&out.samples, OutsideTorques::default()));
+    let config = PipelineSettings::default().validate().expect("valid");
+    let batch = inertia::pipeline::batch(&out.samples, &config).expect("batch");
+    let b = batch
+        .diagnostics
+        .outside
+        .expect("outside torques in the batch report");
+    for (s, b, truth) in [
+        (
+            streaming.residual_dipole_am2,
+            b.residual_dipole_am2,
+            DIPOLE_AM2,
+        ),
+        (streaming.centre_of_mass_m, b.centre_of_mass_m, CENTRE_M),
+    ] {
+        let (s, b) = (s.expect("streaming"), b.expect("batch"));
+        let (ss, bs) = (s.sigma_all().expect("σ"), b.sigma_all().expect("σ"));
+        for i in 0..3 {
+            assert!((s.value[i] - b.value[i]).abs() <= ss[i], "{s:?} vs {b:?}");
+            assert!((b.value[i] - truth[i]).abs() <= 3.0 * bs[i], "{b:?}");
+        }
+    }
+}

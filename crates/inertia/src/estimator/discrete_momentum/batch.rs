@@ -24,6 +24,69 @@ pub(crate) struct BatchReduction {
     pub(crate) without_torque: Option<(RecursiveQr, f64)>,
     /// The damping's row of the shared factor, where the rows estimate one.
     pub(crate) damping: Option<DampingRow>,
+    /// The shared factor for the outside torques' values, where the rows use them.
+    pub(crate) outside: Option<OutsideRows>,
+}
+
+/// The shared factor of a batch reduction, kept for the outside torques' values
+/// ([`crate::estimator::external_torque`]): `R` (upper triangular over the shared
+/// columns used, `j` last), `Qᵀy`, the columns, the residual variance.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct OutsideRows {
+    r: nalgebra::DMatrix<f64>,
+    qty: nalgebra::DVector<f64>,
+    columns: std::vec::Vec<usize>,
+    s2: f64,
+}
+
+/// A 3-vector unknown's value and σ per component.
+pub(crate) type ValueSigma = ([f64; 3], [Option<f64>; 3]);
+
+impl OutsideRows {
+    /// The residual dipole and the centre of mass at `j` (where the rows use them), each
+    /// with its least-squares σ per component (every other unknown free).
+    #[must_use]
+    pub(crate) fn at(&self, j: &InertiaVector) -> [Option<ValueSigma>; 2] {
+        use est::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
+        let n = self.columns.len();
+        let lead = n - 6;
+        // Back-substitution over the leading columns with `j` fixed.
+        let mut x = nalgebra::DVector::zeros(lead);
+        for i in (0..lead).rev() {
+            let d = self.r[(i, i)];
+            if d == 0.0 {
+                continue;
+            }
+            let mut s = self.qty[i];
+            for k in i + 1..lead {
+                s -= self.r[(i, k)] * x[k];
+            }
+            for k in 0..6 {
+                s -= self.r[(i, lead + k)] * j[k];
+            }
+            x[i] = s / d;
+        }
+        let sigma = |p: usize| {
+            let mut e = nalgebra::DVector::zeros(n);
+            e[p] = 1.0;
+            self.r
+                .transpose()
+                .solve_lower_triangular(&e)
+                .filter(|_| self.s2.is_finite() && self.r[(p, p)] != 0.0)
+                .map(|u| crate::math::sqrt(self.s2 * u.norm_squared()))
+        };
+        [DIPOLE, CENTRE_OF_MASS].map(|block| {
+            let at: std::vec::Vec<usize> = (block..block + 3)
+                .filter_map(|k| self.columns.iter().position(|&c| c == k))
+                .collect();
+            (at.len() == 3).then(|| {
+                (
+                    [x[at[0]], x[at[1]], x[at[2]]],
+                    [sigma(at[0]), sigma(at[1]), sigma(at[2])],
+                )
+            })
+        })
+    }
 }
 
 #[cfg(test)]
@@ -204,13 +267,15 @@ pub(crate) fn reduce_batch(
                     z[i] = -z[i];
                 }
             }
+            let rss = (energy - qty.norm_squared()).max(0.0);
             let damping = damping_at.filter(|_| drop == 0).map(|p| {
                 let r_dj = Vector6::from_fn(|i, _| r[(p, off + i)]);
-                (r[(p, p)], r_dj, qty[p], r)
+                (r[(p, p)], r_dj, qty[p], r.clone())
             });
-            (rr, z, (energy - qty.norm_squared()).max(0.0), damping)
+            let full = (drop == 0).then_some((r, qty));
+            (rr, z, rss, damping, full)
         };
-    let (rr, z, shared_rss, damping_factor) = solve_shared(&blocks, &|_| true, 0);
+    let (rr, z, shared_rss, damping_factor, full) = solve_shared(&blocks, &|_| true, 0);
     let damping_of = |row: &Option<(f64, Vector6<f64>, f64, DMatrix<f64>)>, j: &InertiaVector| {
         row.as_ref()
             .map(|(r_dd, r_dj, z_d, _)| (z_d - r_dj.dot(j)) / r_dd)
@@ -226,7 +291,7 @@ pub(crate) fn reduce_batch(
         0
     };
     let without_torque = (torque > 0).then(|| {
-        let (r, z, held_rss, _) = solve_shared(&blocks, &|_| true, torque);
+        let (r, z, held_rss, _, _) = solve_shared(&blocks, &|_| true, torque);
         let growth = (held_rss - shared_rss).max(0.0);
         let qr = RecursiveQr {
             r,
@@ -249,7 +314,7 @@ pub(crate) fn reduce_batch(
     let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
         (0..chains.len().min(GROUPS))
             .map(|g| {
-                let (r, z, _, d) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
+                let (r, z, _, d, _) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
                 let j = crate::solver::unconstrained_minimiser(&r, &z)?;
                 Some((j, damping_of(&d, &j)))
             })
@@ -278,7 +343,7 @@ pub(crate) fn reduce_batch(
                         reduce_chain(&kept).0
                     })
                     .collect();
-                let (r, z, _, d) = solve_shared(&without, &|_| true, 0);
+                let (r, z, _, d, _) = solve_shared(&without, &|_| true, 0);
                 let j = crate::solver::unconstrained_minimiser(&r, &z)?;
                 Some((j, damping_of(&d, &j)))
             })
@@ -312,6 +377,18 @@ pub(crate) fn reduce_batch(
             .and_then(jackknife_sigma)
             .map(|s| s.map(|v| v * time_block_scale)),
         without_torque,
+        outside: full
+            .filter(|_| {
+                shared_columns
+                    .iter()
+                    .any(|&k| (DIPOLE..CENTRE_OF_MASS + 3).contains(&k))
+            })
+            .map(|(r, qty)| OutsideRows {
+                r,
+                qty,
+                columns: shared_columns.clone(),
+                s2: est::qr::residual_variance(rss, rows as f64 - 6.0 - nuisance),
+            }),
         damping: damping_factor
             .zip(damping_at)
             .map(|((r_dd, r_dj, z_d, r), p)| {

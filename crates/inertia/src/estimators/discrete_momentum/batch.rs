@@ -15,6 +15,7 @@ use super::DISCRETE_MOMENTUM;
 use crate::estimator::consistency::{self, ResidualSegments};
 use crate::estimator::discrete_momentum::{reduce_batch, torque_tested, BatchReduction};
 use crate::estimator::excitation::diagnose;
+use crate::estimator::external_torque::{Estimated3, OutsideEstimates};
 use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::observability::Observability;
@@ -125,6 +126,7 @@ pub(super) fn run_batch(
         } => (density_ratio, damping),
         Finished::Reversed => (None, None),
     };
+    let outside = batch_outside(samples, rows, &reduced[chosen].1, &estimate);
     Ok(BatchOutput {
         estimate,
         diagnostics: Diagnostics {
@@ -134,10 +136,63 @@ pub(super) fn run_batch(
             torque_test,
             gyro_density_ratio,
             damping_nms,
+            outside,
             attitude_is_gyro_integral,
             ..Diagnostics::default()
         },
     })
+}
+
+/// The outside torques of a batch run at its answer `e`, from the chosen reduction:
+/// whether the gravity gradient was modelled, the residual dipole and the centre of mass
+/// with their least-squares σ and, in quadrature, `e`'s σ beyond its noise carried
+/// through `∂x/∂j` (as the streaming run's).
+fn batch_outside(
+    samples: &[Sample],
+    rows: &MomentumRowSettings,
+    b: &BatchReduction,
+    e: &Estimate,
+) -> Option<OutsideEstimates> {
+    let gravity_gradient =
+        rows.outside.gravity_gradient && samples.iter().any(|s| s.external.position_m.is_some());
+    let j = e.j()?;
+    let values = b.outside.as_ref().map(|o| {
+        let at = o.at(&j);
+        let beyond: [f64; 6] = e.uncertainty.map_or([0.0; 6], |u| {
+            core::array::from_fn(|k| {
+                let (t, n) = (u.sigma_kg_m2[k], u.noise_kg_m2[k]);
+                libm::sqrt((t * t - n * n).max(0.0))
+            })
+        });
+        let moved: [_; 6] = core::array::from_fn(|k| {
+            let mut jk = j;
+            jk[k] += 1.0;
+            o.at(&jk)
+        });
+        core::array::from_fn::<_, 2, _>(|blk| {
+            at[blk].map(|(value, sigma)| {
+                let sigma = core::array::from_fn(|i| {
+                    let carried: f64 = (0..6)
+                        .filter_map(|k| moved[k][blk].map(|m| (m.0[i] - value[i]) * beyond[k]))
+                        .map(|v| v * v)
+                        .sum();
+                    sigma[i].map(|s| libm::sqrt(s * s + carried))
+                });
+                Estimated3 {
+                    value,
+                    sigma,
+                    undetermined_direction: None,
+                }
+            })
+        })
+    });
+    let [dipole, centre] = values.unwrap_or([None, None]);
+    let o = OutsideEstimates {
+        gravity_gradient,
+        residual_dipole_am2: dipole,
+        centre_of_mass_m: centre,
+    };
+    o.any().then_some(o)
 }
 
 /// The batch run's candidates once one is chosen, as the σ and the status of its answer
