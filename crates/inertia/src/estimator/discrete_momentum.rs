@@ -568,12 +568,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         }
         let x = self.qr.nuisance_at(&j);
         // The part of σ beyond the noise, per element of j.
-        let beyond: [f64; 6] = e.uncertainty.map_or([0.0; 6], |u| {
-            core::array::from_fn(|k| {
-                let (t, n) = (u.sigma_kg_m2[k], u.noise_kg_m2[k]);
-                crate::math::sqrt((t * t - n * n).max(0.0))
-            })
-        });
+        let beyond = e.uncertainty.map_or([0.0; 6], |u| u.beyond_noise_kg_m2());
         let sensitivity: [_; 6] = core::array::from_fn(|k| {
             let mut jk = j;
             jk[k] += 1.0;

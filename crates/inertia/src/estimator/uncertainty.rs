@@ -50,6 +50,16 @@ pub struct Uncertainty {
 
 #[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl Uncertainty {
+    /// The part of each element's σ beyond its noise (discretisation bias, model spread,
+    /// consider terms), `√(σ² − σ_noise²)`, kg m².
+    #[must_use]
+    pub(crate) fn beyond_noise_kg_m2(&self) -> [f64; 6] {
+        core::array::from_fn(|k| {
+            let (t, n) = (self.sigma_kg_m2[k], self.noise_kg_m2[k]);
+            crate::math::sqrt((t * t - n * n).max(0.0))
+        })
+    }
+
     /// This σ widened by a relative uncertainty `r` of the rotor momentum's scale (a
     /// consider parameter): the momentum rows are linear in `ρ`, so without a known torque
     /// a scale error `ε` of `ρ` scales the answer by `1 + ε` exactly, and to first order

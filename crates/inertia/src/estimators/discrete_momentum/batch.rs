@@ -158,12 +158,7 @@ fn batch_outside(
     let j = e.j()?;
     let values = b.outside.as_ref().map(|o| {
         let at = o.at(&j);
-        let beyond: [f64; 6] = e.uncertainty.map_or([0.0; 6], |u| {
-            core::array::from_fn(|k| {
-                let (t, n) = (u.sigma_kg_m2[k], u.noise_kg_m2[k]);
-                libm::sqrt((t * t - n * n).max(0.0))
-            })
-        });
+        let beyond = e.uncertainty.map_or([0.0; 6], |u| u.beyond_noise_kg_m2());
         let moved: [_; 6] = core::array::from_fn(|k| {
             let mut jk = j;
             jk[k] += 1.0;
