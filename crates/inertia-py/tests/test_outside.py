@@ -338,11 +338,9 @@ UNIT_THRUSTERS = "".join(
 )
 
 
-def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path):
-    """A spacecraft file's thrusters with throttle columns (`read_csv(spacecraft=…)`):
-    the same report as the force columns they replace, by Python and by the CLI, and the
-    Telemetry's force is the file's."""
-    src = outside_files["thrusters"]
+def with_throttles(src, tmp_path):
+    """The thrusters file `src` with its force columns as the throttles of
+    `UNIT_THRUSTERS` (written beside it): the file, the spacecraft file, the columns."""
     c = load(src)
     names = [n for n in c if not n.startswith("f_")]
     data = np.column_stack([c[n] for n in names] + [c[f"f_{a}"] for a in "xyz"])
@@ -351,6 +349,15 @@ def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path)
                comments="", fmt="%.17g")
     sc = tmp_path / "thrusters.toml"
     sc.write_text(UNIT_THRUSTERS)
+    return path, sc, c
+
+
+def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path):
+    """A spacecraft file's thrusters with throttle columns (`read_csv(spacecraft=…)`):
+    the same report as the force columns they replace, by Python and by the CLI, and the
+    Telemetry's force is the file's."""
+    src = outside_files["thrusters"]
+    path, sc, c = with_throttles(src, tmp_path)
     expected = inertia.estimate(str(src)).to_dict()
     got = inertia.estimate(str(path), spacecraft=str(sc)).to_dict()
     agree(expected, got)
@@ -363,14 +370,7 @@ def test_spacecraft_thrusters_give_the_files_force(cli, outside_files, tmp_path)
 def test_a_thruster_telemetry_survives_pickling(outside_files, tmp_path):
     """`read_csv(spacecraft=…)` with thrusters, pickled and restored: the same estimate."""
     src = outside_files["thrusters"]
-    c = load(src)
-    names = [n for n in c if not n.startswith("f_")]
-    data = np.column_stack([c[n] for n in names] + [c[f"f_{a}"] for a in "xyz"])
-    path = tmp_path / "throttles.csv"
-    np.savetxt(path, data, delimiter=",", header=",".join(names + ["t_x", "t_y", "t_z"]),
-               comments="", fmt="%.17g")
-    sc = tmp_path / "thrusters.toml"
-    sc.write_text(UNIT_THRUSTERS)
+    path, sc, c = with_throttles(src, tmp_path)
     t = inertia.read_csv(str(path), spacecraft=str(sc))
     back = pickle.loads(pickle.dumps(t))
     np.testing.assert_array_equal(back.f, t.f)

@@ -14,7 +14,7 @@ use inertia::pipeline::{Pipeline, PipelineSettings};
 use inertia::sample::Sample;
 use inertia::sim::control::SlewController;
 use inertia::sim::scenario::{Common, Scenario};
-use inertia::sim::{simulate, AttitudeSource, Orbit, SimOutput};
+use inertia::sim::{simulate, AttitudeSource, InputLaw, Orbit, SimOutput};
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::{Matrix3, Vector3};
 
@@ -45,10 +45,8 @@ fn common(noise: bool, seed: u64) -> Common {
     c
 }
 
-/// The slew scenario with the dipole's torque `m × B` and the force's torque about the
-/// centre of mass `F × c` acting (the torque about the origin, reported, is zero); the
-/// samples carry the field and the force as measured (exactly).
-fn spin_with(dipole: bool, force: bool, noise: bool, seed: u64) -> SimOutput {
+/// The paper's slew, its controller unchanged, with an unknown `torque` acting.
+fn slew_under(torque: &dyn InputLaw, noise: bool, seed: u64) -> SimOutput {
     let c = common(noise, seed);
     let scenario = Scenario::slew();
     let Scenario::Slew(plan) = &scenario else {
@@ -63,6 +61,13 @@ fn spin_with(dipole: bool, force: bool, noise: bool, seed: u64) -> SimOutput {
         plan.damping,
     )
     .expect("controller");
+    simulate(&cfg, &control, torque).expect("sim")
+}
+
+/// The slew scenario with the dipole's torque `m × B` and the force's torque about the
+/// centre of mass `F × c` acting (the torque about the origin, reported, is zero); the
+/// samples carry the field and the force as measured (exactly).
+fn slew_with(dipole: bool, force: bool, noise: bool, seed: u64) -> SimOutput {
     let (m, b_i, com) = (
         Vector3::from(DIPOLE_AM2),
         Vector3::from(FIELD_T),
@@ -79,7 +84,7 @@ fn spin_with(dipole: bool, force: bool, noise: bool, seed: u64) -> SimOutput {
         }
         tau
     };
-    let mut out = simulate(&cfg, &control, &torque).expect("sim");
+    let mut out = slew_under(&torque, noise, seed);
     for (s, truth) in out.samples.iter_mut().zip(&out.truth) {
         // The reported torque about the origin is zero; the sim wrote the acting one.
         s.tau_nm = Vector3::zeros();
@@ -165,7 +170,7 @@ fn the_gravity_gradient_from_the_positions_is_exact_and_left_out_biases_j() {
 /// and J with them; left out, J is biased.
 #[test]
 fn the_dipole_and_the_centre_of_mass_are_exact_on_ideal_data() {
-    let out = spin_with(true, true, false, 1);
+    let out = slew_with(true, true, false, 1);
     let truth = common(false, 1).inertia_kg_m2;
     let p = run(&out.samples, OutsideTorques::default());
     let e = error(&p, &truth);
@@ -186,7 +191,7 @@ fn the_dipole_and_the_centre_of_mass_are_exact_on_ideal_data() {
 #[test]
 fn with_noise_the_centre_of_mass_is_within_a_millimetre_and_both_within_three_sigma() {
     for seed in 1..=3 {
-        let out = spin_with(true, true, true, seed);
+        let out = slew_with(true, true, true, seed);
         let p = run(&out.samples, OutsideTorques::default());
         let o = outside(&p);
         let (m, c) = (o.residual_dipole_am2.unwrap(), o.centre_of_mass_m.unwrap());
@@ -313,24 +318,10 @@ fn the_spacecraft_files_thrusters_give_the_force_and_the_centre_of_mass() {
 /// components across it are still within 3σ. With forces in every direction nothing is.
 #[test]
 fn a_centre_of_mass_along_a_fixed_force_is_reported_as_not_determined() {
-    let c = common(true, 1);
-    let scenario = Scenario::slew();
-    let Scenario::Slew(plan) = &scenario else {
-        unreachable!()
-    };
-    let cfg = scenario.config(&c);
-    let control = SlewController::new(
-        plan.nominal_inertia_kg_m2,
-        cfg.initial.q,
-        plan.slews.clone(),
-        plan.natural_freq_rad_s,
-        plan.damping,
-    )
-    .expect("controller");
     let com = Vector3::from(CENTRE_M);
     let along_z = |t_s: f64| Vector3::new(0.0, 0.0, 0.02 * (1.0 + (0.05 * t_s).sin()));
     let torque = move |t_s: f64, _: &inertia::dynamics::GyrostatState| along_z(t_s).cross(&com);
-    let mut out = simulate(&cfg, &control, &torque).expect("sim");
+    let mut out = slew_under(&torque, true, 1);
     for s in &mut out.samples {
         s.tau_nm = Vector3::zeros();
         s.external.force_n = Some(along_z(s.t_s));
@@ -346,7 +337,7 @@ fn a_centre_of_mass_along_a_fixed_force_is_reported_as_not_determined() {
         let sigma = sigma.expect("σ across the force");
         assert!((value - truth).abs() <= 3.0 * sigma, "{e:?}");
     }
-    let full = spin_with(false, true, true, 1);
+    let full = slew_with(false, true, true, 1);
     let o = outside(&run(&full.samples, OutsideTorques::default()));
     assert_eq!(o.centre_of_mass_m.expect("c").undetermined_direction, None);
 }
@@ -356,7 +347,7 @@ fn a_centre_of_mass_along_a_fixed_force_is_reported_as_not_determined() {
 /// σ of its values and within 3σ of the truth.
 #[test]
 fn the_batch_run_reports_the_dipole_and_the_centre_of_mass_as_the_streaming_run() {
-    let out = spin_with(true, true, true, 2);
+    let out = slew_with(true, true, true, 2);
     let streaming = outside(&run(&out.samples, OutsideTorques::default()));
     let config = PipelineSettings::default().validate().expect("valid");
     let batch = inertia::pipeline::batch(&out.samples, &config).expect("batch");

@@ -1,6 +1,8 @@
 //! Seeded random constrained least-squares problems for solver tests.
 #![allow(dead_code)]
 
+pub mod momentum_balance;
+
 use inertia::attitude::Quaternion;
 use inertia::constraints::ConstraintSet;
 use inertia::tensor::{j_from_matrix, InertiaVector};
