@@ -358,6 +358,9 @@ impl Plan {
             inertial_torque: self.inertial_torque,
             // Air drag: a laboratory effect, not in the C API.
             damping: false,
+            // A batch calibration with a spacecraft file: not in the C API, which has
+            // neither.
+            calibrate_rotors: false,
             // Every outside torque the samples' `InertiaExternal` gives is modelled.
             outside: Default::default(),
             rotor_scale_sigma: self.rotor_scale_sigma,

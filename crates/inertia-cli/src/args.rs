@@ -180,6 +180,10 @@ pub struct SimulateArgs {
     /// Noise seed.
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub seed: u64,
+    /// The wheels' stored momentum at rest, N m s, body axes, e.g. `0:0:0.05` (a
+    /// momentum-biased spacecraft; slews only) [default: none].
+    #[arg(long, value_name = "X:Y:Z", allow_hyphen_values = true)]
+    pub momentum_bias: Option<String>,
     /// Gyro rate noise spectral density, deg/s/√Hz [default: 1e-5, or the preset's].
     #[arg(
         long,
@@ -543,6 +547,13 @@ pub struct EstimateArgs {
     /// unknown D, N m s, reported; discrete-momentum estimator).
     #[arg(long)]
     pub damping: bool,
+    /// Estimate the spacecraft file's rotor parameters with J (each wheel's spin-inertia
+    /// error and the two tilts of its axis, wherever the file gives them a σ, which is
+    /// their prior; with --batch). The overall scale of the wheels stays the file's σ; the
+    /// tilts need a total angular momentum (a momentum bias), else their σ is a consider
+    /// term and the report says why.
+    #[arg(long)]
+    pub calibrate_rotors: bool,
     /// Do not model the gravity-gradient torque from the telemetry's positions
     /// (r_x,r_y,r_z; modelled by default where given): for a known torque that already
     /// holds it.

@@ -209,6 +209,7 @@ pub fn description(a: &EstimateArgs) -> Result<RunDescription, CliError> {
     options.torque_bias = a.no_torque_bias.then_some(false);
     options.inertial_torque = a.inertial_torque;
     options.damping = a.damping.then_some(true);
+    options.calibrate_rotors = a.calibrate_rotors.then_some(true);
     options.outside = (a.no_gravity_gradient
         || a.gravity_mu.is_some()
         || a.no_residual_dipole

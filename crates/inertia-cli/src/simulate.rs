@@ -86,7 +86,7 @@ fn settings(
     a: &SimulateArgs,
     commands_duration: Option<f64>,
 ) -> Result<(Scenario, Common), CliError> {
-    let (sc, mut common) = match (a.preset, a.scenario) {
+    let (mut sc, mut common) = match (a.preset, a.scenario) {
         (Some(p), _) => {
             let p = match p {
                 PresetArg::SmallSat => Preset::small_sat(),
@@ -108,6 +108,16 @@ fn settings(
             v[3], v[1], v[5], //
             v[4], v[5], v[2],
         );
+    }
+    if let Some(v) = vector("--momentum-bias", &a.momentum_bias)? {
+        match &mut sc {
+            Scenario::Slew(p) => p.momentum_bias_nms = v,
+            Scenario::Spin(_) => {
+                return Err(input(
+                    "--momentum-bias: the spin starts with its own momentum; give it with a slew",
+                ))
+            }
+        }
     }
     if let Some(d) = a.duration {
         if !(d.is_finite() && d > 0.0) {

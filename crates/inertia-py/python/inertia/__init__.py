@@ -538,6 +538,7 @@ def estimate(
     torque_bias: bool = True,
     inertial_torque: str = "short",
     damping: bool = False,
+    calibrate_rotors: bool = False,
     outside: Optional[Mapping[str, Any]] = None,
     rotor_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
@@ -617,6 +618,11 @@ def estimate(
             ``"off"``, ``"on"`` or ``"auto"`` (a nested χ² test decides;
             ``report["row_model"]``).
             damping: estimate a linear damping torque −D ω (air drag; ``report["damping_nms"]``).
+            calibrate_rotors: with ``batch=True`` and a ``spacecraft`` file whose rotors have a
+            σ, estimate each rotor's spin-inertia error and axis tilts with J, the file's σ
+            their prior (``report["rotor_calibration"]``: values, σ, how many combinations
+            the data fix); the wheels' common scale stays the file's σ, and the tilts need
+            a total angular momentum (else a warning, and the file's σ a consider term).
             outside: which torques of the outside measurements are modelled, a dict
             (``--no-gravity-gradient``, ``--gravity-mu``, ``--no-residual-dipole``,
             ``--no-centre-of-mass``): ``gravity_gradient`` (default ``True``),

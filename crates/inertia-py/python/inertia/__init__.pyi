@@ -138,6 +138,7 @@ def estimate(
     torque_bias: bool = ...,
     inertial_torque: str = ...,
     damping: bool = ...,
+    calibrate_rotors: bool = ...,
     outside: Optional[Mapping[str, Any]] = ...,
     rotor_scale_sigma: Optional[float] = ...,
     filter_cutoff_hz: Optional[float] = ...,

@@ -35,6 +35,8 @@ pub mod qr;
 pub mod recursive;
 pub mod resample;
 #[cfg(feature = "std")]
+pub mod rotor_calibration;
+#[cfg(feature = "std")]
 pub mod rotor_inertia;
 pub mod rows;
 pub(crate) mod shared_qr;

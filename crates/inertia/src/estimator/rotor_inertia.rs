@@ -103,6 +103,10 @@ pub(crate) fn consider(
         .map(crate::spacecraft::Rotor::relative_sigma)
         .collect();
     let sources = sources(spacecraft);
+    let sources: Vec<(std::string::String, Vec<Vector3<f64>>)> = sources
+        .into_iter()
+        .map(|s| (s.label, s.directions))
+        .collect();
     if sources.is_empty() {
         return Err(RotorInertiaError::NotComputable("no rotor has a σ"));
     }
@@ -129,13 +133,23 @@ pub(crate) fn consider(
     })
 }
 
-/// An error source: its label, and per rotor the change of its momentum's direction per
-/// unit of its momentum ([`sources`]).
-type Source = (std::string::String, Vec<Vector3<f64>>);
+/// An independent 1σ error source of the rotors ([`sources`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Source {
+    /// `spin inertia` (shared), `rw1 spin inertia`, `rw1 axis tilt 1`, ….
+    pub(crate) label: std::string::String,
+    /// Per rotor, the change of its momentum's direction per unit of its momentum.
+    pub(crate) directions: Vec<Vector3<f64>>,
+    /// Its σ in [`Self::unit`]: the relative σ of the spin inertia (the largest of the
+    /// rotors' for a shared source), or the tilt's σ in degrees.
+    pub(crate) sigma: f64,
+    /// `relative` or `deg`.
+    pub(crate) unit: &'static str,
+}
 
 /// The change of each sample's rotor momentum that a source's `directions` make:
 /// `Σ_i J_i u_i ω̃_i d_i`, read at the run's time tag `delay_s` (as the sum was).
-fn source_momentum(
+pub(crate) fn source_momentum(
     samples: &[Sample],
     speeds: &[f64],
     spacecraft: &Spacecraft,
@@ -164,7 +178,7 @@ fn source_momentum(
 /// The independent 1σ error sources of `spacecraft` ([module docs](self)): a label, and
 /// per rotor the change of its momentum's direction per unit of its momentum (`s_i a_i`
 /// for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
-fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
+pub(crate) fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
     let rotors = &spacecraft.rotors;
     let axis = |i: usize| Vector3::from(rotors[i].axis);
     let only = |i: usize, d: Vector3<f64>| -> Vec<Vector3<f64>> {
@@ -175,22 +189,30 @@ fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
     let mut out = Vec::new();
     match spacecraft.rotor_errors {
         RotorErrors::Shared => {
-            if rotors.iter().any(|r| r.relative_sigma() > 0.0) {
-                out.push((
-                    "spin inertia".into(),
-                    (0..rotors.len())
+            let largest = rotors
+                .iter()
+                .map(|r| r.relative_sigma())
+                .fold(0.0, f64::max);
+            if largest > 0.0 {
+                out.push(Source {
+                    label: "spin inertia".into(),
+                    directions: (0..rotors.len())
                         .map(|i| axis(i) * rotors[i].relative_sigma())
                         .collect(),
-                ));
+                    sigma: largest,
+                    unit: "relative",
+                });
             }
         }
         RotorErrors::Independent => {
             for (i, r) in rotors.iter().enumerate() {
                 if r.relative_sigma() > 0.0 {
-                    out.push((
-                        std::format!("{} spin inertia", r.name),
-                        only(i, axis(i) * r.relative_sigma()),
-                    ));
+                    out.push(Source {
+                        label: std::format!("{} spin inertia", r.name),
+                        directions: only(i, axis(i) * r.relative_sigma()),
+                        sigma: r.relative_sigma(),
+                        unit: "relative",
+                    });
                 }
             }
         }
@@ -199,10 +221,12 @@ fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
         if r.spin_axis_sigma_deg > 0.0 {
             let t = r.spin_axis_sigma_deg.to_radians();
             for (j, e) in r.tilt_directions().iter().enumerate() {
-                out.push((
-                    std::format!("{} axis tilt {}", r.name, j + 1),
-                    only(i, e * t),
-                ));
+                out.push(Source {
+                    label: std::format!("{} axis tilt {}", r.name, j + 1),
+                    directions: only(i, e * t),
+                    sigma: r.spin_axis_sigma_deg,
+                    unit: "deg",
+                });
             }
         }
     }

@@ -212,7 +212,14 @@ impl<S: RowSource + Send, B: Backend + Send> Estimator for Constrained<S, B> {
 fn run_batch<S: RowSource + Default>(
     samples: &[Sample],
     c: &PipelineConfig,
+    rotors: &crate::pipeline::interface::RotorSources,
 ) -> Result<BatchOutput, PipelineError> {
+    if !rotors.is_empty() {
+        return Err(PipelineError::NotApplicable {
+            setting: "calibrate_rotors",
+            estimator: c.estimator.name,
+        });
+    }
     let mut source = S::default();
     let wrap = |source| PipelineError::Estimator {
         sample: match source {

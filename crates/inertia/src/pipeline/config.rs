@@ -4,7 +4,7 @@
 //! settings, so that they do not depend on the registry that lists them.
 
 use super::error::PipelineError;
-use super::interface::{BatchOutput, Capabilities, Estimator};
+use super::interface::{BatchOutput, Capabilities, Estimator, RotorSources};
 use crate::constraints::Constraints;
 use crate::estimator::momentum_rows::{RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
@@ -33,6 +33,7 @@ pub struct PipelineConfig {
     pub(crate) torque_bias: bool,
     pub(crate) inertial_torque: InertialTorque,
     pub(crate) damping: bool,
+    pub(crate) calibrate_rotors: bool,
     pub(crate) outside: crate::estimator::momentum_rows::OutsideTorques,
     pub(crate) max_chain_s: Option<f64>,
     pub(crate) attitude_drift_deg_rth: Option<f64>,
@@ -252,8 +253,10 @@ pub const SHORT_RECORD_S: f64 = 30.0;
 
 /// Build a streaming estimator from a validated configuration.
 pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
-/// Estimate from all samples at once.
-pub(crate) type BatchFn = fn(&[Sample], &PipelineConfig) -> Result<BatchOutput, PipelineError>;
+/// Estimate from all samples at once, with the rotor parameters' sources where the run
+/// estimates them ([`super::interface::RotorSources`]).
+pub(crate) type BatchFn =
+    fn(&[Sample], &PipelineConfig, &RotorSources) -> Result<BatchOutput, PipelineError>;
 
 /// A registered estimator.
 #[derive(Debug)]

@@ -32,6 +32,10 @@ pub struct Diagnostics {
     /// the residual dipole and the centre of mass with their σ, where the rows model any
     /// ([`crate::estimator::external_torque`]).
     pub outside: Option<OutsideEstimates>,
+    /// The rotor parameters estimated with J, where a batch run estimates them
+    /// ([`crate::estimator::rotor_calibration`]; whitened: the spacecraft file's σ is 1).
+    #[cfg(feature = "std")]
+    pub rotor_calibration: Option<crate::estimator::rotor_calibration::RotorFit>,
     /// The test for a constant disturbance torque at the last solve, where made: whether
     /// the torque was held at zero for want of evidence
     /// ([`crate::estimator::discrete_momentum::torque_tested`]).

@@ -15,6 +15,30 @@ pub(crate) trait Estimator: Send {
     fn diagnostics(&self) -> Diagnostics;
 }
 
+/// The rotor parameters a batch run estimates with J
+/// ([`crate::estimator::rotor_calibration`]): each source's 1σ change of every sample's
+/// rotor momentum, N m s, and its prior mean (in its σ; 0: the spacecraft file's value);
+/// none: no calibration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct RotorSources {
+    pub(crate) momenta: std::vec::Vec<std::vec::Vec<nalgebra::Vector3<f64>>>,
+    pub(crate) prior_mean: std::vec::Vec<f64>,
+}
+
+impl RotorSources {
+    /// No calibration.
+    pub(crate) const NONE: RotorSources = RotorSources {
+        momenta: std::vec::Vec::new(),
+        prior_mean: std::vec::Vec::new(),
+    };
+
+    /// Whether there is no source.
+    #[must_use]
+    pub(crate) fn is_empty(&self) -> bool {
+        self.momenta.is_empty()
+    }
+}
+
 /// The answer of a batch run.
 #[derive(Debug, Clone)]
 pub struct BatchOutput {

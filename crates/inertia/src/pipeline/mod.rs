@@ -66,7 +66,7 @@ pub use diagnostics::Diagnostics;
 pub use error::{PipelineError, MAX_RESAMPLE_FACTOR};
 pub(crate) use interface::Estimator;
 pub use interface::{BatchOutput, Capabilities};
-pub use run::{check_first_step, Run, RunError, RunErrorKind, RECENT};
+pub use run::{check_first_step, Run, RunError, RunErrorKind, MIN_MOMENTUM_RATIO, RECENT};
 pub use settings::{parse_wheel_delay, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::estimator::resample::Resampler;
@@ -256,6 +256,17 @@ impl Pipeline {
 /// Estimate from all samples at once (eq. 57) with the configured estimator, which must
 /// have a batch form. Memory and resampling do not apply.
 pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    batch_with(samples, config, &interface::RotorSources::NONE)
+}
+
+/// [`batch`] estimating the rotor parameters of `sources` with J
+/// ([`crate::estimator::rotor_calibration`]; an estimator that takes the row-model
+/// settings).
+pub(crate) fn batch_with(
+    samples: &[Sample],
+    config: &PipelineConfig,
+    sources: &interface::RotorSources,
+) -> Result<BatchOutput, PipelineError> {
     config.check_no_wheel_delay()?;
     let run = batch_applies(config)?;
     let mut check = ConventionCheck::default();
@@ -272,8 +283,14 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
         }
     }
     checks::convention_error(&check)?;
-    let mut out = run(samples, config)?;
-    status::apply(&mut out.estimate, config);
+    let mut out = run(samples, config, sources)?;
+    // The rotors' overall scale the rows could not fix: the answer at the scale the
+    // estimated parameters imply, and the rest of it a consider term.
+    let mut config = *config;
+    if let Some(f) = &out.diagnostics.rotor_calibration {
+        config.rotor_inertia_consider = f.apply(&mut out.estimate, config.rotor_inertia_consider);
+    }
+    status::apply(&mut out.estimate, &config);
     checks::reversed_momentum(&out.estimate, None, tau_given, || check.verdict())?;
     Ok(out)
 }

@@ -117,6 +117,9 @@ pub struct Report {
     /// The spacecraft file's rotors and their spin-inertia consider term
     /// ([`crate::estimator::rotor_inertia`]); `null` without rotors with a σ.
     pub rotor_inertia: Option<RotorInertiaEntry>,
+    /// The rotor parameters estimated with J, against the spacecraft file's values
+    /// ([`crate::estimator::rotor_calibration`]); `null` without a calibration made.
+    pub rotor_calibration: Option<crate::estimator::rotor_calibration::RotorCalibration>,
     /// Principal moments, ascending, kg m².
     pub principal_moments: Option<[f64; 3]>,
     /// Their standard deviations, kg m².
@@ -185,6 +188,8 @@ pub struct Report {
     #[serde(skip)]
     rotor_inertia_error: Option<(crate::estimator::rotor_inertia::RotorInertiaError, f64)>,
     #[serde(skip)]
+    calibration_not_made: Option<f64>,
+    #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
     physical: Option<PhysicalMargin>,
@@ -215,6 +220,9 @@ pub enum Warning {
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
+    /// A rotor calibration asked for and not made: the record's total angular momentum is
+    /// this fraction of its rotors' ([`super::run::MIN_MOMENTUM_RATIO`]).
+    RotorCalibrationNotMade(f64),
     /// A gyro axis reads its range limit while the attitude turns faster
     /// ([`crate::telemetry::gyro_range`]).
     GyroAtRangeLimit(crate::telemetry::gyro_range::ClippedAxis),
@@ -273,6 +281,7 @@ impl Warning {
             Warning::WheelDelayNotEstimated(_) => "wheel_delay_not_estimated",
             Warning::HeldWheelSpeeds(..) => "held_wheel_speeds",
             Warning::RotorInertiaNotComputed(..) => "rotor_inertia_not_computed",
+            Warning::RotorCalibrationNotMade(..) => "rotor_calibration_not_made",
             Warning::GyroAtRangeLimit(_) => "gyro_at_range_limit",
         }
     }
@@ -332,6 +341,14 @@ impl fmt::Display for Warning {
                 f,
                 "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
+            ),
+            Warning::RotorCalibrationNotMade(r) => write!(
+                f,
+                "the rotors were not calibrated: the record's total angular momentum is {:.1} % \
+                 of its rotors' (below {} %), and without it the wheels' tilts cannot be told \
+                 from J; their σ from the spacecraft file is a consider term instead",
+                r * 100.0,
+                Num(super::run::MIN_MOMENTUM_RATIO * 100.0)
             ),
             Warning::GyroAtRangeLimit(c) => write!(
                 f,
@@ -423,7 +440,9 @@ impl Report {
             held_speeds: None,
             gyro_range: std::vec::Vec::new(),
             rotor_inertia: None,
+            rotor_calibration: None,
             rotor_inertia_error: None,
+            calibration_not_made: None,
             observability: estimate.observability,
             physical: super::status::physical_margin(estimate),
             attitude: None,
@@ -468,6 +487,9 @@ impl Report {
         );
         if let Some((e, r)) = self.rotor_inertia_error {
             w.push(Warning::RotorInertiaNotComputed(e, r));
+        }
+        if let Some(r) = self.calibration_not_made {
+            w.push(Warning::RotorCalibrationNotMade(r));
         }
         w
     }
@@ -553,6 +575,20 @@ impl Report {
                 self.rotor_inertia_error = Some((*e, sc.stated_relative_sigma()));
             }
         }
+        self.refreshed()
+    }
+
+    /// With the rotor parameters the run estimated, or the ratio of total to rotor
+    /// momentum for which it did not.
+    #[must_use]
+    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
+    pub(crate) fn with_rotor_calibration(
+        mut self,
+        calibration: Option<&crate::estimator::rotor_calibration::RotorCalibration>,
+        not_made: Option<f64>,
+    ) -> Self {
+        self.rotor_calibration = calibration.cloned();
+        self.calibration_not_made = not_made;
         self.refreshed()
     }
 

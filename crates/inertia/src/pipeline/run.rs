@@ -19,11 +19,14 @@
 //!   front end to name in its own vocabulary ([`crate::fix`]).
 
 mod error;
+mod rotors;
 
 pub use error::{RunError, RunErrorKind};
+pub use rotors::MIN_MOMENTUM_RATIO;
 
-use super::{batch, BatchOutput, Pipeline, PipelineConfig, PipelineError};
-use crate::estimator::rotor_inertia::{self, RotorInertiaConsider, RotorInertiaError};
+use super::{batch, batch_with, BatchOutput, Pipeline, PipelineConfig, PipelineError};
+use crate::estimator::rotor_calibration::RotorCalibration;
+use crate::estimator::rotor_inertia::{RotorInertiaConsider, RotorInertiaError};
 use crate::estimator::wheel_delay::{self, DelayError, DelayFit, WheelDelay};
 use crate::estimator::Estimate;
 use crate::sample::Sample;
@@ -106,6 +109,11 @@ pub struct Run {
     rotor_speeds: Vec<f64>,
     /// The rotors' consider term, once computed, or why it could not be.
     rotor_consider: Option<Result<RotorInertiaConsider, RotorInertiaError>>,
+    /// The rotor parameters estimated, once the batch estimate is made.
+    calibration: Option<RotorCalibration>,
+    /// A calibration asked for and not made, for want of total momentum (its ratio to
+    /// the rotors'): the rotors' σ is then their consider term.
+    calibration_not_made: Option<f64>,
 }
 
 impl core::fmt::Debug for Run {
@@ -122,6 +130,14 @@ impl Run {
     /// A run of `config`'s estimator: streaming, or over all samples at once (`batch`,
     /// which the estimator must have, without memory or resampling).
     pub fn new(config: PipelineConfig, batch: bool) -> Result<Self, PipelineError> {
+        if config.calibrate_rotors && !batch {
+            return Err(PipelineError::NeedsSetting {
+                setting: "calibrate_rotors",
+                needs: "batch",
+                requirement: "(one solve over the whole record)",
+                why: "the rotors' parameters are unknowns of the whole record's rows, reduced at once",
+            });
+        }
         let mode = if batch {
             super::batch_applies(&config)?;
             Mode::Batch {
@@ -148,6 +164,8 @@ impl Run {
             rotors: None,
             rotor_speeds: Vec::new(),
             rotor_consider: None,
+            calibration: None,
+            calibration_not_made: None,
         })
     }
 
@@ -334,6 +352,7 @@ impl Run {
                 sample: Some(index),
                 ..e
             })?;
+            self.check_calibration(index)?;
         }
         self.order
             .check(s.t_s, has_w)
@@ -422,8 +441,11 @@ impl Run {
                 }
             }
         }
-        if let Mode::Batch { samples, out: None } = &self.mode {
-            if self.rotor_consider.is_none() {
+        if let Mode::Batch { samples, out: None } = &mut self.mode {
+            if self.config.calibrate_rotors && self.calibration_not_made.is_none() {
+                self.check_calibration(0)
+                    .map_err(|e| RunError { sample: None, ..e })?;
+            } else if self.rotor_consider.is_none() {
                 let taken = samples.clone();
                 self.apply_rotor_consider(&taken);
             }
@@ -440,7 +462,35 @@ impl Run {
                 if samples.len() < entry.capabilities.min_samples() {
                     return Err(too_few(samples.len(), samples.len()));
                 }
-                let o = batch(samples, &self.config.with_delay_applied()).map_err(|e| {
+                let config = self.config.with_delay_applied();
+                let delay_s = match &self.delay {
+                    Some(Ok(d)) => d.delay_s,
+                    _ => 0.0,
+                };
+                let calibrate = config.calibrate_rotors && self.calibration_not_made.is_none();
+                let o = match self.rotors.as_ref().filter(|_| calibrate) {
+                    Some(sc) => {
+                        match rotors::calibrated_batch(
+                            samples,
+                            &config,
+                            sc,
+                            &self.rotor_speeds,
+                            delay_s,
+                        ) {
+                            Ok(rotors::Calibrated::Done(o, c)) => {
+                                self.calibration = c;
+                                Ok(*o)
+                            }
+                            Ok(rotors::Calibrated::NoMomentum(ratio)) => {
+                                self.calibration_not_made = Some(ratio);
+                                return self.finish(on_estimate);
+                            }
+                            Err(e) => Err(e),
+                        }
+                    }
+                    None => batch(samples, &config),
+                }
+                .map_err(|e| {
                     let sample = match &e {
                         PipelineError::Estimator {
                             source: crate::estimator::EstimatorError::Row { sample, .. },
@@ -476,66 +526,6 @@ impl Run {
             self.config.wheel_delay_consider = Some(f.consider_kg_m2());
         }
         self.delay = Some(fit);
-    }
-
-    /// Compute the rotors' consider term from the run's `samples` (where a spacecraft file's
-    /// rotor has a spin-inertia σ) and put it into the configuration ([`super::status`]).
-    /// Where it cannot be computed, σ is widened as if every rotor shared the file's
-    /// relative σ, the root sum square of all
-    /// ([`crate::spacecraft::Spacecraft::stated_relative_sigma`]; the common scale's term,
-    /// [`super::status`]), and the reason kept
-    /// ([`Self::rotor_inertia`]).
-    fn apply_rotor_consider(&mut self, samples: &[Sample]) {
-        let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
-            return;
-        };
-        if self.rotor_consider.is_some() {
-            return;
-        }
-        let delay_s = match &self.delay {
-            Some(Ok(d)) => d.delay_s,
-            _ => 0.0,
-        };
-        // The first solve is the data's own; the later ones (the data changed by each
-        // error source) keep the row model it chose, so that they measure its
-        // sensitivity rather than a switch of model.
-        let mut config = self.config.with_delay_applied();
-        let batch_mode = matches!(self.mode, Mode::Batch { .. });
-        let mut first = true;
-        let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
-            let (j, rows, torque) = if batch_mode {
-                let o = batch(s, &config).ok()?;
-                (
-                    o.estimate.j(),
-                    o.diagnostics.row_model,
-                    o.diagnostics.torque_test,
-                )
-            } else {
-                let mut p = Pipeline::from_config(config).ok()?;
-                for x in s {
-                    p.push_each(x, |_| {}).ok()?;
-                }
-                let d = p.diagnostics();
-                (p.last()?.j(), d.row_model, d.torque_test)
-            };
-            if core::mem::take(&mut first) {
-                config = config.pinned_to(rows, torque);
-            }
-            j
-        };
-        let c = rotor_inertia::consider(samples, &self.rotor_speeds, sc, delay_s, solve);
-        match &c {
-            Ok(c) => self.config.rotor_inertia_consider = Some(c.consider_kg_m2()),
-            Err(_) => {
-                let r = sc.stated_relative_sigma();
-                let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
-                self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
-                // Now in the common scale's: not twice in the checks' reference σ.
-                self.config.rotor_inertia_relative_sigma = 0.0;
-            }
-        }
-        self.rotor_consider = Some(c);
-        self.rotor_speeds = Vec::new();
     }
 
     /// The rotors' spin-inertia consider term (`None` without a spacecraft file whose
@@ -632,6 +622,7 @@ impl Run {
             report
                 .with_wheel_delay(self.delay.as_ref())
                 .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
+                .with_rotor_calibration(self.calibration.as_ref(), self.calibration_not_made)
                 .with_held_speeds(
                     self.held_speeds_period_samples()
                         .map(|p| (p, p as f64 * self.sample_period_s())),

@@ -67,6 +67,11 @@ pub struct PipelineSettings {
     /// momentum estimator; default `false`): one more shared unknown `D`, N m s
     /// ([`crate::estimator::momentum_rows`], "Damping").
     pub damping: bool,
+    /// Estimate the spacecraft file's rotor parameters (each rotor's spin-inertia scale
+    /// and axis tilts, wherever the file gives them a σ) with J, the file's σ as their
+    /// priors, in place of their consider term (discrete momentum estimator, batch runs;
+    /// default `false`; [`crate::estimator::rotor_calibration`]).
+    pub calibrate_rotors: bool,
     /// The torques of outside measurements (positions, magnetic field, force) the
     /// discrete momentum rows model where the telemetry gives them: gravity gradient,
     /// a residual magnetic dipole, the centre of mass (default: each one;
@@ -126,6 +131,7 @@ impl Default for PipelineSettings {
             torque_bias: true,
             inertial_torque: InertialTorque::Short,
             damping: false,
+            calibrate_rotors: false,
             outside: OutsideTorques::default(),
             max_chain_s: Some(DEFAULT_MAX_CHAIN_S),
             attitude_drift_deg_rth: None,
@@ -255,6 +261,10 @@ impl PipelineSettings {
                     ),
                 ),
                 ("damping", self.damping != defaults.damping),
+                (
+                    "calibrate_rotors",
+                    self.calibrate_rotors != defaults.calibrate_rotors,
+                ),
                 ("outside", self.outside != defaults.outside),
                 ("max_chain_s", self.max_chain_s != defaults.max_chain_s),
                 (
@@ -329,6 +339,7 @@ impl PipelineSettings {
             torque_bias: self.torque_bias,
             inertial_torque: self.inertial_torque,
             damping: self.damping,
+            calibrate_rotors: self.calibrate_rotors,
             outside: self.outside,
             max_chain_s: self.max_chain_s,
             attitude_drift_deg_rth: self.attitude_drift_deg_rth,

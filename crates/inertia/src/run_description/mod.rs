@@ -136,6 +136,9 @@ description! {
         inertial_torque: InertialTorque,
         /// A linear damping torque −D ω as an unknown (`--damping`).
         damping: bool,
+        /// The rotors' spin-inertia scale and axis tilts estimated with J, their priors
+        /// from the spacecraft file (batch runs; `--calibrate-rotors`).
+        calibrate_rotors: bool,
         /// The torques of outside measurements modelled (a table: `gravity_gradient`,
         /// `gravity_mu_m3_s2`, `residual_dipole`, `centre_of_mass`; `--no-gravity-gradient`,
         /// `--gravity-mu`, `--no-residual-dipole`, `--no-centre-of-mass`).
@@ -237,6 +240,7 @@ impl RunDescription {
             torque_bias: self.torque_bias.unwrap_or(d.torque_bias),
             inertial_torque: self.inertial_torque.unwrap_or(d.inertial_torque),
             damping: self.damping.unwrap_or(d.damping),
+            calibrate_rotors: self.calibrate_rotors.unwrap_or(d.calibrate_rotors),
             outside: self.outside.unwrap_or(d.outside),
             max_chain_s: (chain != 0.0).then_some(chain),
             attitude_drift_deg_rth: self.attitude_drift,

@@ -222,6 +222,7 @@ impl Preset {
             nominal_inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(0.3, 0.3, 0.2)),
             natural_freq_rad_s: 0.2,
             damping: 0.8,
+            momentum_bias_nms: Vector3::zeros(),
         };
         let realism = Realism {
             attitude: AttitudeSource::Mekf,
@@ -283,6 +284,7 @@ impl Preset {
             nominal_inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(4.5, 5.0, 3.5)),
             natural_freq_rad_s: 0.15,
             damping: 0.8,
+            momentum_bias_nms: Vector3::zeros(),
         };
         let realism = Realism {
             attitude: AttitudeSource::Mekf,

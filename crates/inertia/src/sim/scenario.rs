@@ -122,6 +122,9 @@ pub struct SlewPlan {
     pub natural_freq_rad_s: f64,
     /// Damping ratio.
     pub damping: f64,
+    /// The rotors' momentum at rest, body axes, N m s: a momentum-biased spacecraft's
+    /// stored momentum (zero: the paper's slew, with no total momentum).
+    pub momentum_bias_nms: Vector3<f64>,
 }
 
 impl Default for SlewPlan {
@@ -146,6 +149,7 @@ impl Default for SlewPlan {
             nominal_inertia_kg_m2: Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 3.0)),
             natural_freq_rad_s: 0.2,
             damping: 0.8,
+            momentum_bias_nms: Vector3::zeros(),
         }
     }
 }
@@ -245,10 +249,10 @@ impl Scenario {
             .duration_s
             .unwrap_or_else(|| self.default_duration_s());
         let initial = match self {
-            Scenario::Slew(_) => GyrostatState {
+            Scenario::Slew(p) => GyrostatState {
                 q: Quaternion::IDENTITY,
                 omega_rad_s: Vector3::zeros(),
-                rho_nms: Vector3::zeros(),
+                rho_nms: p.momentum_bias_nms,
             },
             Scenario::Spin(p) => GyrostatState {
                 q: Quaternion::IDENTITY,

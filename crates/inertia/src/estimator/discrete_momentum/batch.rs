@@ -9,6 +9,9 @@ use super::*;
 use crate::estimator as est;
 use crate::estimator::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
 
+/// A row and its rotor parameters' columns ([`est::rotor_calibration::columns`]).
+type RowWithRotors<'a> = (AugmentedRow, &'a [Vector3<f64>]);
+
 /// The batch reduction: the reduced problem in `j` and what goes with it.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BatchReduction {
@@ -24,33 +27,39 @@ pub(crate) struct BatchReduction {
     pub(crate) without_torque: Option<(RecursiveQr, f64)>,
     /// The damping's row of the shared factor, where the rows estimate one.
     pub(crate) damping: Option<DampingRow>,
-    /// The shared factor for the outside torques' values, where the rows use them.
-    pub(crate) outside: Option<OutsideRows>,
+    /// The shared factor, for the outside torques' and the rotors' values, where the rows
+    /// use them.
+    pub(crate) shared: Option<SharedFactor>,
 }
 
-/// The shared factor of a batch reduction, kept for the outside torques' values
-/// ([`crate::estimator::external_torque`]): `R` (upper triangular over the shared
-/// columns used, `j` last), `Qᵀy`, the columns, the residual variance.
+/// The first column index of the rotor parameters' unknowns
+/// ([`crate::estimator::rotor_calibration`]) in a batch reduction's shared columns: past
+/// the rows' own unknowns, source `v` at `ROTOR + v`.
+pub(crate) const ROTOR: usize = crate::estimator::unknowns::UNKNOWNS;
+
+/// The shared factor of a batch reduction, kept for the values of the outside torques
+/// ([`crate::estimator::external_torque`]) and the rotor parameters
+/// ([`crate::estimator::rotor_calibration`]): `R` (upper triangular over the shared columns
+/// used, `j` last, with the rotors' prior rows), `Qᵀy`, the columns, the residual variance
+/// and the weight `s` of the rotors' prior rows.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct OutsideRows {
+pub(crate) struct SharedFactor {
     r: nalgebra::DMatrix<f64>,
     qty: nalgebra::DVector<f64>,
     columns: std::vec::Vec<usize>,
-    s2: f64,
+    pub(crate) s2: f64,
+    pub(crate) prior_weight: f64,
+    /// The rotor parameters' shares of the momentum's own scale (their `γ_v`).
+    gamma: std::vec::Vec<f64>,
 }
 
 /// A 3-vector unknown's value and σ per component.
 pub(crate) type ValueSigma = ([f64; 3], [Option<f64>; 3]);
 
-impl OutsideRows {
-    /// The residual dipole and the centre of mass at `j` (where the rows use them), each
-    /// with its least-squares σ per component (every other unknown free).
-    #[must_use]
-    pub(crate) fn at(&self, j: &InertiaVector) -> [Option<ValueSigma>; 2] {
-        use est::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
-        let n = self.columns.len();
-        let lead = n - 6;
-        // Back-substitution over the leading columns with `j` fixed.
+impl SharedFactor {
+    /// The unknowns before `j` at `j`: back-substitution with `j` fixed.
+    fn leading_at(&self, j: &InertiaVector) -> nalgebra::DVector<f64> {
+        let lead = self.columns.len() - 6;
         let mut x = nalgebra::DVector::zeros(lead);
         for i in (0..lead).rev() {
             let d = self.r[(i, i)];
@@ -66,6 +75,44 @@ impl OutsideRows {
             }
             x[i] = s / d;
         }
+        x
+    }
+
+    /// The rotor parameters at `j`, with their posterior covariance (whitened: the file's
+    /// σ is 1), where the rows estimate them.
+    #[must_use]
+    pub(crate) fn rotors_at(
+        &self,
+        j: &InertiaVector,
+    ) -> Option<crate::estimator::rotor_calibration::RotorFit> {
+        let at: std::vec::Vec<usize> = (0..self.columns.len())
+            .filter(|&p| self.columns[p] >= ROTOR)
+            .collect();
+        if at.is_empty() {
+            return None;
+        }
+        let x = self.leading_at(j);
+        let n = self.columns.len();
+        let e = nalgebra::DMatrix::from_fn(n, at.len(), |i, v| f64::from(u8::from(i == at[v])));
+        let u = self.r.transpose().solve_lower_triangular(&e);
+        let u = u?;
+        let c = (u.transpose() * u) * (self.prior_weight * self.prior_weight);
+        Some(
+            crate::estimator::rotor_calibration::RotorFit::from_covariance(
+                at.iter().map(|&p| x[p]).collect(),
+                &c,
+                &self.gamma,
+            ),
+        )
+    }
+
+    /// The residual dipole and the centre of mass at `j` (where the rows use them), each
+    /// with its least-squares σ per component (every other unknown free).
+    #[must_use]
+    pub(crate) fn at(&self, j: &InertiaVector) -> [Option<ValueSigma>; 2] {
+        use est::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
+        let n = self.columns.len();
+        let x = self.leading_at(j);
         let sigma = |p: usize| {
             let mut e = nalgebra::DVector::zeros(n);
             e[p] = 1.0;
@@ -121,10 +168,13 @@ impl DampingRow {
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
 /// chain over `[X₀ X₁ τ_b κ j]` (the columns the rows use), keeping the rows free of the chain's initial momenta, then
 /// once over the stacked `[τ_b j]` rows of every chain (and, for the jackknife, of every
-/// chain but one group's).
+/// chain but one group's). With rotor `sources` (each one's 1σ change of every sample's
+/// rotor momentum), their parameters are shared unknowns after the torque's, with a
+/// prior row each ([`crate::estimator::rotor_calibration`]).
 pub(crate) fn reduce_batch(
     samples: &[Sample],
     settings: &MomentumRowSettings,
+    sources: &crate::pipeline::interface::RotorSources,
 ) -> Result<BatchReduction, EstimatorError> {
     use est::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
     use est::momentum_rows::J;
@@ -157,6 +207,34 @@ pub(crate) fn reduce_batch(
         }
     }
     chains.retain(|c| !c.is_empty());
+    // The rotor parameters' columns, per row, in the chains' order.
+    let (rotor_columns, gamma) = if sources.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        est::rotor_calibration::columns(samples, settings, &sources.momenta)?
+    };
+    let n_rotor = sources.momenta.len();
+    let mut next = 0;
+    let chains: Vec<Vec<RowWithRotors>> = chains
+        .into_iter()
+        .map(|c| {
+            c.into_iter()
+                .map(|r| {
+                    let ex = rotor_columns.get(next).map_or(&[][..], |v| &v[..]);
+                    next += 1;
+                    (r, ex)
+                })
+                .collect()
+        })
+        .collect();
+    // A row's coefficient of column `k` (a rotor parameter's past the rows' own).
+    let coef = |(r, ex): &RowWithRotors, i: usize, k: usize| {
+        if k < ROTOR {
+            r.a[(i, k)]
+        } else {
+            ex[k - ROTOR][i]
+        }
+    };
     // Householder QR of an m×n system (zero-padded to at least n rows): (R, Qᵀy, ‖y‖²).
     let factor = |a: DMatrix<f64>, y: DVector<f64>| {
         let (m, n) = a.shape();
@@ -173,24 +251,30 @@ pub(crate) fn reduce_batch(
     // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
     // initial momenta chain by chain (a short Richardson chain may use only X₀).
     let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
-    // The torque's columns first (held at zero by dropping them, below), then the rest in
-    // order: the damping's last before j.
+    // The torque's columns first (held at zero by dropping them, below), the rotor
+    // parameters', then the rest in order: the damping's last before j.
     let torque_columns = TORQUE..TORQUE + 3;
     let shared_columns: Vec<usize> = torque_columns
         .clone()
-        .chain((FIRST_SHARED..J).filter(|k| !torque_columns.contains(k)))
-        .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
+        .filter(|&k| chains.iter().flatten().any(|r| uses(&r.0, k)))
+        .chain(ROTOR..ROTOR + n_rotor)
+        .chain(
+            (FIRST_SHARED..J)
+                .filter(|k| !torque_columns.contains(k))
+                .filter(|&k| chains.iter().flatten().any(|r| uses(&r.0, k))),
+        )
         .chain(J..J + 6)
         .collect();
+    let rotor_at = shared_columns.iter().position(|&k| k == ROTOR);
     let shared = shared_columns.len();
     // A chain's rows (those given) free of its initial momenta, in the shared unknowns:
     // (rows of R, Qᵀy), and the chain's (rss, ‖y‖², scalar rows).
-    let reduce_chain = |chain: &[&AugmentedRow]| {
+    let reduce_chain = |chain: &[&RowWithRotors]| {
         // The initial momenta the chain uses, then (with an inertial torque) each one's
         // torque, whose column is the initial momentum's times the block's `s`
         // ([`crate::estimator::momentum_rows`], "Inertial torque"), then the shared unknowns.
         let used: Vec<usize> = (0..settings.anchors_per_chain())
-            .filter(|&k| chain.iter().any(|r| uses(r, k)))
+            .filter(|&k| chain.iter().any(|r| uses(&r.0, k)))
             .collect();
         let trends = if settings.inertial_torque {
             used.len()
@@ -203,14 +287,14 @@ pub(crate) fn reduce_batch(
         let a = DMatrix::from_fn(m, columns, |i, k| {
             let row = chain[i / 3];
             if k < used.len() {
-                row.a[(i % 3, used[k])]
+                row.0.a[(i % 3, used[k])]
             } else if k < anchors {
-                row.a[(i % 3, used[k - used.len()])] * row.trend_s
+                row.0.a[(i % 3, used[k - used.len()])] * row.0.trend_s
             } else {
-                row.a[(i % 3, shared_columns[k - anchors])]
+                coef(row, i % 3, shared_columns[k - anchors])
             }
         });
-        let y = DVector::from_fn(m, |i, _| chain[i / 3].b[i % 3]);
+        let y = DVector::from_fn(m, |i, _| chain[i / 3].0.b[i % 3]);
         let (r, qty, energy) = factor(a, y);
         let mut block = (Vec::new(), Vec::new());
         for i in anchors..columns {
@@ -222,7 +306,7 @@ pub(crate) fn reduce_batch(
     };
     let mut blocks: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     let (mut rss, mut y_energy, mut rows) = (0.0, 0.0, 0);
-    let noise_s: f64 = chains.iter().flatten().map(|r| r.noise_s).sum();
+    let noise_s: f64 = chains.iter().flatten().map(|r| r.0.noise_s).sum();
     let mut nuisance = settings.shared_nuisance() as f64;
     // The outside torques' unknowns, where the rows use them (as the recursive path).
     for block in [DIPOLE, CENTRE_OF_MASS] {
@@ -242,10 +326,11 @@ pub(crate) fn reduce_batch(
     // Where the damping's column is among the shared ones.
     let damping_at = shared_columns.iter().position(|&k| k == DAMPING);
     // The stacked shared rows of the chains' `blocks` that `keep` selects, without their
-    // first `drop` columns (the torque's, held at zero): (R, z, rss) in j, and (all
-    // columns kept) the damping's row of the factor `(r_dd, r_dj, z_d)`.
-    let solve_shared =
-        |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop: usize| {
+    // first `drop` columns (the torque's, held at zero), and the rotor parameters' prior
+    // rows of weight `w` (none at 0): (R, z, rss) in j, and (all columns kept) the
+    // damping's row of the factor `(r_dd, r_dj, z_d)`.
+    let solve_with =
+        |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop: usize, w: f64| {
             let (mut a, mut y) = (Vec::new(), Vec::new());
             for (_, block) in blocks.iter().enumerate().filter(|(c, _)| keep(*c)) {
                 for row in block.0.chunks(shared) {
@@ -253,8 +338,16 @@ pub(crate) fn reduce_batch(
                 }
                 y.extend_from_slice(&block.1);
             }
-            let m = y.len();
             let n = shared - drop;
+            if let Some(at) = rotor_at.filter(|_| w > 0.0) {
+                for v in 0..n_rotor {
+                    let mut row = vec![0.0; n];
+                    row[at + v - drop] = w;
+                    a.extend_from_slice(&row);
+                    y.push(w * sources.prior_mean.get(v).copied().unwrap_or(0.0));
+                }
+            }
+            let m = y.len();
             let (r, qty, energy) = factor(DMatrix::from_row_slice(m, n, &a), DVector::from_vec(y));
             let off = n - 6;
             let mut rr = nalgebra::Matrix6::from_fn(|i, k| r[(off + i, off + k)]);
@@ -275,6 +368,40 @@ pub(crate) fn reduce_batch(
             let full = (drop == 0).then_some((r, qty));
             (rr, z, rss, damping, full)
         };
+    // The rotor parameters' prior weight `s`, the rows' residual σ: first with the
+    // parameters held at zero (a prior row of far more weight than any data row; with
+    // them free, the rows fit a zero J and a zero rotor momentum exactly), then once more
+    // at the parameters that prior weight gives.
+    let prior_weight = if n_rotor > 0 {
+        let dof = rows as f64 - 6.0 - nuisance;
+        let scale = crate::math::sqrt(y_energy / rows.max(1) as f64);
+        let sigma_at = |w: f64| {
+            let (_, _, shared_rss, _, full) = solve_with(&blocks, &|_| true, 0, w);
+            // The data rows' share of ρ²: less the prior rows' `w² |ẑ|²`.
+            let penalty = full
+                .and_then(|(r, qty)| {
+                    let n = r.ncols();
+                    let r = r.rows(0, n).into_owned();
+                    let x = r.solve_upper_triangular(&qty.rows(0, n).into_owned())?;
+                    let at = rotor_at?;
+                    Some(w * w * x.rows(at, n_rotor).norm_squared())
+                })
+                .unwrap_or(0.0);
+            let s = crate::math::sqrt(((rss + shared_rss - penalty) / dof).max(0.0));
+            if s.is_finite() && s > 0.0 {
+                s
+            } else {
+                // Rows fitted exactly: a prior far weaker than the rows' scale.
+                scale * 1e-9
+            }
+        };
+        sigma_at(sigma_at(scale * 1e6))
+    } else {
+        0.0
+    };
+    let solve_shared = |blocks: &[(Vec<f64>, Vec<f64>)], keep: &dyn Fn(usize) -> bool, drop| {
+        solve_with(blocks, keep, drop, prior_weight)
+    };
     let (rr, z, shared_rss, damping_factor, full) = solve_shared(&blocks, &|_| true, 0);
     let damping_of = |row: &Option<(f64, Vector6<f64>, f64, DMatrix<f64>)>, j: &InertiaVector| {
         row.as_ref()
@@ -334,7 +461,7 @@ pub(crate) fn reduce_batch(
                     .iter()
                     .zip(&ids)
                     .map(|(chain, ids)| {
-                        let kept: Vec<&AugmentedRow> = chain
+                        let kept: Vec<&RowWithRotors> = chain
                             .iter()
                             .zip(ids)
                             .filter(|(_, &id)| id != Some(g))
@@ -377,17 +504,20 @@ pub(crate) fn reduce_batch(
             .and_then(jackknife_sigma)
             .map(|s| s.map(|v| v * time_block_scale)),
         without_torque,
-        outside: full
+        shared: full
             .filter(|_| {
-                shared_columns
-                    .iter()
-                    .any(|&k| (DIPOLE..CENTRE_OF_MASS + 3).contains(&k))
+                n_rotor > 0
+                    || shared_columns
+                        .iter()
+                        .any(|&k| (DIPOLE..CENTRE_OF_MASS + 3).contains(&k))
             })
-            .map(|(r, qty)| OutsideRows {
+            .map(|(r, qty)| SharedFactor {
                 r,
                 qty,
                 columns: shared_columns.clone(),
                 s2: est::qr::residual_variance(rss, rows as f64 - 6.0 - nuisance),
+                prior_weight,
+                gamma: gamma.clone(),
             }),
         damping: damping_factor
             .zip(damping_at)

@@ -242,7 +242,12 @@ pub(crate) fn assert_recursive_matches_batch(
     }
     let rec =
         crate::solver::unconstrained_minimiser(&e.reduced().r, &e.reduced().z).expect("regular");
-    let b = reduce_batch(samples, &rows).expect("batch");
+    let b = reduce_batch(
+        samples,
+        &rows,
+        &crate::pipeline::interface::RotorSources::NONE,
+    )
+    .expect("batch");
     let what = format!("{:?} chain {:?}", rows.stencil, rows.max_chain_s);
     let (tested, test) = torque_tested(b.qr, b.without_torque, b.jackknife_sigma_kg_m2, &pd());
     let rec_test = e.torque_test();
@@ -476,10 +481,14 @@ fn recursive_and_batch_jackknife_agree() {
         e.push(s).expect("push");
     }
     let rec = e.jackknife_sigma().expect("recursive");
-    let bat = reduce_batch(&run.samples, &rows)
-        .expect("batch")
-        .jackknife_sigma_kg_m2
-        .expect("batch jackknife");
+    let bat = reduce_batch(
+        &run.samples,
+        &rows,
+        &crate::pipeline::interface::RotorSources::NONE,
+    )
+    .expect("batch")
+    .jackknife_sigma_kg_m2
+    .expect("batch jackknife");
     for k in 0..6 {
         let ratio = rec[k] / bat[k];
         assert!((0.75..=1.33).contains(&ratio), "element {k}: {ratio}");
@@ -550,10 +559,14 @@ fn recursive_and_batch_time_block_jackknives_agree() {
         e.push(s).expect("push");
     }
     let rec = e.jackknife_sigma().expect("recursive jackknife");
-    let bat = reduce_batch(&run.samples, &rows())
-        .expect("batch")
-        .jackknife_sigma_kg_m2
-        .expect("batch jackknife");
+    let bat = reduce_batch(
+        &run.samples,
+        &rows(),
+        &crate::pipeline::interface::RotorSources::NONE,
+    )
+    .expect("batch")
+    .jackknife_sigma_kg_m2
+    .expect("batch jackknife");
     for k in 0..6 {
         let ratio = rec[k] / bat[k];
         assert!((0.5..=4.0).contains(&ratio), "element {k}: {ratio}");
@@ -588,7 +601,12 @@ fn recursive_and_batch_agree_with_damping() {
             e.push(s).expect("push");
         }
         let j = crate::tensor::j_from_matrix(&out.inertia_kg_m2);
-        let b = reduce_batch(&out.samples, &rows).expect("batch");
+        let b = reduce_batch(
+            &out.samples,
+            &rows,
+            &crate::pipeline::interface::RotorSources::NONE,
+        )
+        .expect("batch");
         let (dr, _) = e.damping_at(&j).expect("recursive D");
         let (db, sb) = b.damping_at(&j).expect("batch D");
         assert!(

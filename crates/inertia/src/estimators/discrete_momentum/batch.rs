@@ -26,7 +26,7 @@ use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
 use crate::pipeline::diagnostics::Diagnostics;
 use crate::pipeline::error::PipelineError;
-use crate::pipeline::interface::BatchOutput;
+use crate::pipeline::interface::{BatchOutput, RotorSources};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use crate::tensor::InertiaVector;
@@ -47,6 +47,7 @@ fn wrap(source: EstimatorError) -> PipelineError {
 pub(super) fn run_batch(
     samples: &[Sample],
     c: &PipelineConfig,
+    rotors: &RotorSources,
 ) -> Result<BatchOutput, PipelineError> {
     // The drift weighting needs an estimate of J before each row is folded: recursive
     // runs only.
@@ -70,7 +71,7 @@ pub(super) fn run_batch(
         if long && rows.inertial_torque {
             continue;
         }
-        reduced.push((rows, reduce_batch(samples, &rows).map_err(wrap)?));
+        reduced.push((rows, reduce_batch(samples, &rows, rotors).map_err(wrap)?));
     }
     let attitude_is_gyro_integral = drop_batch_twins(&mut reduced, c);
     let mut fits: Vec<(f64, f64, Option<f64>)> = reduced
@@ -104,6 +105,7 @@ pub(super) fn run_batch(
     );
     let mut run = BatchRun {
         samples,
+        rotors,
         config: c,
         reduced: &reduced,
         fits: &fits,
@@ -127,6 +129,12 @@ pub(super) fn run_batch(
         Finished::Reversed => (None, None),
     };
     let outside = batch_outside(samples, rows, &reduced[chosen].1, &estimate);
+    let rotor_calibration = reduced[chosen]
+        .1
+        .shared
+        .as_ref()
+        .zip(estimate.j())
+        .and_then(|(f, j)| f.rotors_at(&j));
     Ok(BatchOutput {
         estimate,
         diagnostics: Diagnostics {
@@ -137,6 +145,7 @@ pub(super) fn run_batch(
             gyro_density_ratio,
             damping_nms,
             outside,
+            rotor_calibration,
             attitude_is_gyro_integral,
             ..Diagnostics::default()
         },
@@ -156,7 +165,7 @@ fn batch_outside(
     let gravity_gradient =
         rows.outside.gravity_gradient && samples.iter().any(|s| s.external.position_m.is_some());
     let j = e.j()?;
-    let values = b.outside.as_ref().map(|o| {
+    let values = b.shared.as_ref().map(|o| {
         let at = o.at(&j);
         let beyond = e.uncertainty.map_or([0.0; 6], |u| u.beyond_noise_kg_m2());
         let moved: [_; 6] = core::array::from_fn(|k| {
@@ -194,6 +203,8 @@ fn batch_outside(
 /// see them ([`finish`]).
 struct BatchRun<'a> {
     samples: &'a [Sample],
+    /// The rotor parameters' sources, where the run estimates them.
+    rotors: &'a RotorSources,
     config: &'a PipelineConfig,
     /// Every candidate's rows and their reduction.
     reduced: &'a [(MomentumRowSettings, BatchReduction)],
@@ -308,8 +319,18 @@ impl Evidence for BatchRun<'_> {
             .chunks_exact(2)
             .map(|p| double_step(&p[0], &p[1]))
             .collect();
+        // A double step keeps its first sample's rotor momentum.
+        let half_rotors = RotorSources {
+            momenta: self
+                .rotors
+                .momenta
+                .iter()
+                .map(|d| d.chunks_exact(2).map(|p| p[0]).collect())
+                .collect(),
+            prior_mean: self.rotors.prior_mean.clone(),
+        };
         match (self.reduced.first(), self.config.gyro_noise_rad_s_rthz) {
-            (Some((first, full)), gyro) => match reduce_batch(&half, first) {
+            (Some((first, full)), gyro) => match reduce_batch(&half, first, &half_rotors) {
                 Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &self.config.constraints),
                 Err(_) => [0.0; 6],
             },

@@ -561,6 +561,7 @@ impl Estimator for DiscreteMomentum {
                 Twins::Same => Some(true),
                 Twins::Independent => Some(false),
             },
+            rotor_calibration: None,
         }
     }
 }

@@ -173,7 +173,12 @@ fn ruling_out_candidates_changes_no_answer() {
         // until the fit rules one out.
         assert_eq!(pruned.twins, Twins::Independent);
         assert_eq!(pruned.diagnostics().attitude_is_gyro_integral, Some(false));
-        let batch = run_batch(&run.samples, &config).unwrap();
+        let batch = run_batch(
+            &run.samples,
+            &config,
+            &crate::pipeline::interface::RotorSources::NONE,
+        )
+        .unwrap();
         assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(false));
     }
 }
@@ -232,13 +237,23 @@ fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
     // The batch run makes the same test once, on the whole record: the same
     // verdict, and the attitude's candidates left out of the choice. Over a record
     // shorter than the horizon, no test.
-    let batch = run_batch(&run.samples, &config).unwrap();
+    let batch = run_batch(
+        &run.samples,
+        &config,
+        &crate::pipeline::interface::RotorSources::NONE,
+    )
+    .unwrap();
     assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(true));
     assert_eq!(
         batch.diagnostics.row_model.map(|r| r.rotation),
         Some(RotationSource::Gyro)
     );
-    let short = run_batch(&run.samples[..2000], &config).unwrap();
+    let short = run_batch(
+        &run.samples[..2000],
+        &config,
+        &crate::pipeline::interface::RotorSources::NONE,
+    )
+    .unwrap();
     assert_eq!(short.diagnostics.attitude_is_gyro_integral, None);
 }
 

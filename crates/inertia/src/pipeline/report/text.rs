@@ -94,6 +94,9 @@ impl fmt::Display for ReportText<'_> {
             if r.rotor_inertia.is_some() {
                 parts.push("the rotors' stated uncertainty");
             }
+            if r.rotor_calibration.is_some() {
+                parts.push("the rotors' calibration");
+            }
             if r.rotor_scale_sigma_kg_m2.is_some() {
                 parts.push("the wheels' stated scale");
             }
@@ -206,6 +209,28 @@ impl fmt::Display for ReportText<'_> {
                 ri.sources.len(),
                 ri.sigma_kg_m2.iter().fold(0.0f64, |a, &b| a.max(b))
             )?;
+        }
+        if let Some(c) = &r.rotor_calibration {
+            writeln!(
+                s,
+                "rotors calibrated with J (against the spacecraft file; the data fix {} of {} combinations, the file's σ the rest; total angular momentum {:.1} % of the rotors'):",
+                c.data_fixed,
+                c.sources.len(),
+                100.0 * c.momentum_ratio
+            )?;
+            for (k, name) in c.sources.iter().enumerate() {
+                let (scale, unit) = match c.unit[k] {
+                    "relative" => (100.0, " %"),
+                    _ => (1.0, "°"),
+                };
+                writeln!(
+                    s,
+                    "  {name}: {:+.4}{unit} ± {:.4}{unit} (file: ± {:.4}{unit})",
+                    scale * c.value[k],
+                    scale * c.sigma[k],
+                    scale * c.prior_sigma[k]
+                )?;
+            }
         }
         if let Some(t) = r.torque_bias_nm {
             let test = r

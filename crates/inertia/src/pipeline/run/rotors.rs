@@ -1,0 +1,216 @@
+//! The spacecraft file's rotor uncertainty in a run: measured as a consider term
+//! ([`crate::estimator::rotor_inertia`]) or, asked for in a batch run, estimated with J
+//! ([`crate::estimator::rotor_calibration`]).
+
+use super::{batch, batch_with, BatchOutput, Mode, Pipeline, PipelineConfig};
+use super::{PipelineError, Run, RunError, RunErrorKind};
+use crate::estimator::rotor_calibration::{self, RotorCalibration, RotorFit};
+use crate::estimator::rotor_inertia::{self, Source};
+use crate::pipeline::interface::RotorSources;
+use crate::sample::Sample;
+use crate::spacecraft::Spacecraft;
+use std::vec::Vec;
+
+/// A batch estimate with the rotor parameters, or why they were not estimated.
+pub(super) enum Calibrated {
+    /// The estimate, and the parameters (`None` where the estimator gave no answer).
+    Done(std::boxed::Box<BatchOutput>, Option<RotorCalibration>),
+    /// The record carries too little total angular momentum for the tilts (its ratio to
+    /// the rotors' momentum, [`MIN_MOMENTUM_RATIO`]): they are left to the consider term.
+    NoMomentum(f64),
+}
+
+/// Below this ratio of the total angular momentum to the rotors' (the norm of the mean
+/// inertial momentum over the RMS rotor momentum), the tilts are not estimated: on the zero-momentum
+/// slew (ratio 0.001–0.009, from the noise) the estimated tilts moved J 1–4 σ from the
+/// truth and further than the file's σ did; at a ratio of 0.018 and above they came within
+/// 1e-4 of it, within 3σ (`tests/integration/rotor_calibration.rs`).
+pub const MIN_MOMENTUM_RATIO: f64 = 0.03;
+
+/// The batch estimate of `samples` (their rotor momentum from `sc`'s rotors, `speeds` one
+/// per rotor and sample, read `delay_s` late) with the rotor parameters
+/// ([`crate::estimator::rotor_calibration`]): estimated about the file's values, then once
+/// more about those estimates (the tilts' first-order model re-linearised where the
+/// estimate moved), each time with the file's σ about the file's values as the prior.
+/// The parameters are reported against the file's values. With tilts to estimate and a
+/// record whose total momentum is below [`MIN_MOMENTUM_RATIO`] of the rotors', none.
+pub(super) fn calibrated_batch(
+    samples: &[Sample],
+    config: &PipelineConfig,
+    sc: &Spacecraft,
+    speeds: &[f64],
+    delay_s: f64,
+) -> Result<Calibrated, PipelineError> {
+    let sources = rotor_inertia::sources(sc);
+    let momenta = |sc: &Spacecraft, sources: &[Source]| -> Vec<_> {
+        sources
+            .iter()
+            .map(|s| rotor_inertia::source_momentum(samples, speeds, sc, &s.directions, delay_s))
+            .collect()
+    };
+    let first = batch_with(
+        samples,
+        config,
+        &RotorSources {
+            momenta: momenta(sc, &sources),
+            prior_mean: vec![0.0; sources.len()],
+        },
+    )?;
+    let (Some(fit), Some(j)) = (
+        first.diagnostics.rotor_calibration.clone(),
+        first.estimate.j(),
+    ) else {
+        return Ok(Calibrated::Done(std::boxed::Box::new(first), None));
+    };
+    let ratio = rotor_calibration::momentum_ratio(samples, &j);
+    if ratio < MIN_MOMENTUM_RATIO && sources.iter().any(|s| s.unit == "deg") {
+        return Ok(Calibrated::NoMomentum(ratio));
+    }
+    // The rotors at the estimate, and the samples' momentum from them.
+    let moved = moved(sc, &sources, &fit.value);
+    let mut again: Vec<Sample> = samples.to_vec();
+    let m = sc.rotors.len();
+    for (k, s) in again.iter_mut().enumerate() {
+        s.rho_nms = moved.momentum_nms(&speeds[k * m..(k + 1) * m]);
+    }
+    crate::estimator::wheel_delay::shift_rho(&mut again, delay_s);
+    let second_sources = rotor_inertia::sources(&moved);
+    let second = batch_with(
+        &again,
+        config,
+        &RotorSources {
+            momenta: momenta(&moved, &second_sources),
+            prior_mean: fit.value.iter().map(|z| -z).collect(),
+        },
+    )?;
+    let report = second.diagnostics.rotor_calibration.as_ref().map(|f| {
+        let total = RotorFit {
+            value: f.value.iter().zip(&fit.value).map(|(a, b)| a + b).collect(),
+            ..f.clone()
+        };
+        RotorCalibration::new(&sources, &total, ratio)
+    });
+    Ok(Calibrated::Done(std::boxed::Box::new(second), report))
+}
+
+/// `sc` with each rotor's spin inertia and axis moved by the sources' values `z` (in
+/// their σ): the inertia by its relative error, the axis turned by its two tilts (exactly,
+/// not to first order). The σ stay relative to the moved values.
+fn moved(sc: &Spacecraft, sources: &[Source], z: &[f64]) -> Spacecraft {
+    let mut out = sc.clone();
+    for (i, r) in out.rotors.iter_mut().enumerate() {
+        let axis = nalgebra::Vector3::from(r.axis);
+        let mut scale = 0.0;
+        let mut tilt = nalgebra::Vector3::zeros();
+        for (s, zv) in sources.iter().zip(z) {
+            let d = s.directions[i] * *zv;
+            scale += d.dot(&axis);
+            tilt += d - axis * d.dot(&axis);
+        }
+        let relative = r.relative_sigma();
+        r.spin_inertia_kg_m2 *= 1.0 + scale;
+        r.spin_inertia_sigma_kg_m2 = relative * r.spin_inertia_kg_m2;
+        // A tilt by the angle |t| towards t.
+        let angle = tilt.norm();
+        if angle > 0.0 {
+            let a = axis * angle.cos() + tilt / angle * angle.sin();
+            r.axis = a.normalize().into();
+        }
+    }
+    out
+}
+
+impl Run {
+    /// Refuse a rotor calibration without a spacecraft file whose rotors have a σ.
+    pub(super) fn check_calibration(&self, index: usize) -> Result<(), RunError> {
+        if self.config.calibrate_rotors
+            && !self.rotors.as_ref().is_some_and(|r| r.has_inertia_sigma())
+        {
+            return Err(RunError::at(
+                index,
+                RunErrorKind::Pipeline(PipelineError::NeedsSetting {
+                    setting: "calibrate_rotors",
+                    needs: "spacecraft",
+                    requirement: "with a σ for some rotor's spin inertia or axis",
+                    why: "the rotors' parameters are estimated about the file's values, the file's σ their prior",
+                }),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The rotor parameters estimated with J (`None` without a calibration asked for, or
+    /// before [`Self::finish`]), in the spacecraft file's units.
+    #[must_use]
+    pub fn rotor_calibration(&self) -> Option<&RotorCalibration> {
+        self.calibration.as_ref()
+    }
+
+    /// A calibration asked for and not made for want of total angular momentum: its
+    /// ratio to the rotors' ([`MIN_MOMENTUM_RATIO`]); the rotors' σ is then their
+    /// consider term ([`Self::rotor_inertia`]).
+    #[must_use]
+    pub fn rotor_calibration_not_made(&self) -> Option<f64> {
+        self.calibration_not_made
+    }
+
+    /// Compute the rotors' consider term from the run's `samples` (where a spacecraft file's
+    /// rotor has a spin-inertia σ) and put it into the configuration ([`super::status`]).
+    /// Where it cannot be computed, σ is widened as if every rotor shared the file's
+    /// relative σ, the root sum square of all
+    /// ([`crate::spacecraft::Spacecraft::stated_relative_sigma`]; the common scale's term,
+    /// [`super::status`]), and the reason kept
+    /// ([`Self::rotor_inertia`]).
+    pub(super) fn apply_rotor_consider(&mut self, samples: &[Sample]) {
+        let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
+            return;
+        };
+        if self.rotor_consider.is_some() {
+            return;
+        }
+        let delay_s = match &self.delay {
+            Some(Ok(d)) => d.delay_s,
+            _ => 0.0,
+        };
+        // The first solve is the data's own; the later ones (the data changed by each
+        // error source) keep the row model it chose, so that they measure its
+        // sensitivity rather than a switch of model.
+        let mut config = self.config.with_delay_applied();
+        let batch_mode = matches!(self.mode, Mode::Batch { .. });
+        let mut first = true;
+        let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
+            let (j, rows, torque) = if batch_mode {
+                let o = batch(s, &config).ok()?;
+                (
+                    o.estimate.j(),
+                    o.diagnostics.row_model,
+                    o.diagnostics.torque_test,
+                )
+            } else {
+                let mut p = Pipeline::from_config(config).ok()?;
+                for x in s {
+                    p.push_each(x, |_| {}).ok()?;
+                }
+                let d = p.diagnostics();
+                (p.last()?.j(), d.row_model, d.torque_test)
+            };
+            if core::mem::take(&mut first) {
+                config = config.pinned_to(rows, torque);
+            }
+            j
+        };
+        let c = rotor_inertia::consider(samples, &self.rotor_speeds, sc, delay_s, solve);
+        match &c {
+            Ok(c) => self.config.rotor_inertia_consider = Some(c.consider_kg_m2()),
+            Err(_) => {
+                let r = sc.stated_relative_sigma();
+                let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
+                self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
+                // Now in the common scale's: not twice in the checks' reference σ.
+                self.config.rotor_inertia_relative_sigma = 0.0;
+            }
+        }
+        self.rotor_consider = Some(c);
+        self.rotor_speeds = Vec::new();
+    }
+}
