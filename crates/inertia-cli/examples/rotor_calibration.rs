@@ -15,7 +15,9 @@
 //! axis tilted by two angles of σ 0.5°, and/or each spin inertia off by an independent
 //! relative error of σ 2 %; the file states those σ.
 //!
-//! **Columns.** Median relative Frobenius error of: the same record with the true wheels
+//! **Columns.** The median significance of the record's total angular momentum (its
+//! norm over its scatter along the record, `pipeline::MIN_MOMENTUM_SIGNIFICANCE`); median
+//! relative Frobenius error of: the same record with the true wheels
 //! (effect-free); the file's wheels taken as exact (uncalibrated); the calibrated batch
 //! run; then the calibrated median over the effect-free one; "3σ cov.": the calibrated
 //! runs with every element within ±3σ; "determined beyond 3σ"; "calibrated": the runs
@@ -138,8 +140,8 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
     let start = std::time::Instant::now();
-    println!("| data | momentum bias, N m s | errors | effect-free | uncalibrated | calibrated | / effect-free | 3σ cov. | determined beyond 3σ | calibrated | data fix |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| data | momentum bias, N m s | total momentum / its scatter | errors | effect-free | uncalibrated | calibrated | / effect-free | 3σ cov. | determined beyond 3σ | calibrated | data fix |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (data, bias) in [
         ("slew", 0.0),
         ("slew", 0.1),
@@ -169,6 +171,11 @@ fn main() {
                         matches!(e.observability, Observability::Determined { .. })
                     });
                     let fit = r.as_ref().and_then(|r| r.rotor_calibration().cloned());
+                    let ratio = fit.as_ref().map(|f| f.momentum_significance).or_else(|| {
+                        r.as_ref()
+                            .and_then(Run::rotor_calibration_not_made)
+                            .map(|m| m.1)
+                    });
                     (
                         free,
                         plain,
@@ -176,6 +183,7 @@ fn main() {
                         within,
                         determined && !within,
                         fit.as_ref().map(|f| (f.data_fixed, f.sources.len())),
+                        ratio.unwrap_or(f64::NAN),
                     )
                 })
                 .collect();
@@ -185,10 +193,8 @@ fn main() {
                 median(rows.iter().map(|r| r.1).collect()),
                 median(rows.iter().map(|r| r.2).collect()),
             );
-            let frac =
-                |g: &dyn Fn(&(f64, f64, f64, bool, bool, Option<(usize, usize)>)) -> bool| {
-                    rows.iter().filter(|r| g(r)).count() as f64 / n
-                };
+            type Row = (f64, f64, f64, bool, bool, Option<(usize, usize)>, f64);
+            let frac = |g: &dyn Fn(&Row) -> bool| rows.iter().filter(|r| g(r)).count() as f64 / n;
             let fixed: Vec<f64> = rows
                 .iter()
                 .filter_map(|r| r.5.map(|x| x.0 as f64))
@@ -200,7 +206,8 @@ fn main() {
                 format!("{:.0} of {of}", median(fixed))
             };
             println!(
-                "| {data} | {bias} | {label} | {f:.2e} | {p:.2e} | {c:.2e} | {:.2} | {:.2} | {:.2} | {:.2} | {fixed} |",
+                "| {data} | {bias} | {:.2} | {label} | {f:.2e} | {p:.2e} | {c:.2e} | {:.2} | {:.2} | {:.2} | {:.2} | {fixed} |",
+                median(rows.iter().map(|r| r.6).collect()),
                 c / f,
                 frac(&|r| r.3),
                 frac(&|r| r.4),

@@ -550,8 +550,8 @@ pub struct EstimateArgs {
     /// Estimate the spacecraft file's rotor parameters with J (each wheel's spin-inertia
     /// error and the two tilts of its axis, wherever the file gives them a σ, which is
     /// their prior; with --batch). The overall scale of the wheels stays the file's σ; the
-    /// tilts need a total angular momentum (a momentum bias), else their σ is a consider
-    /// term and the report says why.
+    /// record needs a total angular momentum (a momentum bias), else the file's σ is a
+    /// consider term and the report says why.
     #[arg(long)]
     pub calibrate_rotors: bool,
     /// Do not model the gravity-gradient torque from the telemetry's positions

@@ -160,7 +160,7 @@ pub fn run(
         PipelineError::NotApplicable { .. } | PipelineError::NoBatch { .. } => {
             Failure::Argument(format!("batch=True: {e}"))
         }
-        other => Failure::Argument(other.to_string()),
+        other => Failure::Argument(crate::settings::settings_message(other)),
     })?;
     run.check_columns(samples.iter().all(|s| s.omega_rad_s.is_some()))
         .map_err(|e| origin.run_error(&e))?;

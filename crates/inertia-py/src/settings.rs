@@ -276,8 +276,8 @@ pub fn run(kw: &Kwargs<'_>, function: &str) -> PyResult<(RunSettings, RunDescrip
     ))
 }
 
-/// A settings error in the keyword arguments' words (`ValueError`).
-pub fn settings_error(e: PipelineError) -> PyErr {
+/// A settings error in the keyword arguments' words.
+pub fn settings_message(e: PipelineError) -> String {
     let name = |field: &'static str| -> String {
         match RunDescription::key_of(field) {
             "constraints" => "constraints/bounds/nominal".into(),
@@ -293,29 +293,30 @@ pub fn settings_error(e: PipelineError) -> PyErr {
             field,
             value,
             expected,
-        } => value_error(format!(
-            "{}={}: expected {expected}",
-            name(field),
-            Num(value)
-        )),
-        PipelineError::NotApplicable { setting, estimator } => value_error(format!(
+        } => format!("{}={}: expected {expected}", name(field), Num(value)),
+        PipelineError::NotApplicable { setting, estimator } => format!(
             "{} does not apply to the {estimator} estimator",
             name(setting)
-        )),
+        ),
         PipelineError::NeedsSetting {
             setting,
             needs,
             requirement,
             why,
-        } => value_error(format!(
+        } => format!(
             "{} needs {} {requirement}: {why}",
             name(setting),
             name(needs)
-        )),
-        PipelineError::UnknownEstimator { .. } => value_error(format!("estimator: {e}")),
+        ),
+        PipelineError::UnknownEstimator { .. } => format!("estimator: {e}"),
         PipelineError::UnknownSolver { .. } | PipelineError::SolverUnavailable { .. } => {
-            value_error(format!("solver: {e}"))
+            format!("solver: {e}")
         }
-        other => value_error(other.to_string()),
+        other => other.to_string(),
     }
+}
+
+/// A settings error as a `ValueError` ([`settings_message`]).
+pub fn settings_error(e: PipelineError) -> PyErr {
+    value_error(settings_message(e))
 }

@@ -96,3 +96,24 @@ def test_misuse_is_refused_by_name(speed_file, tmp_path):
     bad.write_text(truth.read_text().replace('speed_unit = "rpm"', 'speed_unit = "RPM"', 1))
     with pytest.raises(ValueError, match=r"bad.toml:\d+: `rotor\[0\].speed_unit`"):
         inertia.read_csv(f, spacecraft=bad)
+
+
+def test_calibration_matches_cli_and_is_refused_without_batch(cli, tmp_path):
+    """``calibrate_rotors=True`` with ``batch=True`` on a momentum-biased slew: the CLI's
+    report (``--batch --calibrate-rotors``), the four spin-inertia sources fixed but for
+    their common scale; without ``batch`` a ValueError naming the keywords."""
+    truth = tmp_path / "truth.toml"
+    truth.write_text(pyramid([1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3], 0.0))
+    stated = tmp_path / "stated.toml"
+    stated.write_text(pyramid([1.52e-3, 1.58e-3, 1.73e-3, 1.8e-3], 0.02))
+    f = tmp_path / "biased.csv"
+    run_cli(cli, "simulate", "--scenario", "slew", "--duration", "120", "--momentum-bias",
+            "0.03:-0.02:0.1", "--spacecraft", truth, "-o", f)
+    py = inertia.estimate(f, spacecraft=stated, batch=True, calibrate_rotors=True)
+    c = cli_estimate(cli, f, "--spacecraft", stated, "--batch", "--calibrate-rotors")
+    assert differences(c, py.to_dict()) <= TOL
+    cal = py.report["rotor_calibration"]
+    assert cal["sources"] == [f"rw{i} spin inertia" for i in range(1, 5)]
+    assert cal["unit"] == ["relative"] * 4 and cal["data_fixed"] == 3
+    with pytest.raises(ValueError, match="calibrate_rotors needs batch"):
+        inertia.estimate(f, spacecraft=stated, calibrate_rotors=True)

@@ -58,10 +58,11 @@
 //! total angular momentum, six of the nine entries of the rotor momentum's calibration
 //! are indistinguishable from J (`J ω = −ρ` holds for `(M J, M ρ)` with `M J`
 //! symmetric), and along them least squares also shrinks the residual, as above: the tilts
-//! estimated on the zero-momentum slew were 1–4 σ off and worse than the file's. So the
-//! run estimates tilts only where the record's total momentum is at least
-//! `pipeline::MIN_MOMENTUM_RATIO` of the rotors' (`momentum_ratio`); below it they stay a
-//! consider term. The spin-inertia differences are fixed at any momentum.
+//! estimated on the zero-momentum slew were 1–4 σ off and worse than the file's, and on
+//! the small satellite so were the spin-inertia differences. So the run estimates the
+//! parameters only where the record's total momentum stands out from its scatter by
+//! `pipeline::MIN_MOMENTUM_SIGNIFICANCE` (`total_momentum`); below it they stay a
+//! consider term.
 
 use super::momentum_rows::{MomentumRowSettings, MomentumRows};
 use super::EstimatorError;
@@ -138,9 +139,12 @@ pub struct RotorCalibration {
     /// How many independent combinations the data fix better than the prior
     /// ([`RotorFit::data_fixed`]); the others are the prior's.
     pub data_fixed: usize,
-    /// The record's total angular momentum over its rotors' (RMS): near zero, the tilts
-    /// cannot be told from J.
+    /// The record's total angular momentum over its rotors' (RMS).
     pub momentum_ratio: f64,
+    /// The record's total angular momentum over its scatter along the record: below
+    /// `pipeline::MIN_MOMENTUM_SIGNIFICANCE`, the tilts cannot be told from J and no
+    /// parameter is estimated.
+    pub momentum_significance: f64,
 }
 
 impl RotorCalibration {
@@ -149,7 +153,7 @@ impl RotorCalibration {
     pub(crate) fn new(
         sources: &[super::rotor_inertia::Source],
         fit: &RotorFit,
-        momentum_ratio: f64,
+        (momentum_ratio, momentum_significance): (f64, f64),
     ) -> Self {
         let scale =
             |x: &[f64]| -> Vec<f64> { x.iter().zip(sources).map(|(v, s)| v * s.sigma).collect() };
@@ -161,19 +165,23 @@ impl RotorCalibration {
             sigma: scale(&fit.sigma),
             data_fixed: fit.data_fixed,
             momentum_ratio,
+            momentum_significance,
         }
     }
 }
 
-/// The record's total angular momentum at inertia `j` over its rotors' momentum: the
-/// norm of the mean inertial momentum `q (J ω + ρ)` over the RMS norm of `ρ`, `ω` from
-/// each step's incremental rotation (`2 vec(q_k† q_{k+1}) / h`). Near zero, six of the
-/// nine combinations of the rotors' tilts and scales are indistinguishable from J ([module
-/// docs](self), "What the data fix").
+/// The record's total angular momentum at inertia `j`, from the inertial momentum
+/// `h_k = q_k (J ω_k + ρ_k)` of each step (`ω` from its incremental rotation,
+/// `2 vec(q_k† q_{k+1}) / h`): the norm of its mean over the RMS norm of `ρ` (the ratio),
+/// and over the RMS scatter of `h_k` about the mean (the significance: a momentum the
+/// record holds is constant, one that is zero leaves only `J`'s error and the noise,
+/// which turn with the body). Where it is not significant, six of the nine combinations
+/// of the rotors' tilts and scales are indistinguishable from J ([module docs](self),
+/// "What the data fix").
 #[must_use]
-pub(crate) fn momentum_ratio(samples: &[Sample], j: &crate::tensor::InertiaVector) -> f64 {
+pub(crate) fn total_momentum(samples: &[Sample], j: &crate::tensor::InertiaVector) -> (f64, f64) {
     let jm = crate::tensor::matrix_from_j(j);
-    let (mut h, mut rho2, mut n) = (Vector3::zeros(), 0.0, 0usize);
+    let (mut hs, mut rho2) = (Vec::with_capacity(samples.len()), 0.0);
     for p in samples.windows(2) {
         let dt = p[1].t_s - p[0].t_s;
         if !(dt > 0.0) {
@@ -181,14 +189,16 @@ pub(crate) fn momentum_ratio(samples: &[Sample], j: &crate::tensor::InertiaVecto
         }
         let w = crate::attitude::incremental_rotation(&p[0].q, &p[1].q) * (2.0 / dt);
         let rho = (p[0].rho_nms + p[1].rho_nms) * 0.5;
-        h += p[0].q.rotate(&(jm * w + rho));
+        hs.push(p[0].q.rotate(&(jm * w + rho)));
         rho2 += rho.norm_squared();
-        n += 1;
     }
-    if n == 0 || !(rho2 > 0.0) {
-        return 0.0;
+    let n = hs.len() as f64;
+    if hs.is_empty() || !(rho2 > 0.0) {
+        return (0.0, 0.0);
     }
-    (h / n as f64).norm() / (rho2 / n as f64).sqrt()
+    let mean: Vector3<f64> = hs.iter().sum::<Vector3<f64>>() / n;
+    let scatter = (hs.iter().map(|h| (h - mean).norm_squared()).sum::<f64>() / n).sqrt();
+    (mean.norm() / (rho2 / n).sqrt(), mean.norm() / scatter)
 }
 
 /// The sources' columns of the rows built from `samples` with `settings`: per row (in the

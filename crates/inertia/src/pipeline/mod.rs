@@ -66,7 +66,7 @@ pub use diagnostics::Diagnostics;
 pub use error::{PipelineError, MAX_RESAMPLE_FACTOR};
 pub(crate) use interface::Estimator;
 pub use interface::{BatchOutput, Capabilities};
-pub use run::{check_first_step, Run, RunError, RunErrorKind, MIN_MOMENTUM_RATIO, RECENT};
+pub use run::{check_first_step, Run, RunError, RunErrorKind, MIN_MOMENTUM_SIGNIFICANCE, RECENT};
 pub use settings::{parse_wheel_delay, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
 use crate::estimator::resample::Resampler;

@@ -188,7 +188,7 @@ pub struct Report {
     #[serde(skip)]
     rotor_inertia_error: Option<(crate::estimator::rotor_inertia::RotorInertiaError, f64)>,
     #[serde(skip)]
-    calibration_not_made: Option<f64>,
+    calibration_not_made: Option<(f64, f64)>,
     #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
@@ -221,8 +221,9 @@ pub enum Warning {
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
     /// A rotor calibration asked for and not made: the record's total angular momentum is
-    /// this fraction of its rotors' ([`super::run::MIN_MOMENTUM_RATIO`]).
-    RotorCalibrationNotMade(f64),
+    /// this fraction of its rotors', and this many times its scatter
+    /// ([`super::run::MIN_MOMENTUM_SIGNIFICANCE`]).
+    RotorCalibrationNotMade(f64, f64),
     /// A gyro axis reads its range limit while the attitude turns faster
     /// ([`crate::telemetry::gyro_range`]).
     GyroAtRangeLimit(crate::telemetry::gyro_range::ClippedAxis),
@@ -342,13 +343,15 @@ impl fmt::Display for Warning {
                 "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
             ),
-            Warning::RotorCalibrationNotMade(r) => write!(
+            Warning::RotorCalibrationNotMade(r, z) => write!(
                 f,
                 "the rotors were not calibrated: the record's total angular momentum is {:.1} % \
-                 of its rotors' (below {} %), and without it the wheels' tilts cannot be told \
-                 from J; their σ from the spacecraft file is a consider term instead",
+                 of its rotors' and {:.2} times its own scatter (below {}): without a momentum \
+                 the wheels' errors cannot be told from J; their σ from the spacecraft file is \
+                 a consider term instead",
                 r * 100.0,
-                Num(super::run::MIN_MOMENTUM_RATIO * 100.0)
+                z,
+                Num(super::run::MIN_MOMENTUM_SIGNIFICANCE)
             ),
             Warning::GyroAtRangeLimit(c) => write!(
                 f,
@@ -488,8 +491,8 @@ impl Report {
         if let Some((e, r)) = self.rotor_inertia_error {
             w.push(Warning::RotorInertiaNotComputed(e, r));
         }
-        if let Some(r) = self.calibration_not_made {
-            w.push(Warning::RotorCalibrationNotMade(r));
+        if let Some((r, z)) = self.calibration_not_made {
+            w.push(Warning::RotorCalibrationNotMade(r, z));
         }
         w
     }
@@ -585,7 +588,7 @@ impl Report {
     pub(crate) fn with_rotor_calibration(
         mut self,
         calibration: Option<&crate::estimator::rotor_calibration::RotorCalibration>,
-        not_made: Option<f64>,
+        not_made: Option<(f64, f64)>,
     ) -> Self {
         self.rotor_calibration = calibration.cloned();
         self.calibration_not_made = not_made;

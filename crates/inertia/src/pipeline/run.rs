@@ -22,7 +22,7 @@ mod error;
 mod rotors;
 
 pub use error::{RunError, RunErrorKind};
-pub use rotors::MIN_MOMENTUM_RATIO;
+pub use rotors::MIN_MOMENTUM_SIGNIFICANCE;
 
 use super::{batch, batch_with, BatchOutput, Pipeline, PipelineConfig, PipelineError};
 use crate::estimator::rotor_calibration::RotorCalibration;
@@ -112,8 +112,8 @@ pub struct Run {
     /// The rotor parameters estimated, once the batch estimate is made.
     calibration: Option<RotorCalibration>,
     /// A calibration asked for and not made, for want of total momentum (its ratio to
-    /// the rotors'): the rotors' σ is then their consider term.
-    calibration_not_made: Option<f64>,
+    /// the rotors' and to its scatter): the rotors' σ is then their consider term.
+    calibration_not_made: Option<(f64, f64)>,
 }
 
 impl core::fmt::Debug for Run {
@@ -481,8 +481,8 @@ impl Run {
                                 self.calibration = c;
                                 Ok(*o)
                             }
-                            Ok(rotors::Calibrated::NoMomentum(ratio)) => {
-                                self.calibration_not_made = Some(ratio);
+                            Ok(rotors::Calibrated::NoMomentum(ratio, significance)) => {
+                                self.calibration_not_made = Some((ratio, significance));
                                 return self.finish(on_estimate);
                             }
                             Err(e) => Err(e),

@@ -213,10 +213,11 @@ impl fmt::Display for ReportText<'_> {
         if let Some(c) = &r.rotor_calibration {
             writeln!(
                 s,
-                "rotors calibrated with J (against the spacecraft file; the data fix {} of {} combinations, the file's σ the rest; total angular momentum {:.1} % of the rotors'):",
+                "rotors calibrated with J (against the spacecraft file; the data fix {} of {} combinations, the file's σ the rest; total angular momentum {:.1} % of the rotors', {:.1} times its scatter):",
                 c.data_fixed,
                 c.sources.len(),
-                100.0 * c.momentum_ratio
+                100.0 * c.momentum_ratio,
+                c.momentum_significance
             )?;
             for (k, name) in c.sources.iter().enumerate() {
                 let (scale, unit) = match c.unit[k] {
