@@ -25,6 +25,7 @@
 //! consider term); the median count of combinations the data fix, of the sources.
 
 use inertia::estimator::observability::Observability;
+use inertia::estimator::rotor_calibration::NotMade;
 use inertia::estimator::Estimate;
 use inertia::pipeline::{PipelineSettings, Run};
 use inertia::sample::Sample;
@@ -172,9 +173,10 @@ fn main() {
                     });
                     let fit = r.as_ref().and_then(|r| r.rotor_calibration().cloned());
                     let ratio = fit.as_ref().map(|f| f.momentum_significance).or_else(|| {
-                        r.as_ref()
-                            .and_then(Run::rotor_calibration_not_made)
-                            .map(|m| m.1)
+                        match r.as_ref().and_then(Run::rotor_calibration_not_made) {
+                            Some(NotMade::NoMomentum { significance, .. }) => Some(significance),
+                            _ => None,
+                        }
                     });
                     (
                         free,

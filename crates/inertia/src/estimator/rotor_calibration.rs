@@ -27,13 +27,16 @@
 //! (`columns`). (The adaptive stencil's curvature column is also linear in `ρ`; its
 //! change, `κ Σ_v z_v …`, is of second order in the small `κ z` and left out.) The tilts'
 //! first-order model leaves out `θ²/2` of a rotor's momentum along its axis, 1.5e-4 of
-//! it at 1°: the run estimates once about the file's values, then once more about the rotors
-//! moved to that estimate (exactly: axes turned, inertias scaled), its prior still the
-//! file's σ about the file's values (a prior mean `−ẑ`), and reports the sum.
+//! it at 1°: the run estimates once about the file's values, then once more about the
+//! rotors moved to that estimate (exactly: axes turned, inertias scaled; each rotor's
+//! source directions turned with its axis by the smallest rotation, so that the second
+//! pass's values are in the first's directions), its prior still the file's σ about the
+//! file's values (a prior mean `−ẑ`), and reports the sum.
 //!
 //! **The prior.** Each `z_v` is a row `s z_v = s μ_v` beside the data rows (`μ_v` its
-//! prior mean, 0 but in the second pass), `s²` the rows' residual variance at the
-//! parameters held at their prior mean, then at the estimate that weight gives: in the
+//! prior mean, 0 but in the second pass), `s²` the rows' residual variance (less the prior
+//! rows' share `s² |ẑ − μ|²`) at the parameters held at their prior mean, then at the
+//! estimate that weight gives (none where there is no residual: no fit): in the
 //! rows' own noise units it is the file's statement `z_v ~ N(μ_v, 1)`. The least-squares
 //! covariance of the answer then includes the parameters' uncertainty after the data,
 //! and `j`'s reduced problem has them minimised out.
@@ -50,7 +53,9 @@
 //! `ĵ (1 + ĉ)`, and the part the data leave open, `σ_c = √(γᵀ C γ)` (the posterior `C`),
 //! is a consider term `σ_c |ĵ_k|` (`RotorFit::apply`). A scale common to every rotor has
 //! a zero column and keeps its prior (the issue's "one overall scale unobservable, fixed
-//! by a prior on the rotors' inertia"); a known torque could fix it, and is not used to.
+//! by a prior on the rotors' inertia"). A known torque would fix it and breaks the rows'
+//! homogeneity, which this gauge does not handle: the run makes no calibration then
+//! ([`NotMade::KnownTorque`]).
 //!
 //! **What the data fix.** With `C` the parameters' posterior covariance (whitened units)
 //! the data's information is `C⁻¹ − I`; a combination is fixed by the data where its
@@ -112,6 +117,56 @@ impl RotorFit {
             scale,
             scale_sigma,
         }
+    }
+}
+
+/// Why a calibration asked for was not made (the rotors' σ is then their consider term,
+/// [`super::rotor_inertia`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
+pub enum NotMade {
+    /// The record's total angular momentum is `ratio` of the rotors' (RMS) and
+    /// `significance` times its scatter along the record, below
+    /// `pipeline::MIN_MOMENTUM_SIGNIFICANCE`: the tilts cannot be told from J.
+    NoMomentum {
+        /// Its ratio to the rotors' momentum.
+        ratio: f64,
+        /// Its ratio to its own scatter.
+        significance: f64,
+    },
+    /// The record has a known torque, which fixes the momentum's scale that the
+    /// calibration takes as its gauge ([module docs](self), "The overall scale").
+    KnownTorque,
+    /// The rows gave no fit of the parameters (no answer, no residual to weigh the prior
+    /// by, or not one speed per rotor and sample).
+    NoFit,
+}
+
+impl core::fmt::Display for NotMade {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("the rotors were not calibrated: ")?;
+        match self {
+            NotMade::NoMomentum {
+                ratio,
+                significance,
+            } => write!(
+                f,
+                "the record's total angular momentum is {:.1} % of its rotors' and {:.2} \
+                 times its own scatter (below {}): without a momentum the wheels' errors \
+                 cannot be told from J",
+                ratio * 100.0,
+                significance,
+                crate::text::Num(crate::pipeline::MIN_MOMENTUM_SIGNIFICANCE)
+            )?,
+            NotMade::KnownTorque => f.write_str(
+                "the record has a known torque, which fixes the momentum's scale that the \
+                 calibration takes as given (not supported)",
+            )?,
+            NotMade::NoFit => f.write_str("the rows gave no fit of the rotors' parameters")?,
+        }
+        f.write_str("; their σ from the spacecraft file is a consider term instead")
     }
 }
 

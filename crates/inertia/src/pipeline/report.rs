@@ -188,7 +188,7 @@ pub struct Report {
     #[serde(skip)]
     rotor_inertia_error: Option<(crate::estimator::rotor_inertia::RotorInertiaError, f64)>,
     #[serde(skip)]
-    calibration_not_made: Option<(f64, f64)>,
+    calibration_not_made: Option<crate::estimator::rotor_calibration::NotMade>,
     #[serde(skip)]
     observability: Observability,
     #[serde(skip)]
@@ -220,10 +220,8 @@ pub enum Warning {
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
-    /// A rotor calibration asked for and not made: the record's total angular momentum is
-    /// this fraction of its rotors', and this many times its scatter
-    /// ([`super::run::MIN_MOMENTUM_SIGNIFICANCE`]).
-    RotorCalibrationNotMade(f64, f64),
+    /// A rotor calibration asked for and not made, and why.
+    RotorCalibrationNotMade(crate::estimator::rotor_calibration::NotMade),
     /// A gyro axis reads its range limit while the attitude turns faster
     /// ([`crate::telemetry::gyro_range`]).
     GyroAtRangeLimit(crate::telemetry::gyro_range::ClippedAxis),
@@ -343,16 +341,7 @@ impl fmt::Display for Warning {
                 "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
             ),
-            Warning::RotorCalibrationNotMade(r, z) => write!(
-                f,
-                "the rotors were not calibrated: the record's total angular momentum is {:.1} % \
-                 of its rotors' and {:.2} times its own scatter (below {}): without a momentum \
-                 the wheels' errors cannot be told from J; their σ from the spacecraft file is \
-                 a consider term instead",
-                r * 100.0,
-                z,
-                Num(super::run::MIN_MOMENTUM_SIGNIFICANCE)
-            ),
+            Warning::RotorCalibrationNotMade(why) => write!(f, "{why}"),
             Warning::GyroAtRangeLimit(c) => write!(
                 f,
                 "the gyro's {} axis reads its largest rate, {} rad/s, in {} samples while the \
@@ -491,8 +480,8 @@ impl Report {
         if let Some((e, r)) = self.rotor_inertia_error {
             w.push(Warning::RotorInertiaNotComputed(e, r));
         }
-        if let Some((r, z)) = self.calibration_not_made {
-            w.push(Warning::RotorCalibrationNotMade(r, z));
+        if let Some(why) = self.calibration_not_made {
+            w.push(Warning::RotorCalibrationNotMade(why));
         }
         w
     }
@@ -588,7 +577,7 @@ impl Report {
     pub(crate) fn with_rotor_calibration(
         mut self,
         calibration: Option<&crate::estimator::rotor_calibration::RotorCalibration>,
-        not_made: Option<(f64, f64)>,
+        not_made: Option<crate::estimator::rotor_calibration::NotMade>,
     ) -> Self {
         self.rotor_calibration = calibration.cloned();
         self.calibration_not_made = not_made;

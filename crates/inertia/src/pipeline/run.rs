@@ -111,9 +111,9 @@ pub struct Run {
     rotor_consider: Option<Result<RotorInertiaConsider, RotorInertiaError>>,
     /// The rotor parameters estimated, once the batch estimate is made.
     calibration: Option<RotorCalibration>,
-    /// A calibration asked for and not made, for want of total momentum (its ratio to
-    /// the rotors' and to its scatter): the rotors' σ is then their consider term.
-    calibration_not_made: Option<(f64, f64)>,
+    /// A calibration asked for and not made, and why: the rotors' σ is then their
+    /// consider term.
+    calibration_not_made: Option<crate::estimator::rotor_calibration::NotMade>,
 }
 
 impl core::fmt::Debug for Run {
@@ -478,11 +478,11 @@ impl Run {
                             delay_s,
                         ) {
                             Ok(rotors::Calibrated::Done(o, c)) => {
-                                self.calibration = c;
+                                self.calibration = Some(c);
                                 Ok(*o)
                             }
-                            Ok(rotors::Calibrated::NoMomentum(ratio, significance)) => {
-                                self.calibration_not_made = Some((ratio, significance));
+                            Ok(rotors::Calibrated::NotMade(why)) => {
+                                self.calibration_not_made = Some(why);
                                 return self.finish(on_estimate);
                             }
                             Err(e) => Err(e),

@@ -88,7 +88,7 @@ impl SharedFactor {
         let at: std::vec::Vec<usize> = (0..self.columns.len())
             .filter(|&p| self.columns[p] >= ROTOR)
             .collect();
-        if at.is_empty() {
+        if at.is_empty() || !(self.prior_weight > 0.0) {
             return None;
         }
         let x = self.leading_at(j);
@@ -369,7 +369,7 @@ pub(crate) fn reduce_batch(
             (rr, z, rss, damping, full)
         };
     // The rotor parameters' prior weight `s`, the rows' residual σ: first with the
-    // parameters held at zero (a prior row of far more weight than any data row; with
+    // parameters held at their prior mean (a prior row of far more weight than any data row; with
     // them free, the rows fit a zero J and a zero rotor momentum exactly), then once more
     // at the parameters that prior weight gives.
     let prior_weight = if n_rotor > 0 {
@@ -377,25 +377,28 @@ pub(crate) fn reduce_batch(
         let scale = crate::math::sqrt(y_energy / rows.max(1) as f64);
         let sigma_at = |w: f64| {
             let (_, _, shared_rss, _, full) = solve_with(&blocks, &|_| true, 0, w);
-            // The data rows' share of ρ²: less the prior rows' `w² |ẑ|²`.
-            let penalty = full
-                .and_then(|(r, qty)| {
-                    let n = r.ncols();
-                    let r = r.rows(0, n).into_owned();
-                    let x = r.solve_upper_triangular(&qty.rows(0, n).into_owned())?;
-                    let at = rotor_at?;
-                    Some(w * w * x.rows(at, n_rotor).norm_squared())
-                })
-                .unwrap_or(0.0);
-            let s = crate::math::sqrt(((rss + shared_rss - penalty) / dof).max(0.0));
-            if s.is_finite() && s > 0.0 {
-                s
-            } else {
-                // Rows fitted exactly: a prior far weaker than the rows' scale.
-                scale * 1e-9
-            }
+            // The data rows' share of ρ²: less the prior rows' `w² |ẑ − μ|²`.
+            let penalty = full.and_then(|(r, qty)| {
+                let n = r.ncols();
+                let r = r.rows(0, n).into_owned();
+                let x = r.solve_upper_triangular(&qty.rows(0, n).into_owned())?;
+                let at = rotor_at?;
+                Some(
+                    w * w
+                        * (0..n_rotor)
+                            .map(|v| {
+                                let mu = sources.prior_mean.get(v).copied().unwrap_or(0.0);
+                                (x[at + v] - mu).powi(2)
+                            })
+                            .sum::<f64>(),
+                )
+            })?;
+            let s = crate::math::sqrt((rss + shared_rss - penalty) / dof);
+            (s.is_finite() && s > 0.0).then_some(s)
         };
-        sigma_at(sigma_at(scale * 1e6))
+        // Without a residual to weigh the prior by (rows fitted exactly, too few of them)
+        // no prior: the parameters then have no fit ([`SharedFactor::rotors_at`]).
+        sigma_at(scale * 1e6).and_then(sigma_at).unwrap_or(0.0)
     } else {
         0.0
     };

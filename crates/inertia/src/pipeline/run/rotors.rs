@@ -4,21 +4,20 @@
 
 use super::{batch, batch_with, BatchOutput, Mode, Pipeline, PipelineConfig};
 use super::{PipelineError, Run, RunError, RunErrorKind};
-use crate::estimator::rotor_calibration::{self, RotorCalibration, RotorFit};
+use crate::estimator::rotor_calibration::{self, NotMade, RotorCalibration, RotorFit};
 use crate::estimator::rotor_inertia::{self, Source};
 use crate::pipeline::interface::RotorSources;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
 use std::vec::Vec;
 
-/// A batch estimate with the rotor parameters, or why they were not estimated.
+/// A batch estimate with the rotor parameters, or why they were not estimated (then
+/// they are left to the consider term).
 pub(super) enum Calibrated {
-    /// The estimate, and the parameters (`None` where the estimator gave no answer).
-    Done(std::boxed::Box<BatchOutput>, Option<RotorCalibration>),
-    /// The record carries too little total angular momentum (its ratio to the rotors'
-    /// momentum and to its scatter, [`MIN_MOMENTUM_SIGNIFICANCE`]): the parameters are
-    /// left to the consider term.
-    NoMomentum(f64, f64),
+    /// The estimate and the parameters.
+    Done(std::boxed::Box<BatchOutput>, RotorCalibration),
+    /// Not estimated, and why.
+    NotMade(NotMade),
 }
 
 /// Below this ratio of the record's total angular momentum to its scatter along the record
@@ -36,8 +35,9 @@ pub const MIN_MOMENTUM_SIGNIFICANCE: f64 = 3.0;
 /// ([`crate::estimator::rotor_calibration`]): estimated about the file's values, then once
 /// more about those estimates (the tilts' first-order model re-linearised where the
 /// estimate moved), each time with the file's σ about the file's values as the prior.
-/// The parameters are reported against the file's values. With a record whose total
-/// momentum does not stand out from its scatter by [`MIN_MOMENTUM_SIGNIFICANCE`], none.
+/// The parameters are reported against the file's values. None with a known torque, with
+/// a record whose total momentum does not stand out from its scatter by
+/// [`MIN_MOMENTUM_SIGNIFICANCE`], or where the rows give no fit of them ([`NotMade`]).
 pub(super) fn calibrated_batch(
     samples: &[Sample],
     config: &PipelineConfig,
@@ -45,6 +45,18 @@ pub(super) fn calibrated_batch(
     speeds: &[f64],
     delay_s: f64,
 ) -> Result<Calibrated, PipelineError> {
+    let m = sc.rotors.len();
+    if m == 0 || speeds.len() != samples.len() * m {
+        return Ok(Calibrated::NotMade(NotMade::NoFit));
+    }
+    // A known torque fixes the momentum's scale that the calibration takes as its gauge
+    // ([`crate::estimator::rotor_calibration`], "The overall scale").
+    if samples
+        .iter()
+        .any(|s| s.tau_nm != nalgebra::Vector3::zeros())
+    {
+        return Ok(Calibrated::NotMade(NotMade::KnownTorque));
+    }
     let sources = rotor_inertia::sources(sc);
     let momenta = |sc: &Spacecraft, sources: &[Source]| -> Vec<_> {
         sources
@@ -64,21 +76,43 @@ pub(super) fn calibrated_batch(
         first.diagnostics.rotor_calibration.clone(),
         first.estimate.j(),
     ) else {
-        return Ok(Calibrated::Done(std::boxed::Box::new(first), None));
+        return Ok(Calibrated::NotMade(NotMade::NoFit));
     };
     let momentum = rotor_calibration::total_momentum(samples, &j);
     if !(momentum.1 >= MIN_MOMENTUM_SIGNIFICANCE) {
-        return Ok(Calibrated::NoMomentum(momentum.0, momentum.1));
+        return Ok(Calibrated::NotMade(NotMade::NoMomentum {
+            ratio: momentum.0,
+            significance: momentum.1,
+        }));
     }
     // The rotors at the estimate, and the samples' momentum from them.
     let moved = moved(sc, &sources, &fit.value);
     let mut again: Vec<Sample> = samples.to_vec();
-    let m = sc.rotors.len();
     for (k, s) in again.iter_mut().enumerate() {
         s.rho_nms = moved.momentum_nms(&speeds[k * m..(k + 1) * m]);
     }
     crate::estimator::wheel_delay::shift_rho(&mut again, delay_s);
-    let second_sources = rotor_inertia::sources(&moved);
+    // The same sources about the moved rotors: each rotor's directions turned with its axis
+    // (the file's tilt directions carried along, so that the second pass's values add to
+    // the first's; `Rotor::tilt_directions` of a moved axis may be others).
+    let turns: Vec<nalgebra::Matrix3<f64>> = sc
+        .rotors
+        .iter()
+        .zip(&moved.rotors)
+        .map(|(a, b)| minimal_rotation(&a.axis.into(), &b.axis.into()))
+        .collect();
+    let second_sources: Vec<Source> = sources
+        .iter()
+        .map(|s| Source {
+            directions: s
+                .directions
+                .iter()
+                .zip(&turns)
+                .map(|(d, t)| t * d)
+                .collect(),
+            ..s.clone()
+        })
+        .collect();
     let second = batch_with(
         &again,
         config,
@@ -87,14 +121,31 @@ pub(super) fn calibrated_batch(
             prior_mean: fit.value.iter().map(|z| -z).collect(),
         },
     )?;
-    let report = second.diagnostics.rotor_calibration.as_ref().map(|f| {
-        let total = RotorFit {
-            value: f.value.iter().zip(&fit.value).map(|(a, b)| a + b).collect(),
-            ..f.clone()
-        };
-        RotorCalibration::new(&sources, &total, momentum)
-    });
+    let Some(f) = second.diagnostics.rotor_calibration.as_ref() else {
+        return Ok(Calibrated::NotMade(NotMade::NoFit));
+    };
+    let total = RotorFit {
+        value: f.value.iter().zip(&fit.value).map(|(a, b)| a + b).collect(),
+        ..f.clone()
+    };
+    let report = RotorCalibration::new(&sources, &total, momentum);
     Ok(Calibrated::Done(std::boxed::Box::new(second), report))
+}
+
+/// The smallest rotation taking the unit vector `a` to the unit vector `b` (Rodrigues:
+/// `I + [v]× + [v]×² / (1 + c)`, `v = a × b`, `c = a·b`).
+fn minimal_rotation(
+    a: &nalgebra::Vector3<f64>,
+    b: &nalgebra::Vector3<f64>,
+) -> nalgebra::Matrix3<f64> {
+    let v = a.cross(b);
+    let c = a.dot(b);
+    let k = crate::attitude::skew(&v);
+    if c <= -1.0 + 1e-12 {
+        // Opposite: no axis is smallest; not a small tilt, and not reached by `moved`.
+        return nalgebra::Matrix3::identity();
+    }
+    nalgebra::Matrix3::identity() + k + k * k / (1.0 + c)
 }
 
 /// `sc` with each rotor's spin inertia and axis moved by the sources' values `z` (in
@@ -150,11 +201,10 @@ impl Run {
         self.calibration.as_ref()
     }
 
-    /// A calibration asked for and not made for want of total angular momentum: its
-    /// ratio to the rotors' and to its scatter ([`MIN_MOMENTUM_SIGNIFICANCE`]); the rotors'
-    /// σ is then their consider term ([`Self::rotor_inertia`]).
+    /// A calibration asked for and not made, and why; the rotors' σ is then their consider
+    /// term ([`Self::rotor_inertia`]).
     #[must_use]
-    pub fn rotor_calibration_not_made(&self) -> Option<(f64, f64)> {
+    pub fn rotor_calibration_not_made(&self) -> Option<NotMade> {
         self.calibration_not_made
     }
 
