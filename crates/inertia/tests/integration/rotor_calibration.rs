@@ -89,6 +89,16 @@ fn without_sigma(sc: &Spacecraft) -> Spacecraft {
     sc
 }
 
+/// The tilts' |error|/σ: within 3σ in at least 95 % of them, none beyond 5σ.
+fn assert_tilts_covered(tilt_z: &[f64]) {
+    let within = tilt_z.iter().filter(|&&z| z <= 3.0).count() as f64 / tilt_z.len() as f64;
+    let worst = tilt_z.iter().fold(0.0f64, |a, &b| a.max(b));
+    assert!(
+        within >= 0.95 && worst <= 5.0,
+        "{within} within 3σ, worst {worst}"
+    );
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -141,13 +151,7 @@ fn tilted_wheels_on_a_momentum_biased_slew_are_calibrated() {
             }
         }
     }
-    // 48 tilts: within 3σ in at least 95 % of them, none beyond 5σ.
-    let within = tilt_z.iter().filter(|&&z| z <= 3.0).count() as f64 / tilt_z.len() as f64;
-    let worst = tilt_z.iter().fold(0.0f64, |a, &b| a.max(b));
-    assert!(
-        within >= 0.95 && worst <= 5.0,
-        "{within} within 3σ, worst {worst}"
-    );
+    assert_tilts_covered(&tilt_z);
     let (f, c, p) = (median(free), median(calibrated), median(plain));
     assert!(c <= 3.0 * f, "calibrated {c:e} against effect-free {f:e}");
     assert!(c <= 0.01 * p, "calibrated {c:e} against uncalibrated {p:e}");
@@ -264,12 +268,7 @@ fn tilts_of_axis_aligned_wheels_keep_their_directions() {
             tilt_z.push((c.value[v] - d).abs() / c.sigma[v]);
         }
     }
-    let within = tilt_z.iter().filter(|&&z| z <= 3.0).count() as f64 / tilt_z.len() as f64;
-    let worst = tilt_z.iter().fold(0.0f64, |a, &b| a.max(b));
-    assert!(
-        within >= 0.95 && worst <= 5.0,
-        "{within} within 3σ, worst {worst}"
-    );
+    assert_tilts_covered(&tilt_z);
     let (f, c) = (median(free), median(calibrated));
     assert!(c <= 3.0 * f, "calibrated {c:e} against effect-free {f:e}");
 }
