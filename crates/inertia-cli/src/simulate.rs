@@ -380,6 +380,17 @@ pub fn run(a: &SimulateArgs) -> Result<(), CliError> {
         .as_deref()
         .map(|p| inertia::spacecraft::Spacecraft::load(p).map_err(|e| input(e.to_string())))
         .transpose()?;
+    if let (Some(sc), Some(p)) = (&spacecraft, a.spacecraft.as_deref()) {
+        if sc.rotors.is_empty() {
+            return Err(input(format!(
+                "--spacecraft {}: the file lists no rotors; simulate --spacecraft writes each \
+                 rotor's speed (the wheel momentum split among at least three rotors whose \
+                 axes span the body), and its thrusters are not simulated from the file (give \
+                 --thrusters)",
+                p.display()
+            )));
+        }
+    }
     let stdout = is_stdio(&a.output);
     // Create both files first: an unwritable destination fails before the simulation.
     let csv = (!stdout).then(|| Pending::create(&a.output)).transpose()?;
