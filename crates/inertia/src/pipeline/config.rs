@@ -69,6 +69,20 @@ impl PipelineConfig {
         })
     }
 
+    /// Refuse the rotor calibration outside a [`super::Run`] with a spacecraft file, which
+    /// alone holds the rotors' speeds and σ (rather than ignore it).
+    pub(crate) fn check_no_calibration(&self) -> Result<(), PipelineError> {
+        if !self.calibrate_rotors {
+            return Ok(());
+        }
+        Err(PipelineError::NeedsSetting {
+            setting: "calibrate_rotors",
+            needs: "Run",
+            requirement: "with a spacecraft file",
+            why: "the rotors' parameters need their speeds and σ, which only a run with the file holds",
+        })
+    }
+
     /// This configuration with its wheel-speed time tag applied by the run: the time tag
     /// off for the pipeline or batch call, its consider term kept.
     pub(crate) fn with_delay_applied(mut self) -> Self {

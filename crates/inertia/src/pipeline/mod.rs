@@ -108,6 +108,7 @@ impl Pipeline {
     /// Build from an already validated configuration.
     pub fn from_config(config: PipelineConfig) -> Result<Self, PipelineError> {
         config.check_no_wheel_delay()?;
+        config.check_no_calibration()?;
         let resampler = config
             .resample_s
             .map(Resampler::new)
@@ -256,6 +257,7 @@ impl Pipeline {
 /// Estimate from all samples at once (eq. 57) with the configured estimator, which must
 /// have a batch form. Memory and resampling do not apply.
 pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    config.check_no_calibration()?;
     batch_with(samples, config, &interface::RotorSources::NONE)
 }
 

@@ -442,7 +442,7 @@ impl Run {
             }
         }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
-            if self.config.calibrate_rotors && self.calibration_not_made.is_none() {
+            if self.config.calibrate_rotors {
                 self.check_calibration(0)
                     .map_err(|e| RunError { sample: None, ..e })?;
             } else if self.rotor_consider.is_none() {
@@ -467,8 +467,7 @@ impl Run {
                     Some(Ok(d)) => d.delay_s,
                     _ => 0.0,
                 };
-                let calibrate = config.calibrate_rotors && self.calibration_not_made.is_none();
-                let o = match self.rotors.as_ref().filter(|_| calibrate) {
+                let o = match self.rotors.as_ref().filter(|_| config.calibrate_rotors) {
                     Some(sc) => {
                         match rotors::calibrated_batch(
                             samples,
@@ -482,7 +481,9 @@ impl Run {
                                 Ok(*o)
                             }
                             Ok(rotors::Calibrated::NotMade(why)) => {
+                                // The rotors' consider term instead, as without the option.
                                 self.calibration_not_made = Some(why);
+                                self.config.calibrate_rotors = false;
                                 return self.finish(on_estimate);
                             }
                             Err(e) => Err(e),

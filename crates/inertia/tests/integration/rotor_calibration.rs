@@ -290,8 +290,9 @@ fn a_known_torque_leaves_the_rotors_to_the_consider_term() {
     assert_eq!(cal.j(), consider.j());
 }
 
-/// API misuse: a streaming run, a run without a spacecraft file whose rotors have a σ,
-/// and an estimator without the momentum rows are refused, each naming what it needs.
+/// API misuse: a streaming run, a run without a spacecraft file whose rotors have a σ, a
+/// batch estimate or a pipeline outside a run, and an estimator without the momentum rows
+/// are refused, each naming what it needs.
 #[test]
 fn a_calibration_without_batch_or_a_stated_sigma_is_refused() {
     let settings = PipelineSettings {
@@ -319,6 +320,17 @@ fn a_calibration_without_batch_or_a_stated_sigma_is_refused() {
                 ..
             })
         ),
+        "{e}"
+    );
+    // Outside a run (which alone holds the rotors' speeds and σ): refused, not ignored.
+    let e = inertia::pipeline::batch(&samples, &config).unwrap_err();
+    assert!(
+        matches!(e, PipelineError::NeedsSetting { needs: "Run", .. }),
+        "{e}"
+    );
+    let e = inertia::pipeline::Pipeline::from_config(config).unwrap_err();
+    assert!(
+        matches!(e, PipelineError::NeedsSetting { needs: "Run", .. }),
         "{e}"
     );
     let e = PipelineSettings {
