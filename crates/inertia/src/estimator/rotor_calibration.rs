@@ -55,7 +55,11 @@
 //! a zero column and keeps its prior (the issue's "one overall scale unobservable, fixed
 //! by a prior on the rotors' inertia"). A known torque would fix it and breaks the rows'
 //! homogeneity, which this gauge does not handle: the run makes no calibration then
-//! ([`NotMade::KnownTorque`]).
+//! ([`NotMade::KnownTorque`]). The projection is made over the rows as built, before the
+//! chains' initial momenta and J are minimised out: a column that J can partly absorb
+//! keeps some of the shrinking direction after that reduction (a reviewer's argument, not
+//! measured); where it would matter, with little total momentum, the run makes no
+//! calibration (below).
 //!
 //! **What the data fix.** With `C` the parameters' posterior covariance (whitened units)
 //! the data's information is `C⁻¹ − I`; a combination is fixed by the data where its
