@@ -30,13 +30,12 @@ use inertia::estimator::Estimate;
 use inertia::pipeline::{PipelineSettings, Run};
 use inertia::sample::Sample;
 use inertia::sim::presets::Preset;
-use inertia::sim::rotors::pyramid;
+use inertia::sim::rotors::{drawn_pyramid, stated_exact};
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::spacecraft::{RotorErrors, Spacecraft};
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::{Matrix3, Vector3};
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
 const TRUE_J: [f64; 4] = [1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3];
@@ -76,28 +75,7 @@ fn run(
 /// The true wheels and the file ([module docs](self), "Errors").
 fn drawn(seed: u64, tilt_deg: f64, scale: f64) -> (Spacecraft, Spacecraft) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2000 + seed);
-    let n = Normal::new(0.0, 1.0).expect("normal");
-    let j: [f64; 4] = core::array::from_fn(|i| TRUE_J[i] * (1.0 + scale * n.sample(&mut rng)));
-    let mut truth = pyramid(TRUE_J, 0.0, RotorErrors::Independent);
-    let mut stated = pyramid(j, scale, RotorErrors::Independent);
-    let t = tilt_deg.to_radians();
-    for (r, s) in truth.rotors.iter_mut().zip(&mut stated.rotors) {
-        let [e1, e2] = r.tilt_directions();
-        let a =
-            Vector3::from(r.axis) + e1 * (t * n.sample(&mut rng)) + e2 * (t * n.sample(&mut rng));
-        r.axis = a.normalize().into();
-        s.spin_axis_sigma_deg = tilt_deg;
-    }
-    (truth, stated)
-}
-
-fn exact(sc: &Spacecraft) -> Spacecraft {
-    let mut sc = sc.clone();
-    for r in &mut sc.rotors {
-        r.spin_inertia_sigma_kg_m2 = 0.0;
-        r.spin_axis_sigma_deg = 0.0;
-    }
-    sc
+    drawn_pyramid(TRUE_J, scale, RotorErrors::Independent, tilt_deg, &mut rng)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -165,7 +143,7 @@ fn main() {
                             .map_or(f64::NAN, |m| relative_frobenius_error(&m, &truth))
                     };
                     let free = err(&run(&samples, &speeds, truth_sc, false).0);
-                    let plain = err(&run(&samples, &speeds, exact(&stated), false).0);
+                    let plain = err(&run(&samples, &speeds, stated_exact(&stated), false).0);
                     let (cal, r) = run(&samples, &speeds, stated, true);
                     let within = cal.and_then(|e| e.within_3sigma(&truth)) == Some(true);
                     let determined = cal.is_some_and(|e| {

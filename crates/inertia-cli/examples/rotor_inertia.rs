@@ -28,13 +28,12 @@ use inertia::estimator::Estimate;
 use inertia::pipeline::{PipelineSettings, Run};
 use inertia::sample::Sample;
 use inertia::sim::presets::Preset;
-use inertia::sim::rotors::pyramid;
+use inertia::sim::rotors::{drawn_pyramid, stated_exact};
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::spacecraft::{RotorErrors, Spacecraft};
 use inertia::tensor::relative_frobenius_error;
 use nalgebra::Matrix3;
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
 const TRUE_J: [f64; 4] = [1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3];
@@ -114,28 +113,18 @@ impl Case {
     /// true wheels (true inertias, axes tilted by draws of the tilt σ), for one seed.
     fn draw(&self, seed: u64, sigma_stated: bool) -> (Spacecraft, Spacecraft) {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1000 + seed);
-        let normal = Normal::new(0.0, 1.0).expect("normal");
-        let common = normal.sample(&mut rng);
-        let stated_j: [f64; 4] = core::array::from_fn(|_| {
-            let z = match self.errors {
-                RotorErrors::Shared => common,
-                RotorErrors::Independent => normal.sample(&mut rng),
-            };
-            1.0 + z * self.inertia_sigma
-        });
-        let stated_j: [f64; 4] = core::array::from_fn(|i| TRUE_J[i] * stated_j[i]);
-        let scale = if sigma_stated { 1.0 } else { 0.0 };
-        let mut stated = pyramid(stated_j, self.inertia_sigma * scale, self.errors);
-        let mut truth = pyramid(TRUE_J, 0.0, self.errors);
-        let t = self.tilt_sigma_deg.to_radians();
-        for (r, s) in truth.rotors.iter_mut().zip(&mut stated.rotors) {
-            let [e1, e2] = r.tilt_directions();
-            let a = nalgebra::Vector3::from(r.axis)
-                + e1 * (t * normal.sample(&mut rng))
-                + e2 * (t * normal.sample(&mut rng));
-            r.axis = a.normalize().into();
-            s.spin_axis_sigma_deg = self.tilt_sigma_deg * scale;
-        }
+        let (truth, stated) = drawn_pyramid(
+            TRUE_J,
+            self.inertia_sigma,
+            self.errors,
+            self.tilt_sigma_deg,
+            &mut rng,
+        );
+        let stated = if sigma_stated {
+            stated
+        } else {
+            stated_exact(&stated)
+        };
         (stated, truth)
     }
 }

@@ -46,6 +46,53 @@ pub fn pyramid(
     }
 }
 
+/// The wheels as flown and the spacecraft file that describes them: the file is
+/// [`pyramid`] with each spin inertia drawn off `true_j` by a relative error of σ
+/// `inertia_sigma` (one draw for all with [`RotorErrors::Shared`], one per wheel with
+/// `Independent`) and stating that σ and a tilt σ `tilt_deg`; the flown wheels have the
+/// true inertias and each axis tilted from the file's by two draws of σ `tilt_deg`
+/// towards [`Rotor::tilt_directions`]. Draws in that order from `rng`: the common error,
+/// the wheels' errors, the tilts.
+pub fn drawn_pyramid(
+    true_j: [f64; 4],
+    inertia_sigma: f64,
+    errors: RotorErrors,
+    tilt_deg: f64,
+    rng: &mut impl rand::Rng,
+) -> (Spacecraft, Spacecraft) {
+    use rand_distr::{Distribution, StandardNormal};
+    let mut normal = || -> f64 { StandardNormal.sample(&mut *rng) };
+    let common = normal();
+    let stated_j: [f64; 4] = core::array::from_fn(|i| {
+        let z = match errors {
+            RotorErrors::Shared => common,
+            RotorErrors::Independent => normal(),
+        };
+        true_j[i] * (1.0 + z * inertia_sigma)
+    });
+    let mut stated = pyramid(stated_j, inertia_sigma, errors);
+    let mut flown = pyramid(true_j, 0.0, errors);
+    let t = tilt_deg.to_radians();
+    for (r, s) in flown.rotors.iter_mut().zip(&mut stated.rotors) {
+        let [e1, e2] = r.tilt_directions();
+        let a = Vector3::from(r.axis) + e1 * (t * normal()) + e2 * (t * normal());
+        r.axis = a.normalize().into();
+        s.spin_axis_sigma_deg = tilt_deg;
+    }
+    (flown, stated)
+}
+
+/// `spacecraft` with every σ of its rotors zero: its values taken as exact.
+#[must_use]
+pub fn stated_exact(spacecraft: &Spacecraft) -> Spacecraft {
+    let mut sc = spacecraft.clone();
+    for r in &mut sc.rotors {
+        r.spin_inertia_sigma_kg_m2 = 0.0;
+        r.spin_axis_sigma_deg = 0.0;
+    }
+    sc
+}
+
 /// The rotors' stored speeds for each sample (flat: one row of `m` per sample), from each
 /// sample's rotor momentum, with the true spin inertias of `spacecraft`.
 pub fn speeds(samples: &[Sample], spacecraft: &Spacecraft) -> Result<Vec<f64>, SimError> {

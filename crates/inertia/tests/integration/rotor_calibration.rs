@@ -11,7 +11,7 @@ use inertia::pipeline::{
     PipelineError, PipelineSettings, Run, RunErrorKind, MIN_MOMENTUM_SIGNIFICANCE,
 };
 use inertia::sample::Sample;
-use inertia::sim::rotors::pyramid;
+use inertia::sim::rotors::{drawn_pyramid, pyramid, stated_exact};
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::spacecraft::{RotorErrors, Spacecraft};
 use inertia::tensor::relative_frobenius_error;
@@ -65,28 +65,7 @@ fn run(samples: &[Sample], speeds: &[f64], sc: Spacecraft, calibrate: bool) -> (
 /// of `scale`, independent), and the file: nominal axes, the drawn-off inertias, those σ.
 fn drawn(seed: u64, tilt_deg: f64, scale: f64) -> (Spacecraft, Spacecraft) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(100 + seed);
-    let n = Normal::new(0.0, 1.0).expect("normal");
-    let j: [f64; 4] = core::array::from_fn(|i| TRUE_J[i] * (1.0 + scale * n.sample(&mut rng)));
-    let mut truth = pyramid(TRUE_J, 0.0, RotorErrors::Independent);
-    let mut stated = pyramid(j, scale, RotorErrors::Independent);
-    let t = tilt_deg.to_radians();
-    for (r, s) in truth.rotors.iter_mut().zip(&mut stated.rotors) {
-        let [e1, e2] = r.tilt_directions();
-        let a =
-            Vector3::from(r.axis) + e1 * (t * n.sample(&mut rng)) + e2 * (t * n.sample(&mut rng));
-        r.axis = a.normalize().into();
-        s.spin_axis_sigma_deg = tilt_deg;
-    }
-    (truth, stated)
-}
-
-fn without_sigma(sc: &Spacecraft) -> Spacecraft {
-    let mut sc = sc.clone();
-    for r in &mut sc.rotors {
-        r.spin_inertia_sigma_kg_m2 = 0.0;
-        r.spin_axis_sigma_deg = 0.0;
-    }
-    sc
+    drawn_pyramid(TRUE_J, scale, RotorErrors::Independent, tilt_deg, &mut rng)
 }
 
 /// The tilts' |error|/σ: within 3σ in at least 95 % of them, none beyond 5σ.
@@ -119,7 +98,7 @@ fn tilted_wheels_on_a_momentum_biased_slew_are_calibrated() {
         let (samples, speeds, truth) = slew(seed, BIAS_NMS, &truth_sc);
         let err = |e: &Estimate| relative_frobenius_error(&e.inertia().expect("J"), &truth);
         free.push(err(&run(&samples, &speeds, truth_sc.clone(), false).0));
-        plain.push(err(&run(&samples, &speeds, without_sigma(&stated), false).0));
+        plain.push(err(&run(&samples, &speeds, stated_exact(&stated), false).0));
         let (cal, r) = run(&samples, &speeds, stated.clone(), true);
         calibrated.push(err(&cal));
         assert!(
@@ -200,7 +179,7 @@ fn spin_inertia_differences_are_calibrated_and_the_common_scale_is_the_files() {
         let (truth_sc, stated) = drawn(seed, 0.0, 0.02);
         let (samples, speeds, truth) = slew(seed, BIAS_NMS, &truth_sc);
         let err = |e: &Estimate| relative_frobenius_error(&e.inertia().expect("J"), &truth);
-        plain.push(err(&run(&samples, &speeds, without_sigma(&stated), false).0));
+        plain.push(err(&run(&samples, &speeds, stated_exact(&stated), false).0));
         let (cal, r) = run(&samples, &speeds, stated, true);
         calibrated.push(err(&cal));
         assert_eq!(cal.within_3sigma(&truth), Some(true), "seed {seed}");
