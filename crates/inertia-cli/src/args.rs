@@ -426,7 +426,10 @@ pub struct InputArgs {
 #[derive(Debug, Args)]
 pub struct EstimateArgs {
     /// Telemetry CSV file (see README: t, q_x..q_w, rho_x..rho_z, optional tau_*, w_*).
-    pub file: PathBuf,
+    /// Several files are several records of one spacecraft, estimated together with
+    /// `--batch`: one J, each record its own initial momenta and torques.
+    #[arg(required = true, num_args = 1.., value_name = "FILE")]
+    pub files: Vec<PathBuf>,
     /// A run file (TOML, or JSON for a name ending in `.json`) that gives any of the
     /// options below (and the input options) by their long names in snake case
     /// (`memory = 120`, `rho_model = "held"`, `bounds = ["J33=2.7:3.3"]`,

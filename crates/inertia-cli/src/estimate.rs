@@ -40,6 +40,7 @@ pub fn option_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroRadians => "--gyro-unit rad/s",
         Fix::Conjugate => "--conjugate",
         Fix::InertialTorqueOn => "--inertial-torque on",
+        Fix::Batch => "--batch",
         _ => return None,
     })
 }
@@ -81,67 +82,93 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     let config = settings.validate().map_err(settings_error)?;
     let truth = a.truth.as_deref().map(InertiaFile::read).transpose()?;
     let mut history = a.output.as_deref().map(HistoryFile::create).transpose()?;
-    let (source, name) = open(&a.file)?;
-    let reader = TelemetryReader::new(source, &name, options).map_err(telemetry)?;
-    let file = reader.file().to_string();
-    let q_columns = reader.quaternion_columns();
     let mut run = Run::new(config, batch).map_err(settings_error)?;
     if let Some(s) = spacecraft {
         run = run.with_spacecraft(s);
     }
-    run.check_columns(reader.has_gyro())
-        .map_err(|e| run_error(&e, &file, Some(1), &q_columns))?;
-    // Parsing overlaps the estimator.
-    let mut reader = ReadAhead::new(reader);
-    let size = if is_stdio(&a.file) {
-        0
-    } else {
-        std::fs::metadata(&a.file).map_or(0, |m| m.len())
-    };
-    let progress = (std::io::stderr().is_terminal() && !a.json && size > 1 << 20).then(|| {
-        let p = indicatif::ProgressBar::new(size);
-        p.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {bytes}/{total_bytes} {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        p
-    });
-    // The lines of the samples a run's error may name: every one in batch mode or where
-    // the run keeps the samples for the wheel speeds' time tag (the estimate at the end
-    // names any sample), the last `RECENT` streaming.
-    let mut lines = VecDeque::new();
+    // The file and line of the samples a run's error may name: every one in batch mode or
+    // where the run keeps the samples for the wheel speeds' time tag (the estimate at the
+    // end names any sample), the last `RECENT` streaming.
+    let mut lines: VecDeque<(usize, u64)> = VecDeque::new();
     let keep = if batch || run.holds_samples() {
         usize::MAX
     } else {
         RECENT
     };
-    let line_of = |lines: &VecDeque<u64>, n: usize, e: &RunError| -> Option<u64> {
+    let place = |lines: &VecDeque<(usize, u64)>, n: usize, e: &RunError| {
         let first = n - lines.len();
         e.sample
             .and_then(|i| lines.get(i.checked_sub(first)?).copied())
     };
+    if a.files.len() > 1 {
+        let first = a.files[0].display().to_string();
+        run.check_records()
+            .map_err(|e| run_error(&e, &first, None, ""))?;
+    }
+    let mut names: Vec<String> = Vec::new();
+    let mut q_columns = String::new();
+    let mut stats: Option<inertia::telemetry::csv::ReadStats> = None;
     let mut write_error = None;
-    while let Some(item) = reader.next() {
-        let s = item.map_err(|e| telemetry_at(e, Some(run.input_samples())))?;
-        if lines.len() == keep {
-            lines.pop_front();
+    for (k, path) in a.files.iter().enumerate() {
+        let (source, name) = open(path)?;
+        let reader = TelemetryReader::new(source, &name, options.clone()).map_err(telemetry)?;
+        let file = reader.file().to_string();
+        q_columns = reader.quaternion_columns();
+        if k > 0 {
+            run.next_record()
+                .map_err(|e| run_error(&e, &file, None, &q_columns))?;
         }
-        lines.push_back(reader.last_line());
-        let n = run.input_samples();
-        run.push_with_actuators(&s, reader.last_speeds(), reader.last_throttles(), |e| {
-            if let (Some(h), None) = (history.as_mut(), &write_error) {
-                write_error = h.write(e).err();
+        run.check_columns(reader.has_gyro())
+            .map_err(|e| run_error(&e, &file, Some(1), &q_columns))?;
+        names.push(file);
+        // Parsing overlaps the estimator.
+        let mut reader = ReadAhead::new(reader);
+        let size = if is_stdio(path) {
+            0
+        } else {
+            std::fs::metadata(path).map_or(0, |m| m.len())
+        };
+        let progress = (std::io::stderr().is_terminal() && !a.json && size > 1 << 20).then(|| {
+            let p = indicatif::ProgressBar::new(size);
+            p.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {bytes}/{total_bytes} {eta}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            p
+        });
+        while let Some(item) = reader.next() {
+            let s = item.map_err(|e| telemetry_at(e, Some(run.input_samples())))?;
+            if lines.len() == keep {
+                lines.pop_front();
             }
-        })
-        .map_err(|e| run_error(&e, &file, line_of(&lines, n + 1, &e), &q_columns))?;
-        if let Some(e) = write_error.take() {
-            return Err(e);
-        }
-        if let Some(pb) = &progress {
-            if n.is_multiple_of(4096) {
-                pb.set_position(reader.byte_position());
+            lines.push_back((k, reader.last_line()));
+            let n = run.input_samples();
+            run.push_with_actuators(&s, reader.last_speeds(), reader.last_throttles(), |e| {
+                if let (Some(h), None) = (history.as_mut(), &write_error) {
+                    write_error = h.write(e).err();
+                }
+            })
+            .map_err(|e| {
+                let at = place(&lines, n + 1, &e);
+                let file = at.map_or(&names[k], |(f, _)| &names[f]);
+                run_error(&e, file, at.map(|p| p.1), &q_columns)
+            })?;
+            if let Some(e) = write_error.take() {
+                return Err(e);
+            }
+            if let Some(pb) = &progress {
+                if n.is_multiple_of(4096) {
+                    pb.set_position(reader.byte_position());
+                }
             }
         }
+        if let Some(p) = progress {
+            p.finish_and_clear();
+        }
+        let read = reader
+            .finish()
+            .ok_or_else(|| internal("the telemetry reader thread failed"))?;
+        stats = Some(stats.map_or(read, |s| s.merged(&read)));
     }
     let n = run.input_samples();
     run.finish(|e| {
@@ -149,19 +176,19 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
             write_error = h.write(e).err();
         }
     })
-    .map_err(|e| run_error(&e, &file, line_of(&lines, n, &e), &q_columns))?;
+    .map_err(|e| {
+        let at = place(&lines, n, &e);
+        let file = at.map_or_else(|| names.join(", "), |(f, _)| names[f].clone());
+        run_error(&e, &file, at.map(|p| p.1), &q_columns)
+    })?;
     if let Some(e) = write_error.take() {
         return Err(e);
-    }
-    if let Some(p) = progress {
-        p.finish_and_clear();
     }
     if let Some(h) = history {
         h.finish()?;
     }
-    let stats = reader
-        .finish()
-        .ok_or_else(|| internal("the telemetry reader thread failed"))?;
+    let stats = stats.ok_or_else(|| internal("no input file"))?;
+    let file = names.join(", ");
     let report = run
         .report(&file, &stats)
         .ok_or_else(|| internal("a finished run without an estimate"))?

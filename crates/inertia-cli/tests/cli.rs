@@ -4,6 +4,8 @@
 mod bad_inputs;
 #[path = "cli/plan.rs"]
 mod plan;
+#[path = "cli/records.rs"]
+mod records;
 #[path = "cli/settings_file.rs"]
 mod settings_file;
 #[path = "cli/simulate_effects.rs"]

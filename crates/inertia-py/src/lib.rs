@@ -51,6 +51,23 @@ pub struct Telemetry {
     pub rotors: Option<Rotors>,
 }
 
+impl Telemetry {
+    /// Where these samples came from, to name them in messages.
+    fn origin(&self) -> Origin {
+        match (&self.file, &self.lines) {
+            (Some(name), Some(lines)) => Origin::File {
+                name: name.clone(),
+                lines: lines.clone(),
+                q_columns: self.q_columns.clone(),
+            },
+            _ => Origin::Memory {
+                naming: Naming::Arrays,
+                label: self.label.clone(),
+            },
+        }
+    }
+}
+
 /// What pickling keeps of [`Rotors`]: the spacecraft file's text and name, the speeds.
 type RotorsState<'py> = (String, String, Bound<'py, PyArray2<f64>>);
 
@@ -213,47 +230,50 @@ impl Telemetry {
     /// Estimate from these samples (see `inertia.estimate`).
     #[pyo3(signature = (kwargs=None))]
     fn estimate<'py>(
-        &self,
+        slf: PyRef<'py, Self>,
         py: Python<'py>,
         kwargs: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let kw = Kwargs::new(kwargs, py, "estimate")?;
-        let (s, d) = settings::run(&kw, "estimate")?;
-        if let Some(name) = d
-            .given()
-            .into_iter()
-            .find(|k| RunDescription::INPUT_KEYS.contains(k))
-        {
-            return Err(value_error(format!(
-                "{name}: these samples were already read and checked; give it to read_csv"
-            )));
-        }
-        let config = s.pipeline.validate().map_err(settings::settings_error)?;
-        let origin = match (&self.file, &self.lines) {
-            (Some(name), Some(lines)) => Origin::File {
-                name: name.clone(),
-                lines: lines.clone(),
-                q_columns: self.q_columns.clone(),
-            },
-            _ => Origin::Memory {
-                naming: Naming::Arrays,
-                label: self.label.clone(),
-            },
-        };
-        let out = py
-            .allow_threads(|| {
-                run::run(
-                    &self.samples,
-                    self.rotors.as_ref(),
-                    &self.stats,
-                    &origin,
-                    config,
-                    &s,
-                )
-            })
-            .map_err(|f| f.into_py(py))?;
-        result(py, &out.report, out.history.as_deref())
+        estimate_records(py, vec![slf], kwargs)
     }
+}
+
+/// Estimate from several records of one spacecraft together (`inertia.estimate` with a
+/// list: one J, each record its own initial momenta and torques; `batch=True`).
+#[pyfunction]
+#[pyo3(signature = (records, kwargs=None))]
+fn estimate_records<'py>(
+    py: Python<'py>,
+    records: Vec<PyRef<'py, Telemetry>>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kw = Kwargs::new(kwargs, py, "estimate")?;
+    let (s, d) = settings::run(&kw, "estimate")?;
+    if let Some(name) = d
+        .given()
+        .into_iter()
+        .find(|k| RunDescription::INPUT_KEYS.contains(k))
+    {
+        return Err(value_error(format!(
+            "{name}: these samples were already read and checked; give it to read_csv"
+        )));
+    }
+    let config = s.pipeline.validate().map_err(settings::settings_error)?;
+    let origins: Vec<Origin> = records.iter().map(|t| t.origin()).collect();
+    let parts: Vec<run::Record<'_>> = records
+        .iter()
+        .zip(&origins)
+        .map(|(t, origin)| run::Record {
+            samples: &t.samples,
+            rotors: t.rotors.as_ref(),
+            stats: &t.stats,
+            origin,
+        })
+        .collect();
+    let out = py
+        .allow_threads(|| run::run_records(&parts, config, &s))
+        .map_err(|f| f.into_py(py))?;
+    result(py, &out.report, out.history.as_deref())
 }
 
 /// `(report JSON, report text, history columns or None)`.
@@ -660,6 +680,7 @@ fn _inertia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stream::Stream>()?;
     m.add_function(wrap_pyfunction!(read_csv, m)?)?;
     m.add_function(wrap_pyfunction!(estimate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate_records, m)?)?;
     m.add_function(wrap_pyfunction!(samples_from_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(estimators, m)?)?;
     m.add_function(wrap_pyfunction!(restore, m)?)?;

@@ -89,6 +89,13 @@ impl Origin {
                 ),
                 _,
             ) => Failure::Argument(format!("batch=True: {e}")),
+            // Several records where the run cannot take them: the arguments.
+            (
+                RunErrorKind::RecordsNeedBatch
+                | RunErrorKind::RecordsNeedRows { .. }
+                | RunErrorKind::RecordsWithCalibration,
+                _,
+            ) => Failure::Argument(format!("{e}{fixes}")),
             (RunErrorKind::NeedsGyro { .. }, Origin::Memory { .. }) => Failure::Refused {
                 message: format!("w: {e}"),
                 kind: e.error_kind(),
@@ -135,6 +142,7 @@ pub fn keyword_names(fix: Fix) -> Option<&'static str> {
         Fix::GyroRadians => "gyro_unit=\"rad/s\"",
         Fix::Conjugate => "conjugate=True",
         Fix::InertialTorqueOn => "inertial_torque=\"on\"",
+        Fix::Batch => "batch=True",
         _ => return None,
     })
 }
@@ -143,6 +151,15 @@ pub fn keyword_names(fix: Fix) -> Option<&'static str> {
 pub struct Output {
     pub report: Report,
     pub history: Option<Vec<Estimate>>,
+}
+
+/// One record of a run: its samples, the spacecraft file's rotors and their speeds, what
+/// reading counted, and where the samples came from.
+pub struct Record<'a> {
+    pub samples: &'a [Sample],
+    pub rotors: Option<&'a crate::Rotors>,
+    pub stats: &'a Stats,
+    pub origin: &'a Origin,
 }
 
 /// Estimate from `samples` as `inertia estimate` does from a file: the library's [`Run`].
@@ -154,7 +171,26 @@ pub fn run(
     config: PipelineConfig,
     settings: &RunSettings,
 ) -> Result<Output, Failure> {
+    let record = Record {
+        samples,
+        rotors,
+        stats,
+        origin,
+    };
+    run_records(&[record], config, settings)
+}
+
+/// [`run`] over several records of one spacecraft, estimated together
+/// ([`Run::next_record`]; `batch=True`).
+pub fn run_records(
+    records: &[Record<'_>],
+    config: PipelineConfig,
+    settings: &RunSettings,
+) -> Result<Output, Failure> {
     let (batch, history, truth) = (settings.batch, settings.history, settings.truth.as_ref());
+    let first = records
+        .first()
+        .ok_or_else(|| Failure::Argument("no records to estimate from".into()))?;
     let mut run = Run::new(config, batch).map_err(|e| match e {
         // Settings the batch form does not take are argument errors.
         PipelineError::NotApplicable { .. } | PipelineError::NoBatch { .. } => {
@@ -162,36 +198,82 @@ pub fn run(
         }
         other => Failure::Argument(crate::settings::settings_message(other)),
     })?;
-    run.check_columns(samples.iter().all(|s| s.omega_rad_s.is_some()))
-        .map_err(|e| origin.run_error(&e))?;
+    if records.len() > 1 {
+        run.check_records()
+            .map_err(|e| first.origin.run_error(&e))?;
+    }
+    let source = |r: &Record<'_>| r.rotors.map(|x| x.source.clone());
+    if records.iter().any(|r| source(r) != source(first)) {
+        return Err(Failure::Argument(
+            "spacecraft: every record must be read with the same spacecraft file (or none)".into(),
+        ));
+    }
+    if let Some(r) = first.rotors {
+        // The thrusters' torque and force are in the samples already (`read_csv`).
+        let mut spacecraft = r.spacecraft.clone();
+        spacecraft.thrusters.clear();
+        run = run.with_spacecraft(spacecraft);
+    }
     let mut kept = history.then(Vec::new);
     let mut keep = |e: &Estimate| {
         if let Some(h) = kept.as_mut() {
             h.push(*e);
         }
     };
-    match rotors {
-        Some(r) => {
-            // The thrusters' torque and force are in the samples already (`read_csv`).
-            let mut spacecraft = r.spacecraft.clone();
-            spacecraft.thrusters.clear();
-            run = run.with_spacecraft(spacecraft);
-            let m = r.spacecraft.rotors.len();
-            for (k, s) in samples.iter().enumerate() {
-                let w = r.speeds.get(k * m..(k + 1) * m).unwrap_or(&[]);
-                run.push_with_speeds(s, w, &mut keep)
-                    .map_err(|e| origin.run_error(&e))?;
-            }
+    // Each record's first input sample, to name a sample in its own record.
+    let mut starts = Vec::with_capacity(records.len());
+    for (k, r) in records.iter().enumerate() {
+        let origin = r.origin;
+        if k > 0 {
+            run.next_record().map_err(|e| origin.run_error(&e))?;
         }
-        None => {
-            for s in samples {
-                run.push(s, &mut keep).map_err(|e| origin.run_error(&e))?;
+        run.check_columns(r.samples.iter().all(|s| s.omega_rad_s.is_some()))
+            .map_err(|e| origin.run_error(&e))?;
+        let start = run.input_samples();
+        starts.push(start);
+        let local = |e: RunError| RunError {
+            sample: e.sample.map(|i| i - start),
+            ..e
+        };
+        match r.rotors {
+            Some(rotors) => {
+                let m = rotors.spacecraft.rotors.len();
+                for (i, s) in r.samples.iter().enumerate() {
+                    let w = rotors.speeds.get(i * m..(i + 1) * m).unwrap_or(&[]);
+                    run.push_with_speeds(s, w, &mut keep)
+                        .map_err(|e| origin.run_error(&local(e)))?;
+                }
+            }
+            None => {
+                for s in r.samples {
+                    run.push(s, &mut keep)
+                        .map_err(|e| origin.run_error(&local(e)))?;
+                }
             }
         }
     }
-    run.finish(&mut keep).map_err(|e| origin.run_error(&e))?;
+    run.finish(&mut keep).map_err(|e| {
+        // The record of the sample named, if any.
+        let k = e
+            .sample
+            .map_or(0, |i| starts.partition_point(|&s| s <= i).saturating_sub(1));
+        let local = RunError {
+            sample: e.sample.map(|i| i - starts[k]),
+            ..e
+        };
+        records[k].origin.run_error(&local)
+    })?;
+    let label = records
+        .iter()
+        .map(|r| r.origin.label())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let stats = records
+        .iter()
+        .skip(1)
+        .fold(*first.stats, |a, r| a.merged(r.stats));
     let report = run
-        .report(origin.label(), stats)
+        .report(&label, &stats)
         .ok_or_else(|| Failure::Argument("a finished run without an estimate".into()))?
         .with_truth(truth);
     Ok(Output {

@@ -54,6 +54,8 @@ pub enum Fix {
     Conjugate,
     /// Estimate a disturbance torque fixed in the inertial frame, per chain.
     InertialTorqueOn,
+    /// Estimate over all samples at once (batch).
+    Batch,
 }
 
 impl Fix {
@@ -76,6 +78,7 @@ impl Fix {
             Fix::GyroRadians => "gyro_unit = rad/s",
             Fix::Conjugate => "format = conjugate",
             Fix::InertialTorqueOn => "inertial_torque = on",
+            Fix::Batch => "batch = true",
         }
     }
 }

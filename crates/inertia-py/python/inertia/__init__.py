@@ -583,6 +583,9 @@ def estimate(
       streams, the whole file is read before the estimator runs (about 0.1 kB of
       memory per sample), so when a file holds both a bad row and, earlier, a step the
       estimator stops on, the bad row is reported.
+    * a list of paths or :class:`Telemetry`: several records of one spacecraft (passes,
+      throws), estimated together with ``batch=True``: one J, each record its own
+      initial momenta and torques, its own time axis (``report["records"]``).
 
     Settings (the command line's options, same names and defaults):
         estimator: ``"discrete-momentum"`` (default), ``"variational"`` (the paper's),
@@ -666,6 +669,36 @@ def estimate(
     if spacecraft is not None and not isinstance(t, (str, os.PathLike)):
         raise TypeError(
             "spacecraft: give it with a path, or to read_csv (the wheel speeds are read from the file)"
+        )
+    if isinstance(t, (list, tuple)):
+        if not single:
+            raise TypeError(
+                "estimate(records): q, rho, tau, w, r, b, f and dipole are given only with arrays "
+                "(t, q, rho)"
+            )
+        if not t:
+            raise ValueError("estimate(records): the list of records is empty")
+        records = []
+        for k, x in enumerate(t):
+            if isinstance(x, (str, os.PathLike)):
+                records.append(read_csv(x, columns=columns, spacecraft=spacecraft, **conventions))
+            elif isinstance(x, Telemetry):
+                if columns is not None or spacecraft is not None:
+                    raise ValueError(
+                        f"records[{k}]: already read; give columns and spacecraft to read_csv"
+                    )
+                records.append(x)
+            else:
+                raise TypeError(
+                    f"records[{k}]: expected a path or a Telemetry, got {type(x).__name__}"
+                )
+        given = {k: v for k, v in conventions.items() if v not in (None, False)}
+        if given and not all(isinstance(x, (str, os.PathLike)) for x in t):
+            raise ValueError(
+                f"{next(iter(given))}: a convention belongs to reading; give it to read_csv"
+            )
+        return Estimate._from_native(
+            _inertia.estimate_records([r._native for r in records], kwargs=settings)
         )
     if isinstance(t, (str, os.PathLike)):
         telemetry = read_csv(t, columns=columns, spacecraft=spacecraft, **conventions)

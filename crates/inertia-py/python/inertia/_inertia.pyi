@@ -46,6 +46,7 @@ class Stream:
     estimator: str
 
 def read_csv(path: str, kwargs: Optional[Dict[str, Any]] = ...) -> Telemetry: ...
+def estimate_records(records: List[Telemetry], kwargs: Optional[Dict[str, Any]] = ...) -> _Result: ...
 def estimate_arrays(
     t: np.ndarray,
     q: Optional[np.ndarray],

@@ -212,7 +212,7 @@ impl<S: RowSource + Send, B: Backend + Send> Estimator for Constrained<S, B> {
 fn run_batch<S: RowSource + Default>(
     samples: &[Sample],
     c: &PipelineConfig,
-    rotors: &crate::pipeline::interface::RotorSources,
+    rotors: &crate::pipeline::interface::BatchInputs,
 ) -> Result<BatchOutput, PipelineError> {
     if !rotors.is_empty() {
         return Err(PipelineError::NotApplicable {

@@ -4,7 +4,7 @@
 //! settings, so that they do not depend on the registry that lists them.
 
 use super::error::PipelineError;
-use super::interface::{BatchOutput, Capabilities, Estimator, RotorSources};
+use super::interface::{BatchInputs, BatchOutput, Capabilities, Estimator};
 use crate::constraints::Constraints;
 use crate::estimator::momentum_rows::{RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
@@ -268,9 +268,9 @@ pub const SHORT_RECORD_S: f64 = 30.0;
 /// Build a streaming estimator from a validated configuration.
 pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;
 /// Estimate from all samples at once, with the rotor parameters' sources where the run
-/// estimates them ([`super::interface::RotorSources`]).
+/// estimates them ([`super::interface::BatchInputs`]).
 pub(crate) type BatchFn =
-    fn(&[Sample], &PipelineConfig, &RotorSources) -> Result<BatchOutput, PipelineError>;
+    fn(&[Sample], &PipelineConfig, &BatchInputs) -> Result<BatchOutput, PipelineError>;
 
 /// A registered estimator.
 #[derive(Debug)]

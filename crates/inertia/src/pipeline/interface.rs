@@ -15,27 +15,40 @@ pub(crate) trait Estimator: Send {
     fn diagnostics(&self) -> Diagnostics;
 }
 
-/// The rotor parameters a batch run estimates with J
-/// ([`crate::estimator::rotor_calibration`]): each source's 1σ change of every sample's
-/// rotor momentum, N m s, and its prior mean (in its σ; 0: the spacecraft file's value);
-/// none: no calibration.
+/// What a batch run has besides its samples and settings.
+///
+/// * **Rotor parameters** it estimates with J ([`crate::estimator::rotor_calibration`]):
+///   each source's 1σ change of every sample's rotor momentum, N m s, and its prior mean
+///   (in its σ; 0: the spacecraft file's value); none: no calibration.
+/// * **Records**: the index of the first sample of each record after the first, where
+///   the samples are several records of one spacecraft (in time order, a gap between
+///   each two: [`crate::pipeline::Run::next_record`]); empty: one record. Each record has
+///   its own chains (initial momenta, inertial torque) and its own body-frame torque.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub(crate) struct RotorSources {
+pub(crate) struct BatchInputs {
     pub(crate) momenta: std::vec::Vec<std::vec::Vec<nalgebra::Vector3<f64>>>,
     pub(crate) prior_mean: std::vec::Vec<f64>,
+    pub(crate) records: std::vec::Vec<usize>,
 }
 
-impl RotorSources {
-    /// No calibration.
-    pub(crate) const NONE: RotorSources = RotorSources {
+impl BatchInputs {
+    /// No calibration, one record.
+    pub(crate) const NONE: BatchInputs = BatchInputs {
         momenta: std::vec::Vec::new(),
         prior_mean: std::vec::Vec::new(),
+        records: std::vec::Vec::new(),
     };
 
-    /// Whether there is no source.
+    /// Whether there is no rotor source.
     #[must_use]
     pub(crate) fn is_empty(&self) -> bool {
         self.momenta.is_empty()
+    }
+
+    /// The record of sample `i` (0 for the first).
+    #[must_use]
+    pub(crate) fn record_of(&self, i: usize) -> usize {
+        self.records.partition_point(|&start| start <= i)
     }
 }
 

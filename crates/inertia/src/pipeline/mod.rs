@@ -257,8 +257,25 @@ impl Pipeline {
 /// Estimate from all samples at once (eq. 57) with the configured estimator, which must
 /// have a batch form. Memory and resampling do not apply.
 pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput, PipelineError> {
+    batch_of_records(samples, config, &[])
+}
+
+/// [`batch`] over several records laid end to end ([`Run::next_record`]): `starts` is the
+/// index of each later record's first sample.
+pub(crate) fn batch_of_records(
+    samples: &[Sample],
+    config: &PipelineConfig,
+    starts: &[usize],
+) -> Result<BatchOutput, PipelineError> {
     config.check_no_calibration()?;
-    batch_with(samples, config, &interface::RotorSources::NONE)
+    batch_with(
+        samples,
+        config,
+        &interface::BatchInputs {
+            records: starts.to_vec(),
+            ..interface::BatchInputs::NONE
+        },
+    )
 }
 
 /// [`batch`] estimating the rotor parameters of `sources` with J
@@ -267,7 +284,7 @@ pub fn batch(samples: &[Sample], config: &PipelineConfig) -> Result<BatchOutput,
 pub(crate) fn batch_with(
     samples: &[Sample],
     config: &PipelineConfig,
-    sources: &interface::RotorSources,
+    sources: &interface::BatchInputs,
 ) -> Result<BatchOutput, PipelineError> {
     config.check_no_wheel_delay()?;
     let run = batch_applies(config)?;

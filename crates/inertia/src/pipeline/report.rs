@@ -4,7 +4,7 @@
 //! Schema version [`SCHEMA_VERSION`]. Keys (units in the README's conventions; products
 //! of inertia are tensor entries, `J12 = −Σ m x y`): `schema_version`, the input summary
 //! (`file`, `sample_period_s`, `renormalised`, `sign_flips`, `min_step_s`, `max_step_s`,
-//! when the samples came from a file), `estimator`, `solver`, `constraints`, `batch`,
+//! and `records` when there are several, when the samples came from files), `estimator`, `solver`, `constraints`, `batch`,
 //! `samples`, `gaps`, `t`, `status` ([`Observability::code`]), `reason`, `condition`,
 //! `inertia` (3×3, kg m²), `j`, `sigma`, `principal_moments`, `principal_moments_sigma`,
 //! `principal_axes` (columns), `solver_status`, `iterations`, `relative_error` (against a
@@ -69,6 +69,15 @@ pub struct InputSummary {
     /// Whether the attitude was integrated from the gyro rates (the input had no
     /// quaternions).
     pub attitude_from_gyro: bool,
+    /// Records estimated together ([`crate::pipeline::Run::next_record`]): the file names
+    /// are then comma-separated, and `t` is the last record's own time. Written only
+    /// above 1.
+    #[serde(skip_serializing_if = "is_one")]
+    pub records: usize,
+}
+
+fn is_one(n: &usize) -> bool {
+    *n == 1
 }
 
 /// The report of one run.
@@ -635,6 +644,18 @@ impl Report {
     #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
     pub(crate) fn with_input(mut self, input: InputSummary) -> Self {
         self.input = Some(input);
+        self
+    }
+
+    /// Of `records` laid end to end, the last shifted by `offset_s`
+    /// ([`crate::pipeline::Run::next_record`]): the gaps between records are no gaps of
+    /// the data, and the time is the last record's own.
+    #[must_use]
+    pub(crate) fn with_records(mut self, records: usize, offset_s: f64) -> Self {
+        if records > 1 {
+            self.gaps = self.gaps.saturating_sub(records - 1);
+            self.t -= offset_s;
+        }
         self
     }
 

@@ -19,12 +19,13 @@
 //!   front end to name in its own vocabulary ([`crate::fix`]).
 
 mod error;
+mod records;
 mod rotors;
 
 pub use error::{RunError, RunErrorKind};
 pub use rotors::MIN_MOMENTUM_SIGNIFICANCE;
 
-use super::{batch, batch_with, BatchOutput, Pipeline, PipelineConfig, PipelineError};
+use super::{batch_with, BatchOutput, Pipeline, PipelineConfig, PipelineError};
 use crate::estimator::rotor_calibration::RotorCalibration;
 use crate::estimator::rotor_inertia::{RotorInertiaConsider, RotorInertiaError};
 use crate::estimator::wheel_delay::{self, DelayError, DelayFit, WheelDelay};
@@ -114,6 +115,8 @@ pub struct Run {
     /// A calibration asked for and not made, and why: the rotors' σ is then their
     /// consider term.
     calibration_not_made: Option<crate::estimator::rotor_calibration::NotMade>,
+    /// Several records ([`Self::next_record`]).
+    records: records::Records,
 }
 
 impl core::fmt::Debug for Run {
@@ -166,6 +169,7 @@ impl Run {
             rotor_consider: None,
             calibration: None,
             calibration_not_made: None,
+            records: records::Records::default(),
         })
     }
 
@@ -343,9 +347,11 @@ impl Run {
     fn accept(
         &mut self,
         index: usize,
-        s: &Sample,
+        input: &Sample,
         on_estimate: impl FnMut(&Estimate),
     ) -> Result<(), RunError> {
+        let shifted = self.records.shifted(input);
+        let s = &shifted;
         let has_w = s.omega_rad_s.is_some();
         if index == 0 {
             self.check_columns(has_w).map_err(|e| RunError {
@@ -369,6 +375,7 @@ impl Run {
             .map_err(|kind| RunError::at(index, kind))?;
         }
         self.order.accept(s.t_s, has_w);
+        self.records.accepted(s, input.t_s);
         if self.recent.len() == RECENT {
             self.recent.pop_front();
         }
@@ -489,7 +496,7 @@ impl Run {
                             Err(e) => Err(e),
                         }
                     }
-                    None => batch(samples, &config),
+                    None => super::batch_of_records(samples, &config, &self.records.starts),
                 }
                 .map_err(|e| {
                     let sample = match &e {
@@ -637,7 +644,9 @@ impl Run {
                     min_step_s: stats.min_step_s,
                     max_step_s: stats.max_step_s,
                     attitude_from_gyro: stats.attitude_from_gyro,
-                }),
+                    records: self.records.count(),
+                })
+                .with_records(self.records.count(), self.records.offset_s()),
         )
     }
 }

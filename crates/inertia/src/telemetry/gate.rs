@@ -338,6 +338,25 @@ pub struct ReadStats {
 }
 
 impl ReadStats {
+    /// The counts of two inputs read one after the other (several records).
+    #[must_use]
+    pub fn merged(&self, other: &ReadStats) -> ReadStats {
+        let steps = |s: &ReadStats| s.rows > 1;
+        ReadStats {
+            rows: self.rows + other.rows,
+            renormalised: self.renormalised + other.renormalised,
+            sign_flips: self.sign_flips + other.sign_flips,
+            rejected: self.rejected + other.rejected,
+            min_step_s: match (steps(self), steps(other)) {
+                (true, true) => self.min_step_s.min(other.min_step_s),
+                (false, true) => other.min_step_s,
+                _ => self.min_step_s,
+            },
+            max_step_s: self.max_step_s.max(other.max_step_s),
+            attitude_from_gyro: self.attitude_from_gyro || other.attitude_from_gyro,
+        }
+    }
+
     /// Count the step of `dt` s into the next sample, whose quaternion `q` follows `prev`
     /// (before that sample is counted in `rows`): the shortest and longest step, and a sign
     /// opposite to the previous quaternion's.

@@ -24,6 +24,7 @@ mod numeric_range;
 mod outside_torques;
 mod pipeline;
 mod prior;
+mod records;
 mod rotor_calibration;
 mod rotor_inertia;
 mod rotor_scale;

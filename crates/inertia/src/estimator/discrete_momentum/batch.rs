@@ -9,8 +9,9 @@ use super::*;
 use crate::estimator as est;
 use crate::estimator::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
 
-/// A row and its rotor parameters' columns ([`est::rotor_calibration::columns`]).
-type RowWithRotors<'a> = (AugmentedRow, &'a [Vector3<f64>]);
+/// A row, its rotor parameters' columns ([`est::rotor_calibration::columns`]) and its
+/// record ([`crate::pipeline::interface::BatchInputs::records`]).
+type RowWithRotors<'a> = (AugmentedRow, &'a [Vector3<f64>], usize);
 
 /// The batch reduction: the reduced problem in `j` and what goes with it.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,6 +147,22 @@ impl BatchReduction {
     }
 }
 
+/// The factor that puts a χ² of `k` degrees of freedom on the scale of the torque test's
+/// χ²₃ ([`super::TORQUE_CHI2`], its 0.999 quantile), matched at the 0.999 quantiles: 1 for
+/// `k ≤ 3`, else `TORQUE_CHI2 / q_k` with `q_k` the Wilson–Hilferty approximation of
+/// χ²_k's 0.999 quantile, `k (1 − 2/(9k) + z √(2/(9k)))³`, `z = 3.0902` (within 2 % of
+/// the exact quantile for `k ≥ 3`; 16.5 for `k = 3` against 16.27).
+#[must_use]
+pub(crate) fn equivalent_chi2_scale(k: usize) -> f64 {
+    if k <= 3 {
+        return 1.0;
+    }
+    let k = k as f64;
+    let a = 2.0 / (9.0 * k);
+    let q = k * (1.0 - a + 3.0902 * crate::math::sqrt(a)).powi(3);
+    super::TORQUE_CHI2 / q
+}
+
 /// The damping's row of an upper-triangular factor over the shared unknowns, `j` last:
 /// `r_dd D + r_dj·j = z_d` once the unknowns after it are fixed, and its least-squares σ.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,7 +191,7 @@ impl DampingRow {
 pub(crate) fn reduce_batch(
     samples: &[Sample],
     settings: &MomentumRowSettings,
-    sources: &crate::pipeline::interface::RotorSources,
+    sources: &crate::pipeline::interface::BatchInputs,
 ) -> Result<BatchReduction, EstimatorError> {
     use est::jackknife::{jackknife_sigma, GROUPS, MIN_GROUPS};
     use est::momentum_rows::J;
@@ -189,7 +206,9 @@ pub(crate) fn reduce_batch(
     let mut source = MomentumRows::new(*settings);
     let mut clock = ChainClock::new(settings.max_chain_s);
     use std::{vec, vec::Vec};
-    let mut chains: Vec<Vec<AugmentedRow>> = vec![Vec::new()];
+    // Each chain with its record: a record's first row starts a chain (its first sample
+    // follows a gap, [`crate::pipeline::Run::next_record`]).
+    let mut chains: Vec<(usize, Vec<AugmentedRow>)> = vec![(0, Vec::new())];
     let mut epoch = 0;
     for (i, s) in samples.iter().enumerate() {
         let row = source
@@ -197,16 +216,17 @@ pub(crate) fn reduce_batch(
             .map_err(|source| EstimatorError::Row { sample: i, source })?;
         if let Some(row) = row {
             let e = clock.epoch(&source);
-            if e != epoch {
+            let record = sources.record_of(i);
+            if e != epoch || chains.last().is_some_and(|c| c.0 != record) {
                 epoch = e;
-                chains.push(Vec::new());
+                chains.push((record, Vec::new()));
             }
             if let Some(c) = chains.last_mut() {
-                c.push(row);
+                c.1.push(row);
             }
         }
     }
-    chains.retain(|c| !c.is_empty());
+    chains.retain(|c| !c.1.is_empty());
     // The rotor parameters' columns, per row, in the chains' order.
     let (rotor_columns, gamma) = if sources.is_empty() {
         (Vec::new(), Vec::new())
@@ -217,22 +237,39 @@ pub(crate) fn reduce_batch(
     let mut next = 0;
     let chains: Vec<Vec<RowWithRotors>> = chains
         .into_iter()
-        .map(|c| {
+        .map(|(record, c)| {
             c.into_iter()
                 .map(|r| {
                     let ex = rotor_columns.get(next).map_or(&[][..], |v| &v[..]);
                     next += 1;
-                    (r, ex)
+                    (r, ex, record)
                 })
                 .collect()
         })
         .collect();
-    // A row's coefficient of column `k` (a rotor parameter's past the rows' own).
-    let coef = |(r, ex): &RowWithRotors, i: usize, k: usize| {
-        if k < ROTOR {
+    // Every record after the first has its own body torque: three columns past the rotor
+    // parameters', record `r` at `RECORD_TORQUE + 3 (r − 1)`.
+    let record_torque = ROTOR + n_rotor;
+    // A row's coefficient of column `k` (a rotor parameter's or a later record's torque
+    // past the rows' own; the body torque's own columns are the first record's).
+    let coef = |(r, ex, record): &RowWithRotors, i: usize, k: usize| {
+        if (TORQUE..TORQUE + 3).contains(&k) {
+            if *record == 0 {
+                r.a[(i, k)]
+            } else {
+                0.0
+            }
+        } else if k < ROTOR {
             r.a[(i, k)]
-        } else {
+        } else if k < record_torque {
             ex[k - ROTOR][i]
+        } else {
+            let q = k - record_torque;
+            if *record == 1 + q / 3 {
+                r.a[(i, TORQUE + q % 3)]
+            } else {
+                0.0
+            }
         }
     };
     // Householder QR of an m×n system (zero-padded to at least n rows): (R, Qᵀy, ‖y‖²).
@@ -251,12 +288,15 @@ pub(crate) fn reduce_batch(
     // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
     // initial momenta chain by chain (a short Richardson chain may use only X₀).
     let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
-    // The torque's columns first (held at zero by dropping them, below), the rotor
-    // parameters', then the rest in order: the damping's last before j.
+    let uses_shared = |r: &RowWithRotors, k: usize| (0..3).any(|i| coef(r, i, k) != 0.0);
+    // The torque's columns first, every record's (held at zero by dropping them, below),
+    // the rotor parameters', then the rest in order: the damping's last before j.
     let torque_columns = TORQUE..TORQUE + 3;
+    let records = chains.iter().flatten().map(|r| r.2 + 1).max().unwrap_or(1);
     let shared_columns: Vec<usize> = torque_columns
         .clone()
-        .filter(|&k| chains.iter().flatten().any(|r| uses(&r.0, k)))
+        .chain(record_torque..record_torque + 3 * (records - 1))
+        .filter(|&k| chains.iter().flatten().any(|r| uses_shared(r, k)))
         .chain(ROTOR..ROTOR + n_rotor)
         .chain(
             (FIRST_SHARED..J)
@@ -317,6 +357,11 @@ pub(crate) fn reduce_batch(
             nuisance += 3.0;
         }
     }
+    // The later records' body torques.
+    nuisance += shared_columns
+        .iter()
+        .filter(|&&k| k >= record_torque)
+        .count() as f64;
     for chain in &chains {
         nuisance += settings.nuisance_per_chain() as f64;
         let (block, (r, e, m)) = reduce_chain(&chain.iter().collect::<Vec<_>>());
@@ -415,14 +460,16 @@ pub(crate) fn reduce_batch(
     let torque = if settings.torque_bias {
         shared_columns
             .iter()
-            .filter(|k| torque_columns.contains(k))
+            .filter(|&&k| torque_columns.contains(&k) || k >= record_torque)
             .count()
     } else {
         0
     };
     let without_torque = (torque > 0).then(|| {
         let (r, z, held_rss, _, _) = solve_shared(&blocks, &|_| true, torque);
-        let growth = (held_rss - shared_rss).max(0.0);
+        // With several records' torques, `k > 3` unknowns: the growth on the scale of
+        // the test's χ²₃, matched at its threshold ([`equivalent_chi2_scale`]).
+        let growth = (held_rss - shared_rss).max(0.0) * equivalent_chi2_scale(torque);
         let qr = RecursiveQr {
             r,
             z,
@@ -480,14 +527,56 @@ pub(crate) fn reduce_batch(
             .collect()
     };
     let estimates: Option<Vec<(InertiaVector, Option<f64>)>> = estimates;
+    // With at least MIN_GROUPS records, the records are groups too: what differs from one
+    // pass or throw to the next is then in σ. Their few groups make a noisy σ (with four
+    // records, three degrees of freedom), so the larger of the two is kept, element by
+    // element (on 100 sets of four 60 s slews: chains alone 2 of 100 determined beyond
+    // 3σ, records alone 3, `examples/records.rs`).
+    let record_of_chain: Vec<usize> = chains
+        .iter()
+        .map(|c| c.first().map_or(0, |r| r.2))
+        .collect();
+    let by_record: Option<Vec<(InertiaVector, Option<f64>)>> = (records >= MIN_GROUPS)
+        .then(|| {
+            (0..records.min(GROUPS))
+                .map(|g| {
+                    let keep = |c: usize| record_of_chain[c] % GROUPS != g;
+                    let (r, z, _, d, _) = solve_shared(&blocks, &keep, 0);
+                    let j = crate::solver::unconstrained_minimiser(&r, &z)?;
+                    Some((j, damping_of(&d, &j)))
+                })
+                .collect()
+        })
+        .flatten();
+    let larger = |a: Option<[f64; 6]>, b: Option<[f64; 6]>| match (a, b) {
+        (Some(a), Some(b)) => Some(core::array::from_fn(|k| a[k].max(b[k]))),
+        (a, b) => a.or(b),
+    };
     // The delete-one answers' D, as one more element of the jackknife.
-    let damping_jackknife = estimates.as_deref().and_then(|e| {
+    let damping_sigma = |e: &[(InertiaVector, Option<f64>)], scale: f64| {
         let d: Option<Vec<InertiaVector>> = e
             .iter()
             .map(|(_, d)| d.map(InertiaVector::from_element))
             .collect();
-        Some(jackknife_sigma(&d?)?[0] * time_block_scale)
-    });
+        jackknife_sigma(&d?).map(|s| s.map(|v| v * scale))
+    };
+    let damping_jackknife = larger(
+        estimates
+            .as_deref()
+            .and_then(|e| damping_sigma(e, time_block_scale)),
+        by_record.as_deref().and_then(|e| damping_sigma(e, 1.0)),
+    )
+    .map(|s| s[0]);
+    let j_sigma = |e: &[(InertiaVector, Option<f64>)], scale: f64| {
+        let j: Vec<InertiaVector> = e.iter().map(|(j, _)| *j).collect();
+        jackknife_sigma(&j).map(|s| s.map(|v| v * scale))
+    };
+    let jackknife_sigma_kg_m2 = larger(
+        estimates
+            .as_deref()
+            .and_then(|e| j_sigma(e, time_block_scale)),
+        by_record.as_deref().and_then(|e| j_sigma(e, 1.0)),
+    );
     Ok(BatchReduction {
         qr: RecursiveQr {
             r: rr,
@@ -500,12 +589,7 @@ pub(crate) fn reduce_batch(
             nuisance,
         },
         gaps: source.gaps(),
-        jackknife_sigma_kg_m2: estimates
-            .as_ref()
-            .map(|e| e.iter().map(|(j, _)| *j).collect::<Vec<_>>())
-            .as_deref()
-            .and_then(jackknife_sigma)
-            .map(|s| s.map(|v| v * time_block_scale)),
+        jackknife_sigma_kg_m2,
         without_torque,
         shared: full
             .filter(|_| {

@@ -245,7 +245,7 @@ pub(crate) fn assert_recursive_matches_batch(
     let b = reduce_batch(
         samples,
         &rows,
-        &crate::pipeline::interface::RotorSources::NONE,
+        &crate::pipeline::interface::BatchInputs::NONE,
     )
     .expect("batch");
     let what = format!("{:?} chain {:?}", rows.stencil, rows.max_chain_s);
@@ -484,7 +484,7 @@ fn recursive_and_batch_jackknife_agree() {
     let bat = reduce_batch(
         &run.samples,
         &rows,
-        &crate::pipeline::interface::RotorSources::NONE,
+        &crate::pipeline::interface::BatchInputs::NONE,
     )
     .expect("batch")
     .jackknife_sigma_kg_m2
@@ -562,7 +562,7 @@ fn recursive_and_batch_time_block_jackknives_agree() {
     let bat = reduce_batch(
         &run.samples,
         &rows(),
-        &crate::pipeline::interface::RotorSources::NONE,
+        &crate::pipeline::interface::BatchInputs::NONE,
     )
     .expect("batch")
     .jackknife_sigma_kg_m2
@@ -604,7 +604,7 @@ fn recursive_and_batch_agree_with_damping() {
         let b = reduce_batch(
             &out.samples,
             &rows,
-            &crate::pipeline::interface::RotorSources::NONE,
+            &crate::pipeline::interface::BatchInputs::NONE,
         )
         .expect("batch");
         let (dr, _) = e.damping_at(&j).expect("recursive D");
@@ -618,5 +618,16 @@ fn recursive_and_batch_agree_with_damping() {
             (db - THROW.damping_nms).abs() <= 3.0 * sb,
             "{stencil:?}: D = {db:e} ± {sb:e}"
         );
+    }
+}
+
+#[test]
+fn the_torque_tests_chi2_scale_matches_the_quantiles() {
+    use super::batch::equivalent_chi2_scale;
+    // Reference: χ²_k's 0.999 quantile (tables; Abramowitz & Stegun 26.4).
+    assert_eq!(equivalent_chi2_scale(3), 1.0);
+    for (k, q) in [(6, 22.458), (12, 32.909), (24, 51.179), (30, 59.703)] {
+        let ours = super::TORQUE_CHI2 / equivalent_chi2_scale(k);
+        assert!(((ours - q) / q).abs() < 0.02, "k = {k}: {ours} against {q}");
     }
 }

@@ -26,7 +26,7 @@ use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
 use crate::pipeline::diagnostics::Diagnostics;
 use crate::pipeline::error::PipelineError;
-use crate::pipeline::interface::{BatchOutput, RotorSources};
+use crate::pipeline::interface::{BatchInputs, BatchOutput};
 use crate::sample::Sample;
 use crate::solver::Backend;
 use crate::tensor::InertiaVector;
@@ -47,7 +47,7 @@ fn wrap(source: EstimatorError) -> PipelineError {
 pub(super) fn run_batch(
     samples: &[Sample],
     c: &PipelineConfig,
-    rotors: &RotorSources,
+    rotors: &BatchInputs,
 ) -> Result<BatchOutput, PipelineError> {
     // The drift weighting needs an estimate of J before each row is folded: recursive
     // runs only.
@@ -61,11 +61,11 @@ pub(super) fn run_batch(
     let mut reduced: Vec<(MomentumRowSettings, BatchReduction)> = Vec::new();
     // A record longer than [`SHORT_RECORD_S`] is no longer short: without the torque the
     // default adds to short ones ([`InertialTorque::Short`]), as the streaming run rules it
-    // out past that span.
-    let span = match (samples.first(), samples.last()) {
-        (Some(a), Some(b)) => b.t_s - a.t_s,
-        _ => 0.0,
-    };
+    // out past that span. Of several records, the longest.
+    let span = record_ranges(samples.len(), &rotors.records)
+        .into_iter()
+        .filter_map(|r| Some(samples.get(r.end.checked_sub(1)?)?.t_s - samples.get(r.start)?.t_s))
+        .fold(0.0, f64::max);
     let long = c.inertial_torque == InertialTorque::Short && span > SHORT_RECORD_S;
     for rows in candidates(c, has_gyro) {
         if long && rows.inertial_torque {
@@ -152,6 +152,16 @@ pub(super) fn run_batch(
     })
 }
 
+/// The index ranges of the records that start at `starts` (after the first, at 0) in
+/// `n` samples.
+fn record_ranges(n: usize, starts: &[usize]) -> Vec<core::ops::Range<usize>> {
+    let mut bounds: Vec<usize> = core::iter::once(0)
+        .chain(starts.iter().copied().filter(|&s| s > 0 && s < n))
+        .collect();
+    bounds.push(n);
+    bounds.windows(2).map(|w| w[0]..w[1]).collect()
+}
+
 /// The outside torques of a batch run at its answer `e`, from the chosen reduction:
 /// whether the gravity gradient was modelled, the residual dipole and the centre of mass
 /// with their least-squares σ and, in quadrature, `e`'s σ beyond its noise carried
@@ -204,7 +214,7 @@ fn batch_outside(
 struct BatchRun<'a> {
     samples: &'a [Sample],
     /// The rotor parameters' sources, where the run estimates them.
-    rotors: &'a RotorSources,
+    rotors: &'a BatchInputs,
     config: &'a PipelineConfig,
     /// Every candidate's rows and their reduction.
     reduced: &'a [(MomentumRowSettings, BatchReduction)],
@@ -313,21 +323,42 @@ impl Evidence for BatchRun<'_> {
     }
 
     fn discretisation_bias(&self) -> [f64; 6] {
-        // The first candidate on every other sample, as the recursive path's shadow.
-        let half: Vec<Sample> = self
-            .samples
-            .chunks_exact(2)
-            .map(|p| double_step(&p[0], &p[1]))
-            .collect();
-        // A double step keeps its first sample's rotor momentum.
-        let half_rotors = RotorSources {
+        // The first candidate on every other sample of each record, as the recursive
+        // path's shadow; a double step keeps its first sample's rotor momentum.
+        let records = record_ranges(self.samples.len(), &self.rotors.records);
+        let halve = |v: &[Sample]| -> Vec<Sample> {
+            records
+                .iter()
+                .flat_map(|r| {
+                    v[r.clone()]
+                        .chunks_exact(2)
+                        .map(|p| double_step(&p[0], &p[1]))
+                })
+                .collect()
+        };
+        let half = halve(self.samples);
+        let mut starts = Vec::new();
+        let mut n = 0;
+        for r in &records {
+            if n > 0 {
+                starts.push(n);
+            }
+            n += r.len() / 2;
+        }
+        let half_rotors = BatchInputs {
             momenta: self
                 .rotors
                 .momenta
                 .iter()
-                .map(|d| d.chunks_exact(2).map(|p| p[0]).collect())
+                .map(|d| {
+                    records
+                        .iter()
+                        .flat_map(|r| d[r.clone()].chunks_exact(2).map(|p| p[0]))
+                        .collect()
+                })
                 .collect(),
             prior_mean: self.rotors.prior_mean.clone(),
+            records: starts,
         };
         match (self.reduced.first(), self.config.gyro_noise_rad_s_rthz) {
             (Some((first, full)), gyro) => match reduce_batch(&half, first, &half_rotors) {

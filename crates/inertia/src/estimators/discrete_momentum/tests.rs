@@ -176,7 +176,7 @@ fn ruling_out_candidates_changes_no_answer() {
         let batch = run_batch(
             &run.samples,
             &config,
-            &crate::pipeline::interface::RotorSources::NONE,
+            &crate::pipeline::interface::BatchInputs::NONE,
         )
         .unwrap();
         assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(false));
@@ -240,7 +240,7 @@ fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
     let batch = run_batch(
         &run.samples,
         &config,
-        &crate::pipeline::interface::RotorSources::NONE,
+        &crate::pipeline::interface::BatchInputs::NONE,
     )
     .unwrap();
     assert_eq!(batch.diagnostics.attitude_is_gyro_integral, Some(true));
@@ -251,7 +251,7 @@ fn an_attitude_that_is_the_gyros_integral_is_not_folded_twice() {
     let short = run_batch(
         &run.samples[..2000],
         &config,
-        &crate::pipeline::interface::RotorSources::NONE,
+        &crate::pipeline::interface::BatchInputs::NONE,
     )
     .unwrap();
     assert_eq!(short.diagnostics.attitude_is_gyro_integral, None);

@@ -52,6 +52,13 @@ impl fmt::Display for ReportText<'_> {
                 Counted(i.sign_flips, "sign flip"),
                 Counted(r.gaps, "gap")
             )?;
+            if i.records > 1 {
+                writeln!(
+                    s,
+                    "records: {}, estimated together (one J; each its own initial momenta and torques)",
+                    i.records
+                )?;
+            }
             if i.attitude_from_gyro {
                 writeln!(
                     s,

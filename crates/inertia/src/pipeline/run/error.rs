@@ -87,6 +87,24 @@ pub enum RunErrorKind {
         /// The speed columns, comma-separated.
         columns: std::string::String,
     },
+    /// Several records in a run that is not a batch run.
+    #[error("several records are estimated together only over all their samples at once (a batch run): each record's initial momenta and body torque are unknowns of that one solve")]
+    RecordsNeedBatch,
+    /// Several records for an estimator without the discrete momentum rows.
+    #[error("several records need the discrete momentum rows: the {estimator} estimator takes one record per run")]
+    RecordsNeedRows {
+        /// The estimator.
+        estimator: &'static str,
+    },
+    /// Several records with the rotor calibration.
+    #[error("several records are not supported with the rotor calibration: one record per run")]
+    RecordsWithCalibration,
+    /// A record ended (or another begun) before it had a sample.
+    #[error("record {record} has no samples")]
+    EmptyRecord {
+        /// The record, from 1.
+        record: usize,
+    },
     /// An earlier error stopped the run.
     #[error("the run stopped on an earlier error ({0}); start a new one")]
     Stopped(std::string::String),
@@ -167,6 +185,7 @@ impl RunError {
     pub fn fixes(&self) -> &'static [Fix] {
         match &self.kind {
             RunErrorKind::MemoryShorterThanStep { .. } => &[Fix::Memory],
+            RunErrorKind::RecordsNeedBatch => &[Fix::Batch],
             RunErrorKind::Pipeline(e) => e.fixes(),
             _ => &[],
         }
@@ -183,7 +202,12 @@ impl RunError {
             RunErrorKind::RotorMomentumOutOfRange { .. } => ErrorKind::OutOfRange,
             RunErrorKind::Sample(e) => e.error_kind(),
             RunErrorKind::MemoryShorterThanStep { .. } => ErrorKind::MemoryShorterThanStep,
-            RunErrorKind::TooFewSamples { .. } => ErrorKind::TooFewSamples,
+            RunErrorKind::TooFewSamples { .. } | RunErrorKind::EmptyRecord { .. } => {
+                ErrorKind::TooFewSamples
+            }
+            RunErrorKind::RecordsNeedBatch
+            | RunErrorKind::RecordsNeedRows { .. }
+            | RunErrorKind::RecordsWithCalibration => ErrorKind::InvalidSetting,
             RunErrorKind::Stopped(_) => ErrorKind::Stopped,
             RunErrorKind::Pipeline(e) => e.error_kind(),
         }

@@ -2,11 +2,11 @@
 //! ([`crate::estimator::rotor_inertia`]) or, asked for in a batch run, estimated with J
 //! ([`crate::estimator::rotor_calibration`]).
 
-use super::{batch, batch_with, BatchOutput, Mode, Pipeline, PipelineConfig};
+use super::{batch_with, BatchOutput, Mode, Pipeline, PipelineConfig};
 use super::{PipelineError, Run, RunError, RunErrorKind};
 use crate::estimator::rotor_calibration::{self, NotMade, RotorCalibration, RotorFit};
 use crate::estimator::rotor_inertia::{self, Source};
-use crate::pipeline::interface::RotorSources;
+use crate::pipeline::interface::BatchInputs;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
 use std::vec::Vec;
@@ -67,9 +67,10 @@ pub(super) fn calibrated_batch(
     let first = batch_with(
         samples,
         config,
-        &RotorSources {
+        &BatchInputs {
             momenta: momenta(sc, &sources),
             prior_mean: vec![0.0; sources.len()],
+            records: Vec::new(),
         },
     )?;
     let (Some(fit), Some(j)) = (
@@ -116,9 +117,10 @@ pub(super) fn calibrated_batch(
     let second = batch_with(
         &again,
         config,
-        &RotorSources {
+        &BatchInputs {
             momenta: momenta(&moved, &second_sources),
             prior_mean: fit.value.iter().map(|z| -z).collect(),
+            records: Vec::new(),
         },
     )?;
     let Some(f) = second.diagnostics.rotor_calibration.as_ref() else {
@@ -232,9 +234,10 @@ impl Run {
         let mut config = self.config.with_delay_applied();
         let batch_mode = matches!(self.mode, Mode::Batch { .. });
         let mut first = true;
+        let starts = self.records.starts.clone();
         let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
             let (j, rows, torque) = if batch_mode {
-                let o = batch(s, &config).ok()?;
+                let o = crate::pipeline::batch_of_records(s, &config, &starts).ok()?;
                 (
                     o.estimate.j(),
                     o.diagnostics.row_model,
