@@ -70,7 +70,7 @@
 //! estimated on the zero-momentum slew were 1–4 σ off and worse than the file's, and on
 //! the small satellite so were the spin-inertia differences. So the run estimates the
 //! parameters only where the record's total momentum stands out from its scatter by
-//! `pipeline::MIN_MOMENTUM_SIGNIFICANCE` (`total_momentum`); below it they stay a
+//! [`MIN_MOMENTUM_SIGNIFICANCE`] (`total_momentum`); below it they stay a
 //! consider term.
 
 use super::momentum_rows::{MomentumRowSettings, MomentumRows};
@@ -133,7 +133,7 @@ impl RotorFit {
 pub enum NotMade {
     /// The record's total angular momentum is `ratio` of the rotors' (RMS) and
     /// `significance` times its scatter along the record, below
-    /// `pipeline::MIN_MOMENTUM_SIGNIFICANCE`: the tilts cannot be told from J.
+    /// [`MIN_MOMENTUM_SIGNIFICANCE`]: the tilts cannot be told from J.
     NoMomentum {
         /// Its ratio to the rotors' momentum.
         ratio: f64,
@@ -162,7 +162,7 @@ impl core::fmt::Display for NotMade {
                  cannot be told from J",
                 ratio * 100.0,
                 significance,
-                crate::text::Num(crate::pipeline::MIN_MOMENTUM_SIGNIFICANCE)
+                crate::text::Num(MIN_MOMENTUM_SIGNIFICANCE)
             )?,
             NotMade::KnownTorque => f.write_str(
                 "the record has a known torque, which fixes the momentum's scale that the \
@@ -201,7 +201,7 @@ pub struct RotorCalibration {
     /// The record's total angular momentum over its rotors' (RMS).
     pub momentum_ratio: f64,
     /// The record's total angular momentum over its scatter along the record: below
-    /// `pipeline::MIN_MOMENTUM_SIGNIFICANCE`, the tilts cannot be told from J and no
+    /// [`MIN_MOMENTUM_SIGNIFICANCE`], the tilts cannot be told from J and no
     /// parameter is estimated.
     pub momentum_significance: f64,
 }
@@ -228,6 +228,16 @@ impl RotorCalibration {
         }
     }
 }
+
+/// Below this ratio of the record's total angular momentum to its scatter along the record
+/// (the norm of the mean inertial momentum `q (Ĵ ω + ρ)` over the RMS of its deviations),
+/// the rotor parameters are not estimated. With no momentum bias the ratio was 0.1–0.5 on
+/// the slew and the small satellite, whose estimated tilts moved J 1–4 σ (slew) and
+/// 30–40 σ (small satellite, MEMS and MEKF) from the truth, and whose estimated
+/// spin-inertia differences (small satellite) nearly doubled the error; with a bias of
+/// about the rotors' RMS momentum it was 49–167, every tilt was fixed by the data and J
+/// was within 3σ (`examples/rotor_calibration.rs`, `tests/integration/rotor_calibration.rs`).
+pub const MIN_MOMENTUM_SIGNIFICANCE: f64 = 3.0;
 
 /// The record's total angular momentum at inertia `j`, from the inertial momentum
 /// `h_k = q_k (J ω_k + ρ_k)` of each step (`ω` from its incremental rotation,

@@ -22,8 +22,8 @@ mod error;
 mod records;
 mod rotors;
 
+pub use crate::estimator::rotor_calibration::MIN_MOMENTUM_SIGNIFICANCE;
 pub use error::{RunError, RunErrorKind};
-pub use rotors::MIN_MOMENTUM_SIGNIFICANCE;
 
 use super::{batch_with, BatchOutput, Pipeline, PipelineConfig, PipelineError};
 use crate::estimator::rotor_calibration::RotorCalibration;

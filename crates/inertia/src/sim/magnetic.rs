@@ -46,7 +46,7 @@
 //! run's seed, stream 5 (so turning the magnetometer on leaves every other noise
 //! unchanged).
 
-use super::environment::{Orbit, EARTH_RADIUS_M};
+use super::orbit::{Orbit, EARTH_RADIUS_M};
 use super::SimError;
 use crate::attitude::Quaternion;
 use crate::sample::range;

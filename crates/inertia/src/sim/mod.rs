@@ -38,6 +38,7 @@ pub mod environment;
 pub mod gyro;
 pub mod magnetic;
 pub mod mekf;
+mod orbit;
 pub mod presets;
 pub mod realism;
 pub mod rotors;

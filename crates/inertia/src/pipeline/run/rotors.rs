@@ -4,7 +4,9 @@
 
 use super::{batch_with, BatchOutput, Mode, Pipeline, PipelineConfig};
 use super::{PipelineError, Run, RunError, RunErrorKind};
-use crate::estimator::rotor_calibration::{self, NotMade, RotorCalibration, RotorFit};
+use crate::estimator::rotor_calibration::{
+    self, NotMade, RotorCalibration, RotorFit, MIN_MOMENTUM_SIGNIFICANCE,
+};
 use crate::estimator::rotor_inertia::{self, Source};
 use crate::pipeline::interface::BatchInputs;
 use crate::sample::Sample;
@@ -19,16 +21,6 @@ pub(super) enum Calibrated {
     /// Not estimated, and why.
     NotMade(NotMade),
 }
-
-/// Below this ratio of the record's total angular momentum to its scatter along the record
-/// (the norm of the mean inertial momentum `q (Ĵ ω + ρ)` over the RMS of its deviations),
-/// the rotor parameters are not estimated. With no momentum bias the ratio was 0.1–0.5 on
-/// the slew and the small satellite, whose estimated tilts moved J 1–4 σ (slew) and
-/// 30–40 σ (small satellite, MEMS and MEKF) from the truth, and whose estimated
-/// spin-inertia differences (small satellite) nearly doubled the error; with a bias of
-/// about the rotors' RMS momentum it was 49–167, every tilt was fixed by the data and J
-/// was within 3σ (`examples/rotor_calibration.rs`, `tests/integration/rotor_calibration.rs`).
-pub const MIN_MOMENTUM_SIGNIFICANCE: f64 = 3.0;
 
 /// The batch estimate of `samples` (their rotor momentum from `sc`'s rotors, `speeds` one
 /// per rotor and sample, read `delay_s` late) with the rotor parameters
