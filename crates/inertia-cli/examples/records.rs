@@ -3,16 +3,19 @@
 //!
 //! ```sh
 //! cargo run --release -p inertia-cli --example records -- 20   # sets of records per cell
+//! WHEEL_DELAY=estimate cargo run --release -p inertia-cli --example records -- 20
 //! ```
+//!
+//! `WHEEL_DELAY`: the wheel speeds' time tag (`off`, seconds or `estimate`), off when unset.
 //!
 //! **Data.** Each set is `n` records of one spacecraft, each record with its own seed,
 //! initial state and disturbances:
 //!
 //! * **throws:** the lab throw (`Preset::throw`: 0.5 s at 4 kHz, MEMS gyro, the attitude
 //!   integrated from it, the flywheel's speed quantised and held, vibration, air drag and
-//!   an aerodynamic torque fixed in space), each throw tumbling at its own initial rate
-//!   (the preset's turned about a drawn axis) with the aerodynamic torque along its own
-//!   direction;
+//!   an aerodynamic torque fixed in space), each throw tumbling its own way
+//!   (`Preset::with_drawn_tumble`: the initial rate turned about a drawn axis, the
+//!   aerodynamic torque along a drawn direction);
 //! * **slews:** the paper's slew (`Common::physical()`) cut to 60 s, each record with its
 //!   own momentum bias (0–0.15 N m s) and its own constant body torque (1e-6 N m along a
 //!   drawn direction).
@@ -31,13 +34,18 @@ use inertia::sample::Sample;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
 use inertia::tensor::{j_from_matrix, relative_frobenius_error};
-use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
+use nalgebra::{Matrix3, Unit, Vector3};
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
 /// The batch answer over `records` (a record boundary between each two).
 fn pooled(records: &[Vec<Sample>]) -> Option<Estimate> {
-    let config = PipelineSettings::default().validate().ok()?;
+    let config = PipelineSettings {
+        wheel_delay: wheel_delay_from_env(),
+        ..PipelineSettings::default()
+    }
+    .validate()
+    .ok()?;
     let mut run = Run::new(config, true).ok()?;
     for (k, r) in records.iter().enumerate() {
         if k > 0 {
@@ -50,6 +58,14 @@ fn pooled(records: &[Vec<Sample>]) -> Option<Estimate> {
     let mut last = None;
     run.finish(|e| last = Some(*e)).ok()?;
     last
+}
+
+/// The wheel speeds' time tag from `WHEEL_DELAY` (`off`, seconds or `estimate`), off when
+/// unset; a value it cannot read stops the run.
+fn wheel_delay_from_env() -> inertia::estimator::wheel_delay::WheelDelay {
+    std::env::var("WHEEL_DELAY").map_or(Default::default(), |v| {
+        inertia::pipeline::parse_wheel_delay(&v).unwrap_or_else(|e| panic!("WHEEL_DELAY: {e}"))
+    })
 }
 
 /// A unit vector drawn uniformly.
@@ -72,14 +88,7 @@ fn record(cell: &str, set: u64, k: usize) -> (Vec<Sample>, Matrix3<f64>) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let out = match cell {
         "throws" => {
-            let mut p = Preset::throw();
-            let turn = Rotation3::from_axis_angle(&direction(&mut rng), rng.random_range(0.0..3.0));
-            if let Scenario::Spin(plan) = &mut p.scenario {
-                plan.initial_omega_rad_s = turn * plan.initial_omega_rad_s;
-            }
-            let env = &mut p.common.realism.environment;
-            env.inertial_torque_nm =
-                direction(&mut rng).into_inner() * env.inertial_torque_nm.norm();
+            let mut p = Preset::throw().with_drawn_tumble(seed);
             p.common.seed = seed;
             p.simulate()
         }

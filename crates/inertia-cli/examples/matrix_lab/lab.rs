@@ -1,6 +1,7 @@
 //! The lab cells of the Monte Carlo matrix: the hand-thrown device of
 //! `Preset::throw()` (0.5 s at 4 kHz, one flywheel spun up, issue #30), with all its lab
-//! effects, none, each alone and all but each, running the default estimator, the momentum
+//! effects, none, each alone and all but each, and (all effects or none) with each seed's
+//! throw tumbling its own way (`Preset::with_drawn_tumble`), running the default estimator, the momentum
 //! RLS and the filtered equation-error baseline side by side on the same telemetry.
 //!
 //! Each estimator runs through `Run` (`WHEEL_DELAY=off|SECONDS|estimate`: the wheel speeds'
@@ -44,6 +45,8 @@ const ESTIMATORS: [(&str, &str); 3] = [
 pub struct LabCell {
     pub label: String,
     off: Vec<LabEffect>,
+    /// Each seed's throw tumbling its own way (`Preset::with_drawn_tumble`).
+    drawn: bool,
 }
 
 /// Every lab cell.
@@ -53,22 +56,36 @@ pub fn cells() -> Vec<LabCell> {
         LabCell {
             label: "throw | all effects".into(),
             off: Vec::new(),
+            drawn: false,
         },
         LabCell {
             label: "throw | none".into(),
             off: all.clone(),
+            drawn: false,
+        },
+        LabCell {
+            label: "throw, drawn tumble | all effects".into(),
+            off: Vec::new(),
+            drawn: true,
+        },
+        LabCell {
+            label: "throw, drawn tumble | none".into(),
+            off: all.clone(),
+            drawn: true,
         },
     ];
     for (e, name) in EFFECTS {
         cells.push(LabCell {
             label: format!("throw | only {name}"),
             off: all.iter().copied().filter(|x| *x != e).collect(),
+            drawn: false,
         });
     }
     for (e, name) in EFFECTS {
         cells.push(LabCell {
             label: format!("throw | all but {name}"),
             off: vec![e],
+            drawn: false,
         });
     }
     cells
@@ -112,6 +129,9 @@ struct LabRun {
 
 fn run(cell: &LabCell, seed: u64) -> LabRun {
     let mut p = Preset::throw_without(&cell.off);
+    if cell.drawn {
+        p = p.with_drawn_tumble(seed);
+    }
     p.common.seed = seed;
     let out = p
         .simulate()

@@ -17,6 +17,9 @@
 //!   ([`RunErrorKind::Stopped`]).
 //! * The messages describe the fix in words; [`RunError::fixes`] carries it typed, for each
 //!   front end to name in its own vocabulary ([`crate::fix`]).
+//! * Several records of one spacecraft (passes, throws) go into one batch run with
+//!   [`Run::next_record`] between them: one J, each record its own time axis, initial
+//!   momenta and torques.
 
 mod error;
 mod records;

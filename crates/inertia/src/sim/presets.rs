@@ -345,6 +345,35 @@ impl Preset {
     pub fn simulate(&self) -> Result<SimOutput, SimError> {
         self.scenario.simulate(&self.common)
     }
+
+    /// The preset thrown another way, drawn from `seed` (the throw: one throw of a set,
+    /// each tumbling its own way): a spin's initial rate turned about a uniformly drawn
+    /// axis by an angle uniform in [0, π) (its magnitude kept), and the torque fixed in
+    /// the inertial frame along a uniformly drawn direction (its magnitude kept). Other
+    /// presets are returned as they are. The noise seed is the preset's own.
+    #[must_use]
+    pub fn with_drawn_tumble(mut self, seed: u64) -> Self {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        // Uniform on the sphere: a normal vector's direction.
+        fn direction(rng: &mut impl Rng) -> Vector3<f64> {
+            loop {
+                let v = Vector3::from_fn(|_, _| rng.sample::<f64, _>(rand_distr::StandardNormal));
+                if v.norm() > 1e-9 {
+                    break v.normalize();
+                }
+            }
+        }
+        if let Scenario::Spin(plan) = &mut self.scenario {
+            let axis = nalgebra::Unit::new_normalize(direction(&mut rng));
+            let angle = rng.random_range(0.0..core::f64::consts::PI);
+            plan.initial_omega_rad_s =
+                nalgebra::Rotation3::from_axis_angle(&axis, angle) * plan.initial_omega_rad_s;
+            let env = &mut self.common.realism.environment;
+            env.inertial_torque_nm = direction(&mut rng) * env.inertial_torque_nm.norm();
+        }
+        self
+    }
 }
 
 #[cfg(test)]
@@ -365,5 +394,47 @@ mod tests {
         let bare = Preset::throw_without(&all).common.realism;
         assert!(!bare.vibration.is_active());
         assert!(!bare.wheels.is_active() && !bare.environment.is_active());
+    }
+
+    /// A drawn tumble keeps the rate's and the torque's magnitudes, and its directions
+    /// spread over the sphere: over 2000 draws, the mean of each unit vector is within
+    /// 4/√(3·2000) of zero per axis (a uniform unit vector's component has variance 1/3),
+    /// and the turn's angle has the uniform law's mean π/2 within 4 standard errors.
+    #[test]
+    fn a_drawn_tumble_spreads_its_directions_and_keeps_magnitudes() {
+        let base = Preset::throw();
+        let Scenario::Spin(plan) = base.scenario else {
+            panic!("the throw is a spin")
+        };
+        let (w0, tau0) = (
+            plan.initial_omega_rad_s,
+            base.common.realism.environment.inertial_torque_nm,
+        );
+        let n = 2000;
+        let (mut mean_tau, mut mean_angle) = (Vector3::zeros(), 0.0);
+        for seed in 0..n {
+            let p = Preset::throw().with_drawn_tumble(seed);
+            let Scenario::Spin(plan) = p.scenario else {
+                panic!("spin")
+            };
+            let w = plan.initial_omega_rad_s;
+            let tau = p.common.realism.environment.inertial_torque_nm;
+            assert!((w.norm() - w0.norm()).abs() < 1e-12 * w0.norm());
+            assert!((tau.norm() - tau0.norm()).abs() < 1e-12 * tau0.norm());
+            mean_tau += tau / tau.norm();
+            mean_angle += w.angle(&w0);
+        }
+        let n = n as f64;
+        let bound = 4.0 / (3.0 * n).sqrt();
+        assert!((mean_tau / n).amax() < bound, "{}", mean_tau / n);
+        // The angle between w and w0 is at most the turn; its mean over uniform axes and
+        // turns in [0, π) is well above 0 and below π/2 (a sanity bound, not a law).
+        let mean_angle = mean_angle / n;
+        assert!((0.5..1.5).contains(&mean_angle), "{mean_angle}");
+        // Same seed, same throw.
+        assert_eq!(
+            Preset::throw().with_drawn_tumble(7).common.realism,
+            Preset::throw().with_drawn_tumble(7).common.realism
+        );
     }
 }
