@@ -3,6 +3,7 @@
 //!
 //! ```sh
 //! cargo run --release -p inertia-cli --example records -- 20   # sets of records per cell
+//! cargo run --release -p inertia-cli --example records -- 100 slews   # one kind of data
 //! WHEEL_DELAY=estimate cargo run --release -p inertia-cli --example records -- 20
 //! ```
 //!
@@ -143,7 +144,11 @@ fn main() {
         .unwrap_or(20);
     println!("| data | records | answered alone | alone | together | together / alone | σ together / alone | 3σ cov. alone | 3σ cov. together | det. beyond 3σ alone | det. beyond 3σ together |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let filter = std::env::args().nth(2);
     for (cell, n) in [("throws", 5), ("throws", 10), ("slews", 4), ("slews", 8)] {
+        if filter.as_deref().is_some_and(|f| f != cell) {
+            continue;
+        }
         let runs: Vec<_> = (0..sets)
             .into_par_iter()
             .map(|set| {

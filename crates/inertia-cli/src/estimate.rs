@@ -8,7 +8,7 @@ use crate::error::{input, internal, read_failed, telemetry, telemetry_at, CliErr
 use crate::history::HistoryFile;
 use crate::output::{is_stdio, to_stdout};
 use inertia::fix::{Fix, Fixes};
-use inertia::pipeline::{Run, RunError, RECENT};
+use inertia::pipeline::{Run, RunError, RunErrorKind, RECENT};
 use inertia::telemetry::csv::TelemetryReader;
 use inertia::telemetry::read_ahead::ReadAhead;
 use std::collections::VecDeque;
@@ -115,8 +115,10 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
         let file = reader.file().to_string();
         q_columns = reader.quaternion_columns();
         if k > 0 {
+            // An empty record is the one before.
+            let previous = names.last().unwrap_or(&file);
             run.next_record()
-                .map_err(|e| run_error(&e, &file, None, &q_columns))?;
+                .map_err(|e| run_error(&e, previous, None, &q_columns))?;
         }
         run.check_columns(reader.has_gyro())
             .map_err(|e| run_error(&e, &file, Some(1), &q_columns))?;
@@ -178,7 +180,11 @@ pub fn run(a: &EstimateArgs) -> Result<(), CliError> {
     })
     .map_err(|e| {
         let at = place(&lines, n, &e);
-        let file = at.map_or_else(|| names.join(", "), |(f, _)| names[f].clone());
+        let file = match (&e.kind, at) {
+            (RunErrorKind::EmptyRecord { .. }, _) => names.last().cloned().unwrap_or_default(),
+            (_, Some((f, _))) => names[f].clone(),
+            (_, None) => names.join(", "),
+        };
         run_error(&e, &file, at.map(|p| p.1), &q_columns)
     })?;
     if let Some(e) = write_error.take() {

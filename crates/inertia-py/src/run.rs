@@ -225,7 +225,9 @@ pub fn run_records(
     for (k, r) in records.iter().enumerate() {
         let origin = r.origin;
         if k > 0 {
-            run.next_record().map_err(|e| origin.run_error(&e))?;
+            // An empty record is the one before.
+            run.next_record()
+                .map_err(|e| records[k - 1].origin.run_error(&e))?;
         }
         run.check_columns(r.samples.iter().all(|s| s.omega_rad_s.is_some()))
             .map_err(|e| origin.run_error(&e))?;
@@ -253,10 +255,12 @@ pub fn run_records(
         }
     }
     run.finish(&mut keep).map_err(|e| {
-        // The record of the sample named, if any.
-        let k = e
-            .sample
-            .map_or(0, |i| starts.partition_point(|&s| s <= i).saturating_sub(1));
+        // The record of the sample named, if any (an empty record: the last).
+        let k = match (&e.kind, e.sample) {
+            (RunErrorKind::EmptyRecord { .. }, _) => records.len() - 1,
+            (_, Some(i)) => starts.partition_point(|&s| s <= i).saturating_sub(1),
+            (_, None) => 0,
+        };
         let local = RunError {
             sample: e.sample.map(|i| i - starts[k]),
             ..e

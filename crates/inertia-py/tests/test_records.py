@@ -71,3 +71,9 @@ def test_bad_row_named_in_its_own_file(records, tmp_path):
     bad.write_text("\n".join(lines) + "\n")
     with pytest.raises(inertia.DataError, match=r"bad\.csv:6:"):
         inertia.estimate([records[0], bad], batch=True)
+
+
+def test_a_list_of_times_is_still_an_array(records):
+    t = inertia.read_csv(records[0])
+    arrays = inertia.estimate(list(t.t), t.q, t.rho, w=t.w, batch=True)
+    assert arrays.j is not None

@@ -666,11 +666,15 @@ def estimate(
                 "estimate(data): q, rho, tau, w, r, b, f and dipole are given only with arrays "
                 "(t, q, rho)"
             )
-    if spacecraft is not None and not isinstance(t, (str, os.PathLike)):
+    # A list of records: paths or Telemetry (a list of numbers is an array of times).
+    records_given = isinstance(t, (list, tuple)) and (
+        len(t) == 0 or any(isinstance(x, (str, os.PathLike, Telemetry)) for x in t)
+    )
+    if spacecraft is not None and not (isinstance(t, (str, os.PathLike)) or records_given):
         raise TypeError(
             "spacecraft: give it with a path, or to read_csv (the wheel speeds are read from the file)"
         )
-    if isinstance(t, (list, tuple)):
+    if records_given:
         if not single:
             raise TypeError(
                 "estimate(records): q, rho, tau, w, r, b, f and dipole are given only with arrays "

@@ -45,7 +45,9 @@ pub const TORQUE_SHIFT_Z: f64 = 5.0;
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct TorqueTest {
     /// `Δρ²/s²`: how much of the residual the torque unknowns explain, in noise
-    /// variances (χ²₃ when there is no torque and the rows' errors are independent).
+    /// variances (χ²₃ when there is no torque and the rows' errors are independent; with
+    /// several records' torques, put on χ²₃'s scale at the test's threshold,
+    /// `equivalent_chi2_scale` in the batch reduction).
     pub chi2: f64,
     /// Whether `τ_b` was held at zero (`chi2 ≤` [`TORQUE_CHI2`], or the answer's shift
     /// within [`TORQUE_SHIFT_Z`] of its σ).

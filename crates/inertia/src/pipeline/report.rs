@@ -647,18 +647,6 @@ impl Report {
         self
     }
 
-    /// Of `records` laid end to end, the last shifted by `offset_s`
-    /// ([`crate::pipeline::Run::next_record`]): the gaps between records are no gaps of
-    /// the data, and the time is the last record's own.
-    #[must_use]
-    pub(crate) fn with_records(mut self, records: usize, offset_s: f64) -> Self {
-        if records > 1 {
-            self.gaps = self.gaps.saturating_sub(records - 1);
-            self.t -= offset_s;
-        }
-        self
-    }
-
     /// With the estimator's diagnostics: gaps, excitation, row model and torque, the
     /// residual tests.
     #[must_use]

@@ -472,6 +472,9 @@ impl Run {
                 if samples.len() < entry.capabilities.min_samples() {
                     return Err(too_few(samples.len(), samples.len()));
                 }
+                if let Some(e) = self.records.empty_last() {
+                    return Err(e);
+                }
                 let config = self.config.with_delay_applied();
                 let delay_s = match &self.delay {
                     Some(Ok(d)) => d.delay_s,
@@ -515,6 +518,9 @@ impl Run {
                         kind: RunErrorKind::Pipeline(e),
                     }
                 })?;
+                let mut o = o;
+                // Of several records, the answer's time is the last record's own.
+                o.estimate.t_s -= self.records.offset_s();
                 on_estimate(&o.estimate);
                 *out = Some(std::boxed::Box::new(o));
                 Ok(())
@@ -648,8 +654,7 @@ impl Run {
                     max_step_s: stats.max_step_s,
                     attitude_from_gyro: stats.attitude_from_gyro,
                     records: self.records.count(),
-                })
-                .with_records(self.records.count(), self.records.offset_s()),
+                }),
         )
     }
 }

@@ -87,7 +87,7 @@ impl SharedFactor {
         j: &InertiaVector,
     ) -> Option<crate::estimator::rotor_calibration::RotorFit> {
         let at: std::vec::Vec<usize> = (0..self.columns.len())
-            .filter(|&p| self.columns[p] >= ROTOR)
+            .filter(|&p| (ROTOR..ROTOR + self.gamma.len()).contains(&self.columns[p]))
             .collect();
         if at.is_empty() || !(self.prior_weight > 0.0) {
             return None;
@@ -206,17 +206,23 @@ pub(crate) fn reduce_batch(
     let mut source = MomentumRows::new(*settings);
     let mut clock = ChainClock::new(settings.max_chain_s);
     use std::{vec, vec::Vec};
-    // Each chain with its record: a record's first row starts a chain (its first sample
-    // follows a gap, [`crate::pipeline::Run::next_record`]).
+    // Each chain with its record: the rows restart at each record's first sample (no row
+    // spans two records, whatever the gap between them), which starts a chain.
     let mut chains: Vec<(usize, Vec<AugmentedRow>)> = vec![(0, Vec::new())];
     let mut epoch = 0;
+    let (mut record, mut gaps) = (0, 0);
     for (i, s) in samples.iter().enumerate() {
+        if sources.record_of(i) != record {
+            record = sources.record_of(i);
+            gaps += source.gaps();
+            source = MomentumRows::new(*settings);
+            clock = ChainClock::new(settings.max_chain_s);
+        }
         let row = source
             .push(s)
             .map_err(|source| EstimatorError::Row { sample: i, source })?;
         if let Some(row) = row {
             let e = clock.epoch(&source);
-            let record = sources.record_of(i);
             if e != epoch || chains.last().is_some_and(|c| c.0 != record) {
                 epoch = e;
                 chains.push((record, Vec::new()));
@@ -227,6 +233,7 @@ pub(crate) fn reduce_batch(
         }
     }
     chains.retain(|c| !c.1.is_empty());
+    let gaps = gaps + source.gaps();
     // The rotor parameters' columns, per row, in the chains' order.
     let (rotor_columns, gamma) = if sources.is_empty() {
         (Vec::new(), Vec::new())
@@ -248,7 +255,7 @@ pub(crate) fn reduce_batch(
         })
         .collect();
     // Every record after the first has its own body torque: three columns past the rotor
-    // parameters', record `r` at `RECORD_TORQUE + 3 (r − 1)`.
+    // parameters', record `r` at `record_torque + 3 (r − 1)`.
     let record_torque = ROTOR + n_rotor;
     // A row's coefficient of column `k` (a rotor parameter's or a later record's torque
     // past the rows' own; the body torque's own columns are the first record's).
@@ -292,7 +299,10 @@ pub(crate) fn reduce_batch(
     // The torque's columns first, every record's (held at zero by dropping them, below),
     // the rotor parameters', then the rest in order: the damping's last before j.
     let torque_columns = TORQUE..TORQUE + 3;
-    let records = chains.iter().flatten().map(|r| r.2 + 1).max().unwrap_or(1);
+    // The records with rows, in order (a record may have none: too few samples).
+    let mut present: Vec<usize> = chains.iter().flatten().map(|r| r.2).collect();
+    present.dedup();
+    let records = present.last().map_or(1, |r| r + 1);
     let shared_columns: Vec<usize> = torque_columns
         .clone()
         .chain(record_torque..record_torque + 3 * (records - 1))
@@ -390,6 +400,18 @@ pub(crate) fn reduce_batch(
                     row[at + v - drop] = w;
                     a.extend_from_slice(&row);
                     y.push(w * sources.prior_mean.get(v).copied().unwrap_or(0.0));
+                }
+            }
+            // A column no kept row uses (a deleted record's torque) is pinned at zero by a
+            // row of its own: left empty, its row of R would hold information about the
+            // others that the reduction to j drops.
+            let rows_kept = y.len();
+            for k in 0..n {
+                if (0..rows_kept).all(|i| a[i * n + k] == 0.0) {
+                    let mut row = vec![0.0; n];
+                    row[k] = 1.0;
+                    a.extend_from_slice(&row);
+                    y.push(0.0);
                 }
             }
             let m = y.len();
@@ -532,15 +554,19 @@ pub(crate) fn reduce_batch(
     // records, three degrees of freedom), so the larger of the two is kept, element by
     // element (on 100 sets of four 60 s slews: chains alone 2 of 100 determined beyond
     // 3σ, records alone 3, `examples/records.rs`).
-    let record_of_chain: Vec<usize> = chains
+    // Each chain's group: its record's place among the records with rows.
+    let group_of_chain: Vec<usize> = chains
         .iter()
-        .map(|c| c.first().map_or(0, |r| r.2))
+        .map(|c| {
+            let r = c.first().map_or(0, |r| r.2);
+            present.iter().position(|&p| p == r).unwrap_or(0)
+        })
         .collect();
-    let by_record: Option<Vec<(InertiaVector, Option<f64>)>> = (records >= MIN_GROUPS)
+    let by_record: Option<Vec<(InertiaVector, Option<f64>)>> = (present.len() >= MIN_GROUPS)
         .then(|| {
-            (0..records.min(GROUPS))
+            (0..present.len().min(GROUPS))
                 .map(|g| {
-                    let keep = |c: usize| record_of_chain[c] % GROUPS != g;
+                    let keep = |c: usize| group_of_chain[c] % GROUPS != g;
                     let (r, z, _, d, _) = solve_shared(&blocks, &keep, 0);
                     let j = crate::solver::unconstrained_minimiser(&r, &z)?;
                     Some((j, damping_of(&d, &j)))
@@ -588,7 +614,7 @@ pub(crate) fn reduce_batch(
             noise_s,
             nuisance,
         },
-        gaps: source.gaps(),
+        gaps,
         jackknife_sigma_kg_m2,
         without_torque,
         shared: full

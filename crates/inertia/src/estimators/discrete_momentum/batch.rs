@@ -339,8 +339,8 @@ impl Evidence for BatchRun<'_> {
         let half = halve(self.samples);
         let mut starts = Vec::new();
         let mut n = 0;
-        for r in &records {
-            if n > 0 {
+        for (k, r) in records.iter().enumerate() {
+            if k > 0 {
                 starts.push(n);
             }
             n += r.len() / 2;

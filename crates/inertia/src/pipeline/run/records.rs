@@ -4,10 +4,11 @@
 //!
 //! The run lays the records end to end on one time axis: each later record's times are
 //! shifted so that its first sample follows the previous record's last by a gap of
-//! [`GAP_STEPS`] of that record's last step (at least [`MIN_GAP_S`]). Every row, check and
-//! estimate that meets a gap restarts there ([`crate::sample::is_gap`]), so no row spans
-//! two records: each record has its own chains, hence its own initial momenta and
-//! inertial torque. The batch reduction gives each record its own body-frame torque and,
+//! [`GAP_STEPS`] of that record's last step (at least [`MIN_GAP_S`]), at which every check
+//! and time tag restarts ([`crate::sample::is_gap`]). The batch reduction restarts its rows
+//! at each record's first sample, so no row spans two records: each record has its own
+//! chains, hence its own initial momenta and inertial torque. The answer's time is the
+//! last record's own. The batch reduction gives each record its own body-frame torque and,
 //! with four records or more, deletes whole records in its jackknife as well as chains,
 //! keeping the larger σ ([`crate::estimator::discrete_momentum`]).
 
@@ -68,6 +69,17 @@ impl Records {
     #[must_use]
     pub(super) fn offset_s(&self) -> f64 {
         self.offset_s
+    }
+
+    /// A record begun and never given a sample, at the end of the input.
+    #[must_use]
+    pub(super) fn empty_last(&self) -> Option<RunError> {
+        self.pending.then(|| RunError {
+            sample: None,
+            kind: RunErrorKind::EmptyRecord {
+                record: self.count(),
+            },
+        })
     }
 }
 
