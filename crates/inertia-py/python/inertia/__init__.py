@@ -696,13 +696,12 @@ def estimate(
                 raise TypeError(
                     f"records[{k}]: expected a path or a Telemetry, got {type(x).__name__}"
                 )
-        given = {k: v for k, v in conventions.items() if v not in (None, False)}
-        if given and not all(isinstance(x, (str, os.PathLike)) for x in t):
-            raise ValueError(
-                f"{next(iter(given))}: a convention belongs to reading; give it to read_csv"
-            )
+        # Conventions belong to reading: with a record already read, the native side names
+        # one given here (as for one Telemetry, below).
+        read_here = all(isinstance(x, (str, os.PathLike)) for x in t)
+        given = {} if read_here else {k: v for k, v in conventions.items() if v not in (None, False)}
         return Estimate._from_native(
-            _inertia.estimate_records([r._native for r in records], kwargs=settings)
+            _inertia.estimate_records([r._native for r in records], kwargs={**settings, **given})
         )
     if isinstance(t, (str, os.PathLike)):
         telemetry = read_csv(t, columns=columns, spacecraft=spacecraft, **conventions)

@@ -294,8 +294,7 @@ pub(crate) fn reduce_batch(
     // information about the others, which dropping that row would lose. The shared
     // columns (τ_b, κ) by the data as a whole (a constant ρ leaves κ's column zero), the
     // initial momenta chain by chain (a short Richardson chain may use only X₀).
-    let uses = |r: &AugmentedRow, k: usize| (0..3).any(|i| r.a[(i, k)] != 0.0);
-    let uses_shared = |r: &RowWithRotors, k: usize| (0..3).any(|i| coef(r, i, k) != 0.0);
+    let uses = |r: &RowWithRotors, k: usize| (0..3).any(|i| coef(r, i, k) != 0.0);
     // The torque's columns first, every record's (held at zero by dropping them, below),
     // the rotor parameters', then the rest in order: the damping's last before j.
     let torque_columns = TORQUE..TORQUE + 3;
@@ -306,12 +305,12 @@ pub(crate) fn reduce_batch(
     let shared_columns: Vec<usize> = torque_columns
         .clone()
         .chain(record_torque..record_torque + 3 * (records - 1))
-        .filter(|&k| chains.iter().flatten().any(|r| uses_shared(r, k)))
+        .filter(|&k| chains.iter().flatten().any(|r| uses(r, k)))
         .chain(ROTOR..ROTOR + n_rotor)
         .chain(
             (FIRST_SHARED..J)
                 .filter(|k| !torque_columns.contains(k))
-                .filter(|&k| chains.iter().flatten().any(|r| uses(&r.0, k))),
+                .filter(|&k| chains.iter().flatten().any(|r| uses(r, k))),
         )
         .chain(J..J + 6)
         .collect();
@@ -324,7 +323,7 @@ pub(crate) fn reduce_batch(
         // torque, whose column is the initial momentum's times the block's `s`
         // ([`crate::estimator::momentum_rows`], "Inertial torque"), then the shared unknowns.
         let used: Vec<usize> = (0..settings.anchors_per_chain())
-            .filter(|&k| chain.iter().any(|r| uses(&r.0, k)))
+            .filter(|&k| chain.iter().any(|r| uses(r, k)))
             .collect();
         let trends = if settings.inertial_torque {
             used.len()
