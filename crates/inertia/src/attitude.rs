@@ -170,12 +170,6 @@ impl Quaternion {
         }
     }
 
-    /// `true` when every component is finite.
-    #[must_use]
-    pub fn is_finite(&self) -> bool {
-        self.s.is_finite() && self.v.iter().all(|c| c.is_finite())
-    }
-
     /// Rotate a body vector into inertial axes: `x_I = q x_B q†` (eq. 22).
     #[must_use]
     pub fn rotate(&self, x: &Vector3<f64>) -> Vector3<f64> {

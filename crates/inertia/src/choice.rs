@@ -169,12 +169,6 @@ mod tests {
         check::<QuaternionFormat>();
         check::<GyroUnit>();
         // The names the reports use are the same.
-        for v in RhoModel::ALL {
-            assert_eq!(v.name(), v.choice_name());
-        }
-        for v in RotationSource::ALL {
-            assert_eq!(v.name(), v.choice_name());
-        }
         for v in Consistency::ALL {
             assert_eq!(v.name(), v.choice_name());
         }

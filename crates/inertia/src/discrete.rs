@@ -186,7 +186,7 @@ impl RowInput {
     /// Build the input from attitudes at nodes k, k+1, k+2, rotor momentum **node samples**
     /// at the same nodes (averaged to interval values by the trapezoid rule, docs/conventions.md §2),
     /// the known torque at node k+1, and the two interval lengths.
-    pub fn from_nodes(
+    pub(crate) fn from_nodes(
         t_k_s: f64,
         q: [&Quaternion; 3],
         rho_nodes_nms: [&Vector3<f64>; 3],

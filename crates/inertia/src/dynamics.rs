@@ -9,7 +9,7 @@
 //! body rate (rad/s), `ρ` the total rotor angular momentum (N m s), `ρ̇` its rate (N m)
 //! and `τ` the external torque (N m), all in body axes.
 //!
-//! [`rk4_step`] advances `(q, ω, ρ)` by one classical Runge–Kutta step and, alongside,
+//! `rk4_step` advances `(q, ω, ρ)` by one classical Runge–Kutta step and, alongside,
 //! the body-frame integral `∫ω dt` that an integrating (delta-angle) gyro measures. The
 //! quaternion is renormalised after every step.
 
@@ -67,7 +67,7 @@ pub(crate) fn quaternion_rate(q: &Quaternion, omega: &Vector3<f64>) -> Quaternio
 }
 
 /// Inputs evaluated at a time and state: returns `(ρ̇, τ)` in N m.
-pub trait Inputs {
+pub(crate) trait Inputs {
     /// `(ρ̇, τ)` at time `t_s` in state `x`.
     fn eval(&self, t_s: f64, x: &GyrostatState) -> (Vector3<f64>, Vector3<f64>);
 }
@@ -116,7 +116,7 @@ fn advance(x: &GyrostatState, d: &Deriv, dt: f64) -> GyrostatState {
 /// Returns the new state (quaternion renormalised) and the RK4 quadrature of `∫ω dt`
 /// over the step (rad, body axes), consistent to the same order as the state.
 #[must_use]
-pub fn rk4_step(
+pub(crate) fn rk4_step(
     j: &Matrix3<f64>,
     j_inv: &Matrix3<f64>,
     t_s: f64,

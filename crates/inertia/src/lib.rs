@@ -82,6 +82,12 @@
 
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
+// Dead code is judged on the default build: with fewer features some helpers lose the
+// callers that the missing modules (pipeline, simulator, reader) hold.
+#![cfg_attr(
+    not(all(feature = "sim", feature = "csv", feature = "spacecraft")),
+    allow(dead_code)
+)]
 
 pub mod attitude;
 mod barrier;

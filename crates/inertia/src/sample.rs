@@ -59,7 +59,7 @@ pub struct External {
 
 impl External {
     /// Nothing measured.
-    pub const NONE: External = External {
+    pub(crate) const NONE: External = External {
         position_m: None,
         field_t: None,
         force_n: None,
@@ -91,13 +91,13 @@ pub mod range {
     /// Largest |ω| component, rad/s (about 950 rpm).
     pub const RATE_RAD_S: f64 = 100.0;
     /// Largest |r| component of the position, m (beyond the Moon's orbit).
-    pub const POSITION_M: f64 = 1e10;
+    pub(crate) const POSITION_M: f64 = 1e10;
     /// Largest |B| component, T (a hundred times Earth's surface field).
-    pub const FIELD_T: f64 = 1e-2;
+    pub(crate) const FIELD_T: f64 = 1e-2;
     /// Largest |F| component, N.
-    pub const FORCE_N: f64 = 1e6;
+    pub(crate) const FORCE_N: f64 = 1e6;
     /// Largest commanded magnetic dipole component, A m².
-    pub const DIPOLE_AM2: f64 = 1e5;
+    pub(crate) const DIPOLE_AM2: f64 = 1e5;
     /// Largest deviation of the quaternion's norm from 1 (the CSV reader renormalises
     /// within [`crate::telemetry::csv::DEFAULT_UNIT_TOLERANCE`] by default).
     pub(crate) const QUATERNION_NORM: f64 = 1e-3;

@@ -69,13 +69,13 @@
 //! Each rotor's spin inertia ± σ (errors shared by every rotor, or independent) and its
 //! axis's tilt ± σ (two small angles, independent per rotor) are consider parameters:
 //! the answer's move for each 1σ error source is measured by re-running the estimator,
-//! and σ widens by their root sum square ([`crate::estimator::rotor_inertia`]).
+//! and σ widens by their root sum square (`crate::estimator::rotor_inertia`).
 //!
 //! # Validation
 //!
 //! Unknown keys, a missing key, a non-unit axis, a spin inertia that is not positive, a
 //! σ not in `[0, J_i)`, an unknown speed unit, two rotors with one name or one column,
-//! more than [`MAX_ROTORS`] rotors or none: each refused with the file, the line and the
+//! more than `MAX_ROTORS` rotors or none: each refused with the file, the line and the
 //! key ([`SpacecraftError`]).
 
 use crate::text::Clipped;
@@ -112,10 +112,10 @@ pub struct Sensors {
 }
 
 /// The most rotors a spacecraft file may list.
-pub const MAX_ROTORS: usize = 16;
+pub(crate) const MAX_ROTORS: usize = 16;
 
 /// How far an axis's norm may differ from 1 (it is then normalised).
-pub const AXIS_NORM_TOLERANCE: f64 = 1e-3;
+pub(crate) const AXIS_NORM_TOLERANCE: f64 = 1e-3;
 
 /// The unit of a rotor's speed column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -135,11 +135,11 @@ pub enum SpeedUnit {
 
 impl SpeedUnit {
     /// Every unit's name, as a spacecraft file spells it.
-    pub const NAMES: [&'static str; 3] = ["rad/s", "rpm", "deg/s"];
+    pub(crate) const NAMES: [&'static str; 3] = ["rad/s", "rpm", "deg/s"];
 
     /// The factor that turns a speed in this unit into rad/s.
     #[must_use]
-    pub fn to_rad_s(self) -> f64 {
+    pub(crate) fn to_rad_s(self) -> f64 {
         match self {
             SpeedUnit::RadPerS => 1.0,
             SpeedUnit::Rpm => core::f64::consts::PI / 30.0,
@@ -202,13 +202,13 @@ pub struct Rotor {
 impl Rotor {
     /// The momentum per stored speed unit, N m s per unit, body axes: `J_i u_i a_i`.
     #[must_use]
-    pub fn momentum_per_unit(&self) -> Vector3<f64> {
+    pub(crate) fn momentum_per_unit(&self) -> Vector3<f64> {
         Vector3::from(self.axis) * (self.spin_inertia_kg_m2 * self.speed_unit.to_rad_s())
     }
 
     /// The relative σ of its spin inertia, `σ_i/J_i`.
     #[must_use]
-    pub fn relative_sigma(&self) -> f64 {
+    pub(crate) fn relative_sigma(&self) -> f64 {
         self.spin_inertia_sigma_kg_m2 / self.spin_inertia_kg_m2
     }
 
@@ -659,7 +659,7 @@ impl Spacecraft {
     /// Whether any rotor's spin inertia or axis carries an uncertainty (a consider term
     /// applies).
     #[must_use]
-    pub fn has_inertia_sigma(&self) -> bool {
+    pub(crate) fn has_inertia_sigma(&self) -> bool {
         self.rotors
             .iter()
             .any(|r| r.spin_inertia_sigma_kg_m2 > 0.0 || r.spin_axis_sigma_deg > 0.0)
@@ -670,7 +670,7 @@ impl Spacecraft {
     /// and `S` the spin inertias' part, `max_i s_i²` where their errors are shared (one
     /// error) and `Σ_i s_i²` where independent (`s_i` the relative σ of each).
     #[must_use]
-    pub fn stated_relative_sigma(&self) -> f64 {
+    pub(crate) fn stated_relative_sigma(&self) -> f64 {
         let s2 = self
             .rotors
             .iter()

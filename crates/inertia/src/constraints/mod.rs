@@ -31,7 +31,7 @@ use description::{Lin, Lmi, MAX_LIN};
 use nalgebra::Matrix3;
 
 /// Default ε of `J ⪰ εI`, kg m². Above the solvers' tolerances after scaling.
-pub const DEFAULT_EPSILON_KG_M2: f64 = 1e-6;
+pub(crate) const DEFAULT_EPSILON_KG_M2: f64 = 1e-6;
 
 /// Which physical-consistency condition to impose besides `J ⪰ εI`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -67,7 +67,7 @@ pub enum BoundSide {
     Fixed,
 }
 
-/// An element bound the answer sits on ([`ConstraintSet::active_bounds`]).
+/// An element bound the answer sits on (`ConstraintSet::active_bounds`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ActiveBound {
@@ -93,7 +93,7 @@ impl core::fmt::Display for ActiveBound {
 /// A user's constraint set. Build, then [`validate`](ConstraintSet::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConstraintSet {
-    /// ε of `J ⪰ εI`, kg m² (default [`DEFAULT_EPSILON_KG_M2`]).
+    /// ε of `J ⪰ εI`, kg m² (default `DEFAULT_EPSILON_KG_M2`).
     pub epsilon_kg_m2: f64,
     /// Consistency condition (default [`Consistency::Physical`]).
     pub consistency: Consistency,
@@ -102,7 +102,7 @@ pub struct ConstraintSet {
     /// Upper bounds per component of `j`, kg m².
     pub upper_kg_m2: [Option<f64>; 6],
     /// A Gaussian prior on `j` (e.g. from CAD), weighed against the data
-    /// ([`crate::estimator::prior`]). Default `None`.
+    /// (`crate::estimator::prior`). Default `None`.
     pub prior: Option<GaussianPrior>,
 }
 
@@ -175,7 +175,7 @@ impl ProductConvention {
 impl Consistency {
     /// Short name: `physical`, `paper` or `positive-definite` (as on the command line).
     #[must_use]
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Consistency::Physical => "physical",
             Consistency::PaperTriangle => "paper",
@@ -325,7 +325,7 @@ impl ConstraintSet {
     /// `J_ii` within `fraction · |J_ii|`, a product `J_ik` within
     /// `fraction · √(J_ii J_kk)`. `nominal` holds tensor entries (`J12 = −Σ m x y`).
     #[must_use]
-    pub fn with_nominal_inertia(mut self, nominal: &Matrix3<f64>, fraction: f64) -> Self {
+    pub(crate) fn with_nominal_inertia(mut self, nominal: &Matrix3<f64>, fraction: f64) -> Self {
         let j: InertiaVector = crate::tensor::j_from_matrix(nominal);
         for k in Component::ALL {
             let (r, c) = k.position();
@@ -368,7 +368,7 @@ impl ConstraintSet {
     }
 
     /// A Gaussian prior with a relative standard deviation, as
-    /// [`Self::with_nominal_inertia`] scales its bounds: a moment `J_ii` with
+    /// `Self::with_nominal_inertia` scales its bounds: a moment `J_ii` with
     /// `fraction · |J_ii|`, a product `J_ik` with `fraction · √(J_ii J_kk)`.
     #[must_use]
     pub fn with_relative_prior(self, nominal: &Matrix3<f64>, fraction: f64) -> Self {
@@ -395,7 +395,10 @@ impl ConstraintSet {
     /// The element bounds that `j` sits on (within `1e-9` of the bound's size, at least
     /// 1e-12 kg m²): the bounds that hold the answer, which the data alone would have
     /// put elsewhere. An equality is always active ([`BoundSide::Fixed`]).
-    pub fn active_bounds(&self, j: &InertiaVector) -> impl Iterator<Item = ActiveBound> + '_ {
+    pub(crate) fn active_bounds(
+        &self,
+        j: &InertiaVector,
+    ) -> impl Iterator<Item = ActiveBound> + '_ {
         let j = *j;
         Component::ALL.into_iter().flat_map(move |c| {
             let k = c.index();

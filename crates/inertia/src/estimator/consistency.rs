@@ -68,7 +68,7 @@ pub const INCONSISTENT_RATIO: f64 = 300.0;
 /// reach ratios of 970 from the discretisation remainder alone, the answers moved by up
 /// to 10.1 of their early σ (which, without noise, is too small); in the broken runs of
 /// `tests/integration/consistency.rs`, by at least 52.
-pub const SHIFT_Z: f64 = 20.0;
+pub(crate) const SHIFT_Z: f64 = 20.0;
 
 /// An answer and its stated σ per element.
 #[derive(Debug, Clone, Copy, PartialEq)]

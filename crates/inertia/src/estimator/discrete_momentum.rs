@@ -1,7 +1,7 @@
 //! The discrete momentum estimator (beyond the paper): the rows of
 //! [`super::momentum_rows`] in a fixed-size QR over `[X₀; X₁; τ_b; κ; j]`
 //! (`super::augmented_qr`), the nuisance unknowns minimised out exactly (the torque
-//! `τ_b` held at zero instead where the data give no evidence of one, [`torque_tested`]),
+//! `τ_b` held at zero instead where the data give no evidence of one, `torque_tested`),
 //! and the same observability test, constraint sets and solvers as Algorithm 1 on the
 //! reduced problem in `j`.
 //!
@@ -33,11 +33,11 @@ use crate::solver::Backend;
 use nalgebra::{Vector3, Vector6};
 
 /// The 1 − 10⁻³ quantile of χ²₃: below it, the data give no evidence of a constant
-/// disturbance torque ([`torque_tested`]).
+/// disturbance torque (`torque_tested`).
 pub const TORQUE_CHI2: f64 = 16.27;
 
 /// A torque the χ² test keeps is still held at zero where holding it moves no element of
-/// the answer by more than this many of the answer's jackknife σ ([`torque_tested`]).
+/// the answer by more than this many of the answer's jackknife σ (`torque_tested`).
 pub const TORQUE_SHIFT_Z: f64 = 5.0;
 
 /// The outcome of the test for a constant disturbance torque at a solve.
@@ -88,7 +88,7 @@ pub struct TorqueTest {
 /// torque is real: the delete-one answers without it then scatter with the torque's
 /// effect on each group, and a 1e-5 N m torque on the slew was dropped at 1e-2 error.)
 #[must_use]
-pub fn torque_tested(
+pub(crate) fn torque_tested(
     with: RecursiveQr,
     without: Option<(RecursiveQr, f64)>,
     sigma: Option<[f64; 6]>,
@@ -155,14 +155,14 @@ pub struct MomentumEstimatorSettings {
     /// How rows are formed.
     pub rows: MomentumRowSettings,
     /// Solve cadence, memory, observability thresholds, and the gyro rate-noise density
-    /// for errors-in-variables compensation ([`super::compensation`] with the rows'
+    /// for errors-in-variables compensation (`super::compensation` with the rows'
     /// `super::momentum_rows::AugmentedRow::noise_s`).
     pub recursive: RecursiveSettings,
 }
 
 impl MomentumEstimatorSettings {
     /// Check the settings.
-    pub fn validate(&self) -> Result<(), EstimatorError> {
+    pub(crate) fn validate(&self) -> Result<(), EstimatorError> {
         if !self.rows.outside.valid() {
             return Err(EstimatorError::InvalidSetting {
                 field: "rows.outside.gravity_mu_m3_s2",
@@ -389,7 +389,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// Solve with the data so far, stamped `t_s`.
-    pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
+    pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         let with = self.qr.reduced();
         let without = (self.settings.rows.torque_bias
@@ -456,7 +456,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The move of the answer, kg m² per element, where the last solve's torque test held
-    /// the torque at zero for moving the answer too little ([`torque_tested`]): a model
+    /// the torque at zero for moving the answer too little (`torque_tested`): a model
     /// uncertainty the answer's σ carries in quadrature, after every noise σ.
     #[must_use]
     pub fn held_torque_shift(&self) -> Option<[f64; 6]> {
@@ -472,7 +472,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// `Self::reduced` with the prior knowledge stacked on: the state the last solve
     /// used.
     #[must_use]
-    pub fn solved(&self) -> &RecursiveQr {
+    pub(crate) fn solved(&self) -> &RecursiveQr {
         &self.solved
     }
 
@@ -488,7 +488,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         self.last.as_ref()
     }
 
-    /// The torque test at the last solve ([`torque_tested`]); `None` when the torque is
+    /// The torque test at the last solve (`torque_tested`); `None` when the torque is
     /// not estimated (or under forgetting, where it is kept).
     #[must_use]
     pub fn torque_test(&self) -> Option<TorqueTest> {
@@ -506,15 +506,6 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
             let x = self.qr.nuisance_at(&j);
             Vector3::new(x[TORQUE], x[TORQUE + 1], x[TORQUE + 2])
         })
-    }
-
-    /// The estimated damping coefficient `D` of the torque `−D ω`, N m s, at the last
-    /// answer, with its least-squares σ where there is one (`None` before an answer, or
-    /// when it is not estimated). With the body torque held at zero it is still the
-    /// value that fits best with the torque free.
-    #[must_use]
-    pub fn damping_nms(&self) -> Option<(f64, Option<f64>)> {
-        self.damping_at(&self.last.and_then(|e| e.j())?)
     }
 
     /// The damping `D` (N m s) that fits best at `j`, where estimated, with its σ: the
@@ -619,15 +610,9 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// Gaps in the time stamps so far.
-    #[must_use]
-    pub fn gaps(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn gaps(&self) -> usize {
         self.source.gaps()
-    }
-
-    /// Samples fed so far.
-    #[must_use]
-    pub fn samples(&self) -> usize {
-        self.samples
     }
 }
 

@@ -64,7 +64,7 @@ impl Default for OutsideTorques {
 impl OutsideTorques {
     /// Whether μ is usable (finite, positive).
     #[must_use]
-    pub fn valid(&self) -> bool {
+    pub(crate) fn valid(&self) -> bool {
         self.gravity_mu_m3_s2.is_finite() && self.gravity_mu_m3_s2 > 0.0
     }
 }
@@ -81,7 +81,7 @@ pub struct Estimated3 {
     /// others, or without residual degrees of freedom).
     pub sigma: [Option<f64>; 3],
     /// A direction (unit, body axes) along which the data do not determine it: the
-    /// least-squares σ along it exceeds [`UNDETERMINED_RATIO`] times the σ across it (a
+    /// least-squares σ along it exceeds `UNDETERMINED_RATIO` times the σ across it (a
     /// dipole along a field that keeps its direction in the body, a centre of mass along a
     /// force that does, give no torque). Its component along it is then not an estimate.
     pub undetermined_direction: Option<[f64; 3]>,
@@ -102,7 +102,7 @@ impl Estimated3 {
 /// principal directions beyond which the largest is not determined by the data
 /// ([`Estimated3::undetermined_direction`]): a direction the rows cannot see shows as a
 /// pivot of rounding size, 10⁸ or more below the others.
-pub const UNDETERMINED_RATIO: f64 = 1e6;
+pub(crate) const UNDETERMINED_RATIO: f64 = 1e6;
 
 /// The direction of `covariance` (a 3×3 least-squares covariance, infinite on the axis
 /// of an unknown never separated) along which the σ exceeds [`UNDETERMINED_RATIO`] times
@@ -144,7 +144,7 @@ pub struct OutsideEstimates {
 impl OutsideEstimates {
     /// Whether there is anything to report.
     #[must_use]
-    pub fn any(&self) -> bool {
+    pub(crate) fn any(&self) -> bool {
         self.gravity_gradient
             || self.residual_dipole_am2.is_some()
             || self.centre_of_mass_m.is_some()

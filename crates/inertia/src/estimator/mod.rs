@@ -11,13 +11,13 @@
 //!
 //! Every estimate says whether the data determine J ([`observability`]).
 
-pub mod attitude_drift;
+pub(crate) mod attitude_drift;
 pub(crate) mod audit;
 pub(crate) mod augmented_qr;
 #[cfg(feature = "std")]
 pub mod batch;
 pub(crate) mod chain_clock;
-pub mod compensation;
+pub(crate) mod compensation;
 pub mod consistency;
 pub mod discrete_momentum;
 #[cfg(feature = "std")]
@@ -30,14 +30,14 @@ pub(crate) mod normal_equations;
 pub mod observability;
 #[cfg(feature = "std")]
 pub(crate) mod plain_fit;
-pub mod prior;
+pub(crate) mod prior;
 pub mod qr;
 pub mod recursive;
 pub mod resample;
 #[cfg(feature = "std")]
 pub mod rotor_calibration;
 #[cfg(feature = "std")]
-pub mod rotor_inertia;
+pub(crate) mod rotor_inertia;
 pub mod rows;
 pub(crate) mod shared_qr;
 pub mod svd_tracker;
@@ -68,7 +68,7 @@ pub struct Estimate {
     /// Standard deviations per element and principal moment, when the estimator has an
     /// uncertainty model ([`uncertainty`]).
     pub uncertainty: Option<uncertainty::Uncertainty>,
-    /// How a Gaussian prior sat with the data at this solve ([`prior`]), when one was
+    /// How a Gaussian prior sat with the data at this solve (`prior`), when one was
     /// given.
     pub prior: Option<prior::PriorFit>,
 }
@@ -137,7 +137,7 @@ pub enum EstimatorError {
 
 /// Minimum number of samples for one estimate from 3-row blocks over three nodes (two
 /// blocks, six scalar rows).
-pub const MIN_SAMPLES: usize = 4;
+pub(crate) const MIN_SAMPLES: usize = 4;
 
 /// A constructor argument out of its documented range.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]

@@ -208,14 +208,8 @@ impl MomentumRls {
 
     /// Row blocks used so far.
     #[must_use]
-    pub fn updates(&self) -> usize {
+    pub(crate) fn updates(&self) -> usize {
         self.updates
-    }
-
-    /// Estimated initial inertial momentum `h_N`, N m s.
-    #[must_use]
-    pub fn initial_momentum(&self) -> Vector3<f64> {
-        Vector3::new(self.x[6], self.x[7], self.x[8])
     }
 }
 

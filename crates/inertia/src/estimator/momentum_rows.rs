@@ -107,16 +107,7 @@ pub enum RotationSource {
     Gyro,
 }
 
-impl RotationSource {
-    /// Name for reports and options (`attitude`, `gyro`).
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        match self {
-            RotationSource::Attitude => "attitude",
-            RotationSource::Gyro => "gyro",
-        }
-    }
-}
+impl RotationSource {}
 
 /// What the telemetry's rotor momentum does between samples: which rows to use (the
 /// pipeline's setting; [`Stencil`] is what one row model does).
@@ -137,18 +128,7 @@ pub enum RhoModel {
     Plain,
 }
 
-impl RhoModel {
-    /// Name for reports and options (`auto`, `smooth`, `held`, `plain`).
-    #[must_use]
-    pub fn name(&self) -> &'static str {
-        match self {
-            RhoModel::Auto => "auto",
-            RhoModel::Smooth => "smooth",
-            RhoModel::Held => "held",
-            RhoModel::Plain => "plain",
-        }
-    }
-}
+impl RhoModel {}
 
 /// The rows' stencil: one interval, or a Richardson combination of two intervals and
 /// their double step.

@@ -7,7 +7,7 @@
 //! * `y ≡ 0` → [`Unobservable::NoExcitation`];
 //! * `σ_6` below `crate::solver::SINGULAR_RATIO` of `σ_1`, or fewer than six rows →
 //!   [`Unobservable::RankDeficient`];
-//! * `σ_1/σ_6` above the threshold ([`DEFAULT_CONDITION_THRESHOLD`]) →
+//! * `σ_1/σ_6` above the threshold (`DEFAULT_CONDITION_THRESHOLD`) →
 //!   [`Unobservable::IllConditioned`];
 //! * the least-squares standard deviation of `j`, `‖σ_j‖/‖ĵ‖` with
 //!   `Cov(ĵ) = s² (RᵀR)⁻¹`, `s² = ρ²/(rows − 6)`, above [`DEFAULT_MAX_RELATIVE_SIGMA`] →
@@ -26,7 +26,7 @@ use crate::fix::Fix;
 
 /// Default largest acceptable condition number `σ_1/σ_6` of `R`. Past it, noise in the
 /// weakest direction is amplified a million-fold relative to the strongest.
-pub const DEFAULT_CONDITION_THRESHOLD: f64 = 1e6;
+pub(crate) const DEFAULT_CONDITION_THRESHOLD: f64 = 1e6;
 
 /// Default largest acceptable relative standard deviation `‖σ_j‖/‖ĵ‖` of the
 /// unconstrained estimate.
@@ -43,7 +43,7 @@ pub(crate) const NEGATIVE_DAMPING_Z: f64 = 3.0;
 /// Thresholds of the observability test.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ObservabilitySettings {
-    /// Largest acceptable `σ_1/σ_6` (default [`DEFAULT_CONDITION_THRESHOLD`]).
+    /// Largest acceptable `σ_1/σ_6` (default `DEFAULT_CONDITION_THRESHOLD`).
     pub condition_threshold: f64,
     /// Largest acceptable `‖σ_j‖/‖ĵ‖` (default [`DEFAULT_MAX_RELATIVE_SIGMA`]).
     pub max_relative_sigma: f64,
@@ -131,7 +131,7 @@ pub enum Unobservable {
         ratio: f64,
     },
     /// The data contradict the Gaussian prior beyond both their noises
-    /// ([`super::prior::PriorFit::conflicts`]).
+    /// (`super::prior::PriorFit::conflicts`).
     PriorConflict {
         /// Prior-data disagreement, a χ² with at most `rows` degrees of freedom.
         chi2: f64,
@@ -146,7 +146,7 @@ pub enum Unobservable {
         min_second_moment_kg_m2: f64,
     },
     /// A constrained answer breaks `J1 > 0` or `J1 + J2 ≥ J3` (principal moments
-    /// `J1 ≤ J2 ≤ J3`) by more than [`crate::pipeline::status::PHYSICAL_Z`] of its stated
+    /// `J1 ≤ J2 ≤ J3`) by more than `crate::pipeline::status::PHYSICAL_Z` of its stated
     /// σ: a real body's J is physical, so a model check failed
     /// ([`Observability::ModelCheckFailed`]; the answer and its σ stay visible).
     Unphysical {

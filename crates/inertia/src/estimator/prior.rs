@@ -78,7 +78,7 @@ impl PriorFit {
 
     /// The χ² above which the prior and the data conflict.
     #[must_use]
-    pub fn threshold(&self) -> f64 {
+    pub(crate) fn threshold(&self) -> f64 {
         RESIDUAL_VARIANCE_ALLOWANCE * CHI2_999[self.rows.clamp(1, 6) - 1]
     }
 }

@@ -81,7 +81,7 @@ impl RecursiveQr {
     /// Residual degrees of freedom: effective rows minus `j`'s six and the nuisance
     /// unknowns.
     #[must_use]
-    pub fn residual_dof(&self) -> f64 {
+    pub(crate) fn residual_dof(&self) -> f64 {
         residual_dof(self.weight, self.nuisance)
     }
 

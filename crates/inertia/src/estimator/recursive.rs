@@ -30,7 +30,7 @@ pub struct RecursiveSettings {
     /// passed). `None` (default): no forgetting.
     pub memory_s: Option<f64>,
     /// Gyro rate-noise density, rad/s/√Hz, for errors-in-variables bias compensation
-    /// ([`super::compensation`]); `None` (default): no compensation.
+    /// (`super::compensation`); `None` (default): no compensation.
     pub gyro_noise_rad_s_rthz: Option<f64>,
 }
 
@@ -155,7 +155,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     }
 
     /// Solve with the data so far, stamped `t_s`.
-    pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
+    pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
         self.solved = solved;
@@ -206,31 +206,8 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
 
     /// Gaps in the time stamps so far (no row spans a gap).
     #[must_use]
-    pub fn gaps(&self) -> usize {
+    pub(crate) fn gaps(&self) -> usize {
         self.source.gaps()
-    }
-
-    /// Samples fed so far.
-    #[must_use]
-    pub fn samples(&self) -> usize {
-        self.samples
-    }
-
-    /// Whether the data so far determine J (without solving).
-    #[must_use]
-    pub fn observability(&self) -> Observability {
-        let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
-        with_prior(
-            assess(
-                &solved,
-                self.constraints.set().has_bounds(),
-                &combined_settings(&self.settings.observability, fit.as_ref()),
-            ),
-            &self.qr,
-            fit.as_ref(),
-            &self.constraints,
-            &self.settings.observability,
-        )
     }
 }
 

@@ -54,12 +54,6 @@ impl Resampler {
         })
     }
 
-    /// The output period, s.
-    #[must_use]
-    pub fn period_s(&self) -> f64 {
-        self.h_s
-    }
-
     /// Feed an input sample (times increasing); `out` receives each output sample that
     /// became available, in time order.
     pub fn push(&mut self, s: &Sample, mut out: impl FnMut(Sample)) {

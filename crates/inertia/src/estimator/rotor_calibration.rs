@@ -13,7 +13,7 @@
 //! ```
 //!
 //! with one independent standard normal source `z_v` per error the file gives a σ
-//! (the sources of [`super::rotor_inertia`]: one shared spin-inertia source or one per
+//! (the sources of `super::rotor_inertia`: one shared spin-inertia source or one per
 //! rotor, two tilts per rotor) and `δρ_v` that source's 1σ change of the momentum (read at
 //! the run's wheel-speed time tag). The rows of [`super::momentum_rows`] are linear in
 //! `ρ` (`ρ` enters their right-hand side `b`), so the rows of the true momentum are
@@ -125,7 +125,7 @@ impl RotorFit {
 }
 
 /// Why a calibration asked for was not made (the rotors' σ is then their consider term,
-/// [`super::rotor_inertia`]).
+/// `super::rotor_inertia`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
@@ -183,7 +183,7 @@ pub(crate) type Columns = (Vec<Vec<Vector3<f64>>>, Vec<f64>);
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RotorCalibration {
     /// Each parameter: `spin inertia` (one scale shared by every rotor), `rw1 spin
-    /// inertia`, `rw1 axis tilt 1`, … ([`super::rotor_inertia`]'s sources).
+    /// inertia`, `rw1 axis tilt 1`, … (`super::rotor_inertia`'s sources).
     pub sources: Vec<std::string::String>,
     /// Each one's unit: `relative` (the spin inertia's relative error; for a shared
     /// scale, that of the rotor with the largest σ) or `deg` (a tilt of the axis towards

@@ -11,7 +11,7 @@
 //!   `b̂ = (ĵ(h) − ĵ(2h))/3` measures it from the data (Richardson).
 //!
 //! `σ = √(σ_LS² + b̂²)`. With errors-in-variables compensation
-//! ([`super::compensation`], the gyro noise given), a Monte Carlo of 200 seeds per case
+//! (`super::compensation`, the gyro noise given), a Monte Carlo of 200 seeds per case
 //! finds the error inside ±3σ for every element in 90–100 % of runs at the paper's noise
 //! and at 100× its gyro noise (`tests/integration/uncertainty.rs`). Without compensation the
 //! errors-in-variables bias (README noise sweep) is not covered at high gyro noise.
@@ -35,7 +35,7 @@ pub struct Uncertainty {
     /// Its discretisation-bias part `|b̂|`, kg m² (zero without the half-rate estimate).
     pub bias_kg_m2: [f64; 6],
     /// Its consider part from the rotor momentum's scale uncertainty, `r · |ĵ|`, kg m²
-    /// (zero unless given, [`Uncertainty::with_rotor_scale`]).
+    /// (zero unless given, `Uncertainty::with_rotor_scale`).
     pub rotor_scale_kg_m2: [f64; 6],
     /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m² (zero
     /// unless one was estimated, `Uncertainty::with_time_tag`).
@@ -67,7 +67,7 @@ impl Uncertainty {
     /// `ĵ` stands for here). Each element's σ becomes `√(σ² + (r ĵ_k)²)` and each
     /// principal moment's `√(σ² + (r m_i)²)`; `j` is the answer.
     #[must_use]
-    pub fn with_rotor_scale(&self, j: &InertiaVector, r: f64) -> Uncertainty {
+    pub(crate) fn with_rotor_scale(&self, j: &InertiaVector, r: f64) -> Uncertainty {
         let add = |s: f64, x: f64| crate::math::sqrt(s * s + (r * x) * (r * x));
         let (m, _) = crate::eigen3::symmetric_eigen3(&matrix_from_j(j));
         let mut m = [m[0], m[1], m[2]];

@@ -153,12 +153,6 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
         Ok(Some(e))
     }
 
-    /// The main estimator.
-    #[must_use]
-    pub fn main(&self) -> &RecursiveEstimator<S, B> {
-        &self.main
-    }
-
     /// The span whose residuals stand out most.
     #[must_use]
     pub(crate) fn residual_consistency(&self) -> Option<Worst> {

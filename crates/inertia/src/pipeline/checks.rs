@@ -24,7 +24,7 @@ pub struct AttitudeChecks {
 impl AttitudeChecks {
     /// Check input sample `index`: a glitch stops the run under [`GlitchPolicy::Stop`]
     /// (it is counted either way), and a wrong convention stops it once the first
-    /// [`crate::telemetry::convention::STEPS_NEEDED`] steps show it.
+    /// `crate::telemetry::convention::STEPS_NEEDED` steps show it.
     pub fn push(
         &mut self,
         index: usize,

@@ -145,93 +145,26 @@ impl PipelineConfig {
 
     /// The backend's registry entry.
     #[must_use]
-    pub fn backend(&self) -> &'static BackendEntry {
+    pub(crate) fn backend(&self) -> &'static BackendEntry {
         self.backend
     }
 
     /// The validated constraints.
     #[must_use]
-    pub fn constraints(&self) -> &Constraints {
+    pub(crate) fn constraints(&self) -> &Constraints {
         &self.constraints
-    }
-
-    /// Solve every this many row blocks.
-    #[must_use]
-    pub fn solve_every(&self) -> usize {
-        self.solve_every
     }
 
     /// Memory time constant, s.
     #[must_use]
-    pub fn memory_s(&self) -> Option<f64> {
+    pub(crate) fn memory_s(&self) -> Option<f64> {
         self.memory_s
     }
 
     /// Resampling period, s.
     #[must_use]
-    pub fn resample_s(&self) -> Option<f64> {
+    pub(crate) fn resample_s(&self) -> Option<f64> {
         self.resample_s
-    }
-
-    /// Gyro rate-noise density, rad/s/√Hz (converted once, here, from the settings'
-    /// deg/s/√Hz).
-    #[must_use]
-    pub fn gyro_noise_rad_s_rthz(&self) -> Option<f64> {
-        self.gyro_noise_rad_s_rthz
-    }
-
-    /// Whether estimates carry a standard deviation.
-    #[must_use]
-    pub fn uncertainty(&self) -> bool {
-        self.uncertainty
-    }
-
-    /// Source of the incremental rotations (`None`: chosen from the data).
-    #[must_use]
-    pub fn rotation_source(&self) -> Option<RotationSource> {
-        self.rotation_source
-    }
-
-    /// Model of the rotor momentum between samples.
-    #[must_use]
-    pub fn rho_model(&self) -> RhoModel {
-        self.rho_model
-    }
-
-    /// Whether an unknown constant torque is estimated.
-    #[must_use]
-    pub fn torque_bias(&self) -> bool {
-        self.torque_bias
-    }
-
-    /// Relative σ of the rotor momentum's scale (a consider parameter), if any.
-    #[must_use]
-    pub fn rotor_scale_sigma(&self) -> Option<f64> {
-        self.rotor_scale_sigma
-    }
-
-    /// Whether an unknown constant inertial-frame torque is estimated.
-    #[must_use]
-    pub fn inertial_torque(&self) -> InertialTorque {
-        self.inertial_torque
-    }
-
-    /// Longest momentum chain, s.
-    #[must_use]
-    pub fn max_chain_s(&self) -> Option<f64> {
-        self.max_chain_s
-    }
-
-    /// Angle random walk of the attitude solution, deg/√h (the drift weighting).
-    #[must_use]
-    pub fn attitude_drift_deg_rth(&self) -> Option<f64> {
-        self.attitude_drift_deg_rth
-    }
-
-    /// Observability thresholds.
-    #[must_use]
-    pub fn observability(&self) -> &ObservabilitySettings {
-        &self.observability
     }
 }
 
@@ -263,7 +196,7 @@ pub enum InertialTorque {
 
 /// The longest record, s, on which [`InertialTorque::Short`] tests for a torque fixed in
 /// the inertial frame: the default chain length ([`super::DEFAULT_MAX_CHAIN_S`]).
-pub const SHORT_RECORD_S: f64 = 30.0;
+pub(crate) const SHORT_RECORD_S: f64 = 30.0;
 
 /// Build a streaming estimator from a validated configuration.
 pub(crate) type BuildFn = fn(&PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError>;

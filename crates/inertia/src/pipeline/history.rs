@@ -1,4 +1,4 @@
-//! Estimate histories as CSV (feature `csv`), schema version [`SCHEMA_VERSION`]:
+//! Estimate histories as CSV (feature `csv`):
 //!
 //! ```text
 //! t,J11,J22,J33,J12,J13,J23,status,condition,iterations,sJ11,sJ22,sJ33,sJ12,sJ13,sJ23,reason
@@ -14,10 +14,6 @@
 
 use crate::estimator::Estimate;
 use std::io::Write;
-
-/// Version of the history columns; it changes whenever a column is added, removed or
-/// changes meaning.
-pub const SCHEMA_VERSION: u32 = 1;
 
 /// The header.
 pub const HEADER: [&str; 17] = [

@@ -83,7 +83,7 @@ impl Capabilities {
     /// (one momentum difference), else [`crate::estimator::MIN_SAMPLES`] (two 3-row blocks
     /// over three nodes).
     #[must_use]
-    pub const fn min_samples(&self) -> usize {
+    pub(crate) const fn min_samples(&self) -> usize {
         if self.needs_gyro && !self.constraints {
             2
         } else {

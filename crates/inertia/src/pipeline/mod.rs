@@ -62,10 +62,10 @@ pub mod report;
 pub use crate::estimators::constrained::Constrained;
 pub use checks::AttitudeChecks;
 pub use config::{InertialTorque, PipelineConfig};
-pub use diagnostics::Diagnostics;
+pub(crate) use diagnostics::Diagnostics;
 pub use error::{PipelineError, MAX_RESAMPLE_FACTOR};
+pub(crate) use interface::BatchOutput;
 pub(crate) use interface::Estimator;
-pub use interface::{BatchOutput, Capabilities};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, MIN_MOMENTUM_SIGNIFICANCE, RECENT};
 pub use settings::{parse_wheel_delay, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
@@ -218,7 +218,7 @@ impl Pipeline {
     /// How the attitude compares with the gyro rates so far
     /// ([`crate::telemetry::convention`]).
     #[must_use]
-    pub fn attitude_check(&self) -> Verdict {
+    pub(crate) fn attitude_check(&self) -> Verdict {
         self.checks.verdict()
     }
 
@@ -229,16 +229,10 @@ impl Pipeline {
     }
 
     /// What the estimator can say about the run at its latest estimate: gaps, excitation,
-    /// row model, torque and residual tests ([`Diagnostics`]).
+    /// row model, torque and residual tests (`Diagnostics`).
     #[must_use]
     pub fn diagnostics(&self) -> Diagnostics {
         self.estimator.diagnostics()
-    }
-
-    /// Input samples fed.
-    #[must_use]
-    pub fn input_samples(&self) -> usize {
-        self.input_samples
     }
 
     /// Samples the estimator saw (after resampling).

@@ -5,7 +5,6 @@
 
 pub use super::config::{BackendEntry, EstimatorEntry};
 use super::error::PipelineError;
-pub use super::interface::{BatchOutput, Capabilities};
 
 /// Every estimator, the default first.
 pub static ESTIMATORS: &[EstimatorEntry] = &[

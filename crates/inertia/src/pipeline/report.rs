@@ -1,7 +1,7 @@
 //! The end-of-run report (feature `serde`): one [`Report`] serialises to the versioned
 //! JSON schema of `inertia estimate --json` and displays as its text report.
 //!
-//! Schema version [`SCHEMA_VERSION`]. Keys (units in the README's conventions; products
+//! Schema version `SCHEMA_VERSION`. Keys (units in the README's conventions; products
 //! of inertia are tensor entries, `J12 = −Σ m x y`): `schema_version`, the input summary
 //! (`file`, `sample_period_s`, `renormalised`, `sign_flips`, `min_step_s`, `max_step_s`,
 //! and `records` when there are several, when the samples came from files), `estimator`, `solver`, `constraints`, `batch`,
@@ -37,7 +37,6 @@ use crate::text::{Counted, Num};
 use core::fmt::{self, Write};
 use nalgebra::Matrix3;
 use std::string::{String, ToString};
-pub use text::ReportText;
 
 /// Steps where the attitude jumped against the gyro, kept.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -49,7 +48,7 @@ pub struct Glitches {
 }
 
 /// Version of the JSON report; it changes whenever a key is removed or changes meaning.
-pub const SCHEMA_VERSION: u32 = 1;
+pub(crate) const SCHEMA_VERSION: u32 = 1;
 
 /// Where the samples came from (a telemetry file).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -83,7 +82,7 @@ fn is_one(n: &usize) -> bool {
 /// The report of one run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Report {
-    /// [`SCHEMA_VERSION`].
+    /// `SCHEMA_VERSION`.
     pub schema_version: u32,
     /// Where the samples came from.
     #[serde(flatten)]
@@ -124,7 +123,7 @@ pub struct Report {
     /// `null` without one.
     pub wheel_delay: Option<WheelDelayEntry>,
     /// The spacecraft file's rotors and their spin-inertia consider term
-    /// ([`crate::estimator::rotor_inertia`]); `null` without rotors with a σ.
+    /// (`crate::estimator::rotor_inertia`); `null` without rotors with a σ.
     pub rotor_inertia: Option<RotorInertiaEntry>,
     /// The rotor parameters estimated with J, against the spacecraft file's values
     /// ([`crate::estimator::rotor_calibration`]); `null` without a calibration made.
@@ -170,7 +169,7 @@ pub struct Report {
     /// fixed by an equality).
     pub prior: Option<crate::estimator::prior::PriorFit>,
     /// Steps where the attitude jumped against the gyro, kept (`--glitches keep`): how
-    /// many, and the first [`crate::telemetry::glitch::LISTED`].
+    /// many, and the first `crate::telemetry::glitch::LISTED`.
     pub glitches: Option<Glitches>,
     /// The span whose residuals stand out most from the rest.
     pub residual_consistency: Option<Worst>,
@@ -186,7 +185,7 @@ pub struct Report {
     /// sources.
     pub attitude_is_gyro_integral: Option<bool>,
     /// Every warning the text report prints, in its order: `kind` and `message`
-    /// ([`Warning`]). None contradicts the status ([`super::status`]).
+    /// (`Warning`). None contradicts the status ([`super::status`]).
     pub warnings: std::vec::Vec<WarningEntry>,
     #[serde(skip)]
     wheel_delay_error: Option<crate::estimator::wheel_delay::DelayError>,
@@ -208,7 +207,7 @@ pub struct Report {
 
 /// One warning of a report.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Warning {
+pub(crate) enum Warning {
     /// The answer breaks `J1 > 0` or `J1 + J2 ≥ J3` ([`super::status`]): by less than
     /// [`PHYSICAL_Z`] σ when the answer is determined, otherwise it makes no claim.
     NotPhysical(PhysicalMargin),
@@ -268,7 +267,7 @@ pub struct WheelDelayEntry {
     pub sigma_kg_m2: [f64; 6],
 }
 
-/// A [`Warning`] as the JSON report carries it.
+/// A `Warning` as the JSON report carries it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct WarningEntry {
     /// `not_physical`, `span_stands_out`, `attitude_gyro_disagree` or `excitation`.
@@ -280,7 +279,7 @@ pub struct WarningEntry {
 impl Warning {
     /// Its JSON `kind`.
     #[must_use]
-    pub fn kind(&self) -> &'static str {
+    pub(crate) fn kind(&self) -> &'static str {
         match self {
             Warning::NotPhysical(_) => "not_physical",
             Warning::SpanStandsOut(..) => "span_stands_out",
@@ -453,7 +452,7 @@ impl Report {
 
     /// The warnings, in the text report's order.
     #[must_use]
-    pub fn warning_list(&self) -> std::vec::Vec<Warning> {
+    pub(crate) fn warning_list(&self) -> std::vec::Vec<Warning> {
         let mut w = std::vec::Vec::new();
         // A failed physicality check is the status line itself: not said twice.
         if let Some(p) = self

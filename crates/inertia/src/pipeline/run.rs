@@ -182,7 +182,7 @@ impl Run {
     /// [`Self::finish`], which measures their consider term by running the estimator once
     /// more per error source (one for shared spin-inertia errors or one per rotor for
     /// independent ones, two per tilted axis), plus once
-    /// ([`crate::estimator::rotor_inertia`]), and widens σ by it.
+    /// (`crate::estimator::rotor_inertia`), and widens σ by it.
     #[must_use]
     pub fn with_spacecraft(mut self, spacecraft: Spacecraft) -> Self {
         if spacecraft.has_inertia_sigma() && matches!(self.mode, Mode::Streaming(_)) {
@@ -552,12 +552,6 @@ impl Run {
         self.rotor_consider.as_ref()
     }
 
-    /// The spacecraft file's rotors, if the run has them.
-    #[must_use]
-    pub fn spacecraft(&self) -> Option<&Spacecraft> {
-        self.rotors.as_ref()
-    }
-
     /// The wheel-speed time tag applied (`None` without one asked, or before
     /// [`Self::finish`]), or why it could not be estimated.
     #[must_use]
@@ -566,7 +560,7 @@ impl Run {
     }
 
     /// The update period of the wheel speeds, in samples, where they look held between
-    /// updates and no time tag was asked for ([`HeldSpeeds`]); else `None`.
+    /// updates and no time tag was asked for (`HeldSpeeds`); else `None`.
     #[must_use]
     pub fn held_speeds_period_samples(&self) -> Option<usize> {
         (self.config.wheel_delay == WheelDelay::Off)

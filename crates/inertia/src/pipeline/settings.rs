@@ -33,7 +33,7 @@ pub struct PipelineSettings {
     /// estimation ([`crate::estimator::resample`]). `None` (default): as it comes.
     pub resample_s: Option<f64>,
     /// Gyro rate-noise density from the datasheet, deg/s/√Hz, for errors-in-variables
-    /// compensation ([`crate::estimator::compensation`]). `None` (default): none.
+    /// compensation (`crate::estimator::compensation`). `None` (default): none.
     pub gyro_noise_deg_s_rthz: Option<f64>,
     /// Attach a standard deviation to each estimate where the estimator has an
     /// uncertainty model (default `true`; costs about 10 % of throughput).
@@ -88,10 +88,10 @@ pub struct PipelineSettings {
     /// Angle random walk of the attitude solution, deg/√h (discrete momentum estimator):
     /// for an attitude propagated from a gyro, that gyro's ARW. Given with
     /// `gyro_noise_deg_s_rthz`, the momentum rows are weighted for the attitude's drift
-    /// (generalised least squares, [`crate::estimator::attitude_drift`]) from the first
+    /// (generalised least squares, `crate::estimator::attitude_drift`) from the first
     /// answer on, refolded from the first sample (up to an hour at 10 Hz is kept for
     /// that), beside the same rows unweighted; each answer is the weighted one unless
-    /// the unweighted one's bias σ exceeds its noise σ (`drift_weighted` in [`super::Diagnostics`]
+    /// the unweighted one's bias σ exceeds its noise σ (`drift_weighted` in `super::Diagnostics`
     /// says which; so it needs `uncertainty`). Twice the work per sample. `None`
     /// (default): unweighted, right for a star tracker or an MEKF, whose attitude error
     /// is bounded.

@@ -12,7 +12,7 @@
 //!   `J1 > 0` and `J1 + J2 ≥ J3` (the triangle inequality of the second moments, paper
 //!   eq. 9). A constraint set that does not enforce it (`paper` on the diagonal only,
 //!   `positive-definite`) can return an answer that breaks it; when it breaks it by more
-//!   than [`PHYSICAL_Z`] of its stated σ (`σ(J1 + J2 − J3)` from the principal moments' σ,
+//!   than `PHYSICAL_Z` of its stated σ (`σ(J1 + J2 − J3)` from the principal moments' σ,
 //!   taken as independent), a model check failed: the truth is physical, so an answer
 //!   that far outside the physical set is not within 3σ of it, and the row model or the
 //!   data's conventions do not hold. The answer is not determined
@@ -20,18 +20,18 @@
 //!   its σ stay visible: the project refuses only for rank or conditioning, a convention
 //!   error the gyro proves, or a user's limit, and an unphysical answer is none of them
 //!   (the paper's own J breaks `J1 + J2 ≥ J3` by 4.9e-5 kg m², so an estimator that is
-//!   right to its σ can be here when its σ is smaller than that). Within [`PHYSICAL_Z`] σ
+//!   right to its σ can be here when its σ is smaller than that). Within `PHYSICAL_Z` σ
 //!   the answer is consistent with a physical inertia at its accuracy and stays
-//!   determined (the report says so, [`PhysicalMargin`]).
+//!   determined (the report says so, `PhysicalMargin`).
 //! * **What the user said.** A relative uncertainty of the rotor momentum's scale
 //!   ([`super::PipelineSettings::rotor_scale_sigma`], the wheels' spin inertia known to
 //!   ±r) is a consider parameter: σ is widened by `r |ĵ|` per element
-//!   ([`crate::estimator::uncertainty::Uncertainty::with_rotor_scale`]) before the rules
+//!   (`crate::estimator::uncertainty::Uncertainty::with_rotor_scale`) before the rules
 //!   above are applied, and a determined answer whose widened relative σ
 //!   (`σ_F/‖Ĵ‖_F`) exceeds the observability threshold `max_relative_sigma` is not
 //!   determined ([`Unobservable::Uncertain`]): the data cannot give J's scale better than
 //!   the wheels'. A spacecraft file's per-rotor spin inertia ± σ is the same kind of
-//!   term, per rotor ([`crate::estimator::rotor_inertia`]); so is the wheel-speed time
+//!   term, per rotor (`crate::estimator::rotor_inertia`); so is the wheel-speed time
 //!   tag's σ ([`crate::estimator::wheel_delay`]).
 
 use super::config::PipelineConfig;
@@ -43,7 +43,7 @@ use crate::tensor::{matrix_from_j, InertiaVector};
 
 /// How many σ of `J1 + J2 − J3` (or of `J1`) an answer may lie beyond the physical set
 /// and still be determined.
-pub const PHYSICAL_Z: f64 = 3.0;
+pub(crate) const PHYSICAL_Z: f64 = 3.0;
 
 /// A violation smaller than this fraction of `J3` is round-off, not a violation.
 pub(crate) const PHYSICAL_ROUND_OFF: f64 = 1e-6;
@@ -51,7 +51,7 @@ pub(crate) const PHYSICAL_ROUND_OFF: f64 = 1e-6;
 /// How far an answer lies outside the physical set.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct PhysicalMargin {
+pub(crate) struct PhysicalMargin {
     /// Smallest principal moment `J1`, kg m².
     pub min_moment_kg_m2: f64,
     /// `J1 + J2 − J3`, kg m² (negative: the triangle inequality is broken).

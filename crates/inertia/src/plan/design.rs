@@ -311,7 +311,8 @@ pub(crate) fn trains_for(
 }
 
 /// The A-optimal shares over the library with its chain rule (module docs).
-pub fn design(
+#[cfg(test)]
+fn design(
     limits: &Limits,
     j: &Matrix3<f64>,
     noise: &NoiseModel,

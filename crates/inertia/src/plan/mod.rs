@@ -11,12 +11,12 @@
 //!   ── truncate ─▶ at the end of the tour in which 3 σ_F ≤ target
 //! ```
 //!
-//! * [`limits`]: wheel torque and momentum per wheel through the allocation, body rate;
+//! * `limits`: wheel torque and momentum per wheel through the allocation, body rate;
 //!   every limit is linear in the commands because a plan keeps the total angular
 //!   momentum at zero (`J ω = −ρ`);
-//! * [`profile`]: the zero-order-hold command profile and its CSV (body axes and per
+//! * `profile`: the zero-order-hold command profile and its CSV (body axes and per
 //!   wheel);
-//! * [`design`]: the convex design and what it guarantees;
+//! * `design`: the convex design and what it guarantees;
 //! * `predict`: the prediction's rows, noise model and omissions;
 //! * `fixed`: the fixed profiles a plan is compared with (PRBS, chirp, multi-sine,
 //!   multi-step), scaled to the same limits.
@@ -24,17 +24,17 @@
 //! The target is the relative Frobenius σ `σ_F = √(Σ_i w_i σ_i²)/‖J‖_F` (`w` = 1 on the
 //! diagonal, 2 off it): met when `3 σ_F ≤ target`.
 
-pub mod design;
+pub(crate) mod design;
 pub(crate) mod fixed;
-pub mod limits;
+pub(crate) mod limits;
 pub(crate) mod predict;
-pub mod profile;
+pub(crate) mod profile;
 #[cfg(feature = "sim")]
 pub mod rehearse;
 #[cfg(feature = "sim")]
 pub mod request;
 
-pub use design::Design;
+pub(crate) use design::Design;
 pub use limits::{LimitUse, Limits, LimitsError, Wheel};
 pub use predict::{EstimatorModel, NoiseModel, Prediction};
 pub use profile::CommandProfile;
@@ -228,7 +228,7 @@ impl Vehicle {
 
 /// Plan the manoeuvre (module docs): stop at the end of the tour in which the
 /// information-matrix σ meets the target.
-pub fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
+pub(crate) fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
     let full = plan_full(v, s)?;
     let met = s.target_relative.and_then(|t| full.prediction.time_to(t));
     Ok(match met {
@@ -452,7 +452,7 @@ pub struct FixedRun {
 }
 
 /// Every fixed profile at each horizon of `horizons_s`, scaled to the vehicle's limits,
-/// with its prediction under the same model as [`plan`]'s.
+/// with its prediction under the same model as `plan`'s.
 pub fn fixed_profiles(
     v: &Vehicle,
     s: &PlanSettings,

@@ -128,7 +128,7 @@ pub(crate) fn omega_matrix(w: &Vector3<f64>) -> Matrix3x6<f64> {
 
 /// Relative Frobenius σ of per-element σ for inertia `j`.
 #[must_use]
-pub fn relative_sigma(sigma: &[f64; 6], j: &Matrix3<f64>) -> f64 {
+pub(crate) fn relative_sigma(sigma: &[f64; 6], j: &Matrix3<f64>) -> f64 {
     let s2: f64 = (0..6)
         .map(|i| if i < 3 { 1.0 } else { 2.0 } * sigma[i] * sigma[i])
         .sum();

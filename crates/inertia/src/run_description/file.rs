@@ -56,7 +56,7 @@ impl RunDescription {
     }
 
     /// A run file's text (`json`: JSON, else TOML); `file` names it in messages.
-    pub fn parse(text: &str, file: &str, json: bool) -> Result<Self, RunFileError> {
+    pub(crate) fn parse(text: &str, file: &str, json: bool) -> Result<Self, RunFileError> {
         let line_of = |offset: usize| 1 + text[..offset.min(text.len())].matches('\n').count();
         let err = |line: Option<usize>, message: &str| {
             let message = plain(message);

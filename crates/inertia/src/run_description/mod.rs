@@ -23,7 +23,6 @@
 mod file;
 mod values;
 
-pub use file::RunFileError;
 pub use values::{Bounds, ElementBound, Fraction, InertiaInput, PriorSigma};
 
 use crate::constraints::{Consistency, ConstraintSet, ProductConvention};
@@ -188,7 +187,7 @@ type ReadInertia = (Matrix3<f64>, Option<[f64; 6]>);
 /// How a front end reads an inertia file given as `nominal` or `prior`, in the `products`
 /// convention asked for (a file may carry its own): J in tensor entries, kg m², and the
 /// σ per element the file gives, if any; or why not.
-pub type ReadInertiaFile<'a> = dyn FnMut(&Path, Option<ProductConvention>) -> Result<(Matrix3<f64>, Option<[f64; 6]>), String>
+pub(crate) type ReadInertiaFile<'a> = dyn FnMut(&Path, Option<ProductConvention>) -> Result<(Matrix3<f64>, Option<[f64; 6]>), String>
     + 'a;
 
 fn error(key: &'static str, message: String) -> SettingError {
@@ -359,7 +358,7 @@ impl RunDescription {
     }
 
     /// The quaternion format of `scalar_first`, `jpl` and `conjugate` (at most one).
-    pub fn quaternion_format(
+    pub(crate) fn quaternion_format(
         &self,
         name: &dyn Fn(&str) -> String,
     ) -> Result<QuaternionFormat, SettingError> {

@@ -116,12 +116,6 @@ impl SlewController {
         })
     }
 
-    /// The slews.
-    #[must_use]
-    pub fn slews(&self) -> &[Slew] {
-        &self.slews
-    }
-
     /// Reference attitude, body rate and acceleration (reference axes) at `t_s`.
     #[must_use]
     pub(crate) fn reference(&self, t_s: f64) -> (Quaternion, Vector3<f64>, Vector3<f64>) {

@@ -44,10 +44,9 @@
 //! origin `Σ r_i × F_i` is reported in `tau_nm`; the rest of their torque about the
 //! centre of mass, `−c × F`, is unknown.
 //!
-//! [`Environment::torque_nm`] is the unknown torque; [`Environment::actuator_torque_nm`]
-//! the actuators' torque that telemetry reports (with the true field), and
-//! [`Environment::total_torque_nm`] their sum, what acts on the body besides the
-//! scenario's known torque and the white disturbance.
+//! [`Environment::torque_nm`] is the unknown torque; `Environment::total_torque_nm` adds
+//! the actuators' torque that telemetry reports (with the true field): what acts on the
+//! body besides the scenario's known torque and the white disturbance.
 
 use super::magnetic::Magnetic;
 pub use super::orbit::{gravity_gradient_torque_nm, Orbit, EARTH_MU_M3_S2, EARTH_RADIUS_M};
@@ -110,27 +109,11 @@ impl Environment {
         tau
     }
 
-    /// The actuators' torque that telemetry reports, at `t_s` and attitude `q`, N m, body
-    /// axes: the magnetorquers' `m_cmd × B_B` with the **true** field (the telemetry uses
-    /// the measured one) and the thrusters' `Σ r_i × F_i` about the origin.
-    #[must_use]
-    pub fn actuator_torque_nm(&self, t_s: f64, q: &Quaternion) -> Vector3<f64> {
-        let mut tau = Vector3::zeros();
-        if let Some(m) = &self.magnetic {
-            let b = m.field_body_t(self.orbit.as_ref(), t_s, q);
-            tau += m.commanded_dipole_am2(t_s).cross(&b);
-        }
-        if let Some(th) = &self.thrusters {
-            tau += th.force_and_torque(t_s).1;
-        }
-        tau
-    }
-
     /// Everything this environment applies to the body, N m, body axes:
-    /// [`Self::torque_nm`] + [`Self::actuator_torque_nm`] (the magnetic torque
+    /// [`Self::torque_nm`] + the actuators' torque (the magnetic torque
     /// `(m_res + m_cmd) × B_B`, the thrusters' torque about the centre of mass).
     #[must_use]
-    pub fn total_torque_nm(
+    pub(crate) fn total_torque_nm(
         &self,
         t_s: f64,
         q: &Quaternion,

@@ -85,7 +85,7 @@ pub enum FieldModel {
     /// orbit's position; needs [`super::Environment::orbit`].
     Dipole,
     /// A constant field fixed in the inertial frame, T (each component finite, at most
-    /// [`range::FIELD_T`] in size).
+    /// `range::FIELD_T` in size).
     Constant {
         /// The field, T, inertial axes.
         field_t: Vector3<f64>,
@@ -97,7 +97,7 @@ pub enum FieldModel {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Magnetorquer {
-    /// Amplitude `A` per body axis, A m² (finite, |A| ≤ [`range::DIPOLE_AM2`]).
+    /// Amplitude `A` per body axis, A m² (finite, |A| ≤ `range::DIPOLE_AM2`).
     pub amplitude_am2: Vector3<f64>,
     /// Period `P` per body axis, s (finite, > 0).
     pub period_s: Vector3<f64>,
@@ -165,7 +165,7 @@ pub struct Magnetometer {
     /// 1σ white noise per axis and sample, T (finite, ≥ 0). Default 1e-7 T (100 nT, a
     /// small spacecraft's magnetoresistive sensor).
     pub noise_t: f64,
-    /// Constant bias, T, body axes (finite, each at most [`range::FIELD_T`]). Default 0.
+    /// Constant bias, T, body axes (finite, each at most `range::FIELD_T`). Default 0.
     pub bias_t: Vector3<f64>,
 }
 
@@ -186,7 +186,7 @@ pub struct Magnetic {
     /// The field model.
     pub field: FieldModel,
     /// Residual dipole `m_res`, A m², body axes (finite, each at most
-    /// [`range::DIPOLE_AM2`]): its torque `m_res × B_B` is unknown.
+    /// `range::DIPOLE_AM2`): its torque `m_res × B_B` is unknown.
     pub residual_dipole_am2: Vector3<f64>,
     /// Commanded dipole (`None`: no magnetorquers).
     pub magnetorquer: Option<Magnetorquer>,
@@ -236,13 +236,18 @@ impl Magnetic {
     /// The true field at `t_s` in body axes, `C(q)ᵀ B_I`, T, for the attitude `q` (body →
     /// inertial).
     #[must_use]
-    pub fn field_body_t(&self, orbit: Option<&Orbit>, t_s: f64, q: &Quaternion) -> Vector3<f64> {
+    pub(crate) fn field_body_t(
+        &self,
+        orbit: Option<&Orbit>,
+        t_s: f64,
+        q: &Quaternion,
+    ) -> Vector3<f64> {
         q.conjugate().rotate(&self.field_inertial_t(orbit, t_s))
     }
 
     /// The commanded dipole at `t_s`, A m², body axes (zero without magnetorquers).
     #[must_use]
-    pub fn commanded_dipole_am2(&self, t_s: f64) -> Vector3<f64> {
+    pub(crate) fn commanded_dipole_am2(&self, t_s: f64) -> Vector3<f64> {
         self.magnetorquer
             .map_or_else(Vector3::zeros, |m| m.dipole_am2(t_s))
     }

@@ -1,7 +1,7 @@
 //! Gyrostat simulator with sensor models (paper §III eq. 26 and §VI).
 //!
 //! Integrates eq. 26 with quaternion kinematics by RK4 on `substeps` equal substeps of
-//! each sample period (see [`crate::dynamics::rk4_step`]), with
+//! each sample period (see `crate::dynamics::rk4_step`), with
 //!
 //! * the rotor momentum rate `ρ̇` from a [`InputLaw`] of time and true state (a controller);
 //! * a known external torque `τ` from another [`InputLaw`] (reported in telemetry);
@@ -17,38 +17,38 @@
 //!
 //! Beyond the paper ([`Realism`], default off, so the default output is unchanged bit for
 //! bit): attitude from the truth, a star tracker ([`star_tracker`]) or a multiplicative EKF
-//! ([`mekf`]); gyro bias and bias instability ([`gyro`]); wheel commands held at a
-//! controller rate ([`commands`]); wheel telemetry skew, scale error, misalignment, noise
-//! and quantisation, wheel speeds held at their own rate ([`wheels`]); gyro vibration at
-//! the rotor frequency ([`vibration`]); gravity-gradient, constant body-frame and
+//! (`mekf`); gyro bias and bias instability ([`gyro`]); wheel commands held at a
+//! controller rate (`commands`); wheel telemetry skew, scale error, misalignment, noise
+//! and quantisation, wheel speeds held at their own rate (`wheels`); gyro vibration at
+//! the rotor frequency (`vibration`); gravity-gradient, constant body-frame and
 //! inertial-frame unknown torques and air drag ([`environment`]); Earth's magnetic field
 //! with a residual and a commanded dipole and a magnetometer ([`magnetic`]); thrusters
 //! off the centre of mass ([`thrusters`]); telemetry decimation;
 //! spacecraft presets, among them a hand-thrown lab device ([`presets`]). The loop is in
-//! [`run`].
+//! `run`.
 //!
 //! Noise streams (ChaCha8 seeded with [`SimConfig::seed`]), one per source so that
 //! turning one effect on leaves the others' noise unchanged: 0 disturbance torque,
 //! 1 gyro angle random walk, 2 star tracker, 3 wheel telemetry noise, 4 gyro bias
 //! instability, 5 magnetometer, 6 force sensor.
 
-pub mod commands;
+pub(crate) mod commands;
 pub mod control;
 pub mod environment;
 pub mod gyro;
 pub mod magnetic;
-pub mod mekf;
+pub(crate) mod mekf;
 mod orbit;
 pub mod presets;
 pub mod realism;
 pub mod rotors;
-pub mod run;
+pub(crate) mod run;
 pub mod scenario;
 pub mod sensors;
 pub mod star_tracker;
 pub mod thrusters;
-pub mod vibration;
-pub mod wheels;
+pub(crate) mod vibration;
+pub(crate) mod wheels;
 
 pub use commands::CommandHold;
 pub use environment::{Environment, Orbit};

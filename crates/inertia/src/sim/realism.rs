@@ -28,7 +28,7 @@ pub enum AttitudeSource {
     /// A star-tracker measurement at every telemetry node ([`StarTracker`]).
     StarTracker,
     /// The estimate of a multiplicative EKF fusing gyro and star tracker
-    /// ([`super::mekf`]).
+    /// (`super::mekf`).
     Mekf,
 }
 
@@ -54,7 +54,7 @@ pub struct Realism {
     /// Telemetry decimation: write every n-th integration node (n ≥ 1), so the telemetry
     /// period is `n · dt_s`. The gyro's delta angle covers the whole telemetry step.
     pub telemetry_every: usize,
-    /// Gyro vibration at the rotor frequency ([`super::vibration`]).
+    /// Gyro vibration at the rotor frequency (`super::vibration`).
     pub vibration: RotorVibration,
 }
 

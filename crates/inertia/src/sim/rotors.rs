@@ -2,7 +2,7 @@
 //! rotors ([`crate::spacecraft`]).
 //!
 //! The simulator's wheels are three orthogonal-wheel equivalents whose sum `ρ` (body
-//! axes) it integrates ([`super::wheels`]). A spacecraft with `m` rotors on axes `a_i`
+//! axes) it integrates (`super::wheels`). A spacecraft with `m` rotors on axes `a_i`
 //! (`A = [a_1 … a_m]`, which must span the three body axes) carries that momentum as the
 //! minimum-norm split `h = Aᵀ(AAᵀ)⁻¹ ρ` (as a pseudo-inverse wheel allocator does), and
 //! rotor `i` spins at `ω_i = h_i / J_i`, telemetered in its speed unit:

@@ -59,7 +59,7 @@ pub struct Thruster {
     pub position_m: Vector3<f64>,
     /// Direction of its force, body axes (normalised on use; finite, non-zero).
     pub direction: Vector3<f64>,
-    /// Largest thrust `F_max`, N (finite, in 0..=[`range::FORCE_N`]).
+    /// Largest thrust `F_max`, N (finite, in 0..=`range::FORCE_N`).
     pub thrust_n: f64,
 }
 
@@ -119,7 +119,8 @@ pub struct Thrusters {
 impl Thrusters {
     /// These thrusters (at most [`MAX_THRUSTERS`]) with the default [`Firing`], the
     /// centre of mass at the origin and a noise-free force.
-    pub fn new(units: &[Thruster]) -> Result<Self, SimError> {
+    #[cfg(test)]
+    fn new(units: &[Thruster]) -> Result<Self, SimError> {
         if units.len() > MAX_THRUSTERS {
             return Err(SimError::InvalidSetting {
                 field: "environment.thrusters.units",
@@ -192,7 +193,7 @@ impl Thrusters {
     /// The total force `F = Σ F_i` and its torque about the origin `Σ r_i × F_i` at
     /// `t_s`: (N, N m), body axes.
     #[must_use]
-    pub fn force_and_torque(&self, t_s: f64) -> (Vector3<f64>, Vector3<f64>) {
+    pub(crate) fn force_and_torque(&self, t_s: f64) -> (Vector3<f64>, Vector3<f64>) {
         let mut force = Vector3::zeros();
         let mut torque = Vector3::zeros();
         for (u, f) in self.iter().zip(self.thrusts_n(t_s)) {
@@ -207,7 +208,7 @@ impl Thrusters {
 
     /// The total force at `t_s`, N, body axes.
     #[must_use]
-    pub fn force_n(&self, t_s: f64) -> Vector3<f64> {
+    pub(crate) fn force_n(&self, t_s: f64) -> Vector3<f64> {
         self.force_and_torque(t_s).0
     }
 

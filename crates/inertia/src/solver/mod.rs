@@ -142,7 +142,7 @@ pub(crate) const SINGULAR_RATIO: f64 = 1e-10;
 /// The unconstrained minimiser `R⁻¹ z` of an upper-triangular `R` by back substitution,
 /// or `None` when a pivot is below `SINGULAR_RATIO` of the largest.
 #[must_use]
-pub fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<InertiaVector> {
+pub(crate) fn unconstrained_minimiser(r: &Matrix6<f64>, z: &Vector6<f64>) -> Option<InertiaVector> {
     let dmax = r.diagonal().amax();
     if !(dmax > 0.0) {
         return None;

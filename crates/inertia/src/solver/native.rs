@@ -10,7 +10,7 @@
 //! allocation, `no_std`-capable.
 
 use super::{Backend, Residuals, Solution, SolveError, SolveStatus};
-pub use crate::barrier::BarrierSettings;
+pub(crate) use crate::barrier::BarrierSettings;
 use crate::barrier::{self, Problem};
 use crate::constraints::Constraints;
 use crate::tensor::InertiaVector;
@@ -111,12 +111,6 @@ impl NativeSolver {
             memo: super::lmi_face::EigenMemo::default(),
             last_face: None,
         })
-    }
-
-    /// The settings.
-    #[must_use]
-    pub fn settings(&self) -> &NativeSettings {
-        &self.settings
     }
 
     #[cfg(test)]

@@ -30,11 +30,11 @@ use std::string::ToString;
 use std::vec::Vec;
 
 /// The most thrusters a spacecraft file may list.
-pub const MAX_THRUSTERS: usize = 32;
+pub(crate) const MAX_THRUSTERS: usize = 32;
 
 /// The largest throttle accepted (a throttle is a fraction of full thrust; a little
 /// over 1 allows for rounding in the telemetry).
-pub const MAX_THROTTLE: f64 = 1.5;
+pub(crate) const MAX_THROTTLE: f64 = 1.5;
 
 /// One thruster.
 #[derive(Debug, Clone, PartialEq)]

@@ -20,7 +20,7 @@ use crate::sample::Sample;
 use nalgebra::Vector3;
 
 /// Steps needed before a verdict.
-pub const STEPS_NEEDED: usize = 64;
+pub(crate) const STEPS_NEEDED: usize = 64;
 /// Smallest gyro rate counted, rad/s (a step slower than this says little about frames).
 pub(crate) const MIN_RATE_RAD_S: f64 = 2e-3;
 /// Smallest `|cos|` of the angle between the gyro's rate and the attitude's for a step to

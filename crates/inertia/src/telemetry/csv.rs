@@ -3,7 +3,7 @@
 //! # Format
 //!
 //! A header line, then one row per node. Columns are found by name (defaults below,
-//! renamable with [`ColumnNames`]); extra columns are ignored. SI units, body axes.
+//! renamable with `ColumnNames`); extra columns are ignored. SI units, body axes.
 //!
 //! | columns | meaning | required |
 //! |---|---|---|
@@ -291,12 +291,6 @@ impl<R: Read> TelemetryReader<R> {
     #[must_use]
     pub fn has_gyro(&self) -> bool {
         self.idx.w.is_some()
-    }
-
-    /// `true` when the file has known-torque columns.
-    #[must_use]
-    pub fn has_torque(&self) -> bool {
-        self.idx.tau.is_some()
     }
 
     /// The last row's rotor speeds ([`CsvOptions::speed_columns`], in their order and
@@ -633,7 +627,7 @@ impl<R: Read> Iterator for TelemetryReader<R> {
 }
 
 mod columns;
-pub use columns::ColumnNames;
+pub(crate) use columns::ColumnNames;
 mod error;
 #[cfg(test)]
 mod tests;

@@ -9,7 +9,7 @@
 //! 2. the quaternion read in its [`QuaternionFormat`] (Hamilton scalar last or first, or
 //!    JPL, eq. 1's convention, or Hamilton inertial → body), its norm within [`GateOptions::unit_tolerance`] of 1, then
 //!    renormalised (and counted);
-//! 3. across samples ([`Order`]): time increasing, gyro rates given for every sample or
+//! 3. across samples (`Order`): time increasing, gyro rates given for every sample or
 //!    none, and, in strict mode ([`GateOptions::period_tolerance`]), a uniform step;
 //! 4. ρ (and with it nothing else) negated where the data use the opposite sign
 //!    ([`GateOptions::negate_rho`]); gyro rates stored in deg/s converted to rad/s
@@ -136,7 +136,7 @@ impl ExternalKind {
 
     /// Its field, axis `k`.
     #[must_use]
-    pub fn field(self, k: usize) -> Field {
+    pub(crate) fn field(self, k: usize) -> Field {
         match self {
             ExternalKind::Position => Field::Position(k),
             ExternalKind::Field => Field::MagneticField(k),
@@ -156,7 +156,7 @@ impl ExternalKind {
 
     /// Name for messages.
     #[must_use]
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             ExternalKind::Position => "positions (r_x,r_y,r_z)",
             ExternalKind::Field => "magnetic fields (b_x,b_y,b_z)",
@@ -323,7 +323,7 @@ impl SampleError {
 /// The checks across samples: time increasing and gyro rates all-or-none. Also used by
 /// [`crate::pipeline::Run`] for samples that did not come through a [`Gate`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Order {
+pub(crate) struct Order {
     last_t_s: Option<f64>,
     gyro: Option<bool>,
     /// Which outside measurements the accepted samples have ([`ExternalKind::ALL`] order).
@@ -473,12 +473,6 @@ impl Gate {
             },
             ..Self::default()
         }
-    }
-
-    /// The options.
-    #[must_use]
-    pub fn options(&self) -> &GateOptions {
-        &self.options
     }
 
     /// Counts so far.

@@ -72,7 +72,7 @@ pub enum GlitchPolicy {
 }
 
 /// Glitches listed in full; beyond, only counted.
-pub const LISTED: usize = 16;
+pub(crate) const LISTED: usize = 16;
 
 /// The running test ([module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq)]

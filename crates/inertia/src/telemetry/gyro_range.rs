@@ -20,14 +20,14 @@ use nalgebra::Vector3;
 
 /// How much faster than the limit the attitude must turn for a reading at the limit to
 /// count as clipped.
-pub const MARGIN: f64 = 0.02;
+pub(crate) const MARGIN: f64 = 0.02;
 /// Fewest clipped samples for a verdict on an axis.
-pub const MIN_CLIPPED: u32 = 3;
+pub(crate) const MIN_CLIPPED: u32 = 3;
 
 /// An axis whose gyro readings stop at a limit the attitude exceeds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct ClippedAxis {
+pub(crate) struct ClippedAxis {
     /// Body axis, 0 = x, 1 = y, 2 = z.
     pub axis: usize,
     /// The largest `|w|` read on it, rad/s: the gyro's range limit.
@@ -50,7 +50,7 @@ struct Axis {
 
 /// The test of the [module docs](self), fed sample by sample.
 #[derive(Debug, Clone, Default)]
-pub struct GyroRange {
+pub(crate) struct GyroRange {
     axes: [Axis; 3],
     /// The previous sample's time, attitude and gyro rates.
     previous: Option<(f64, Quaternion, Vector3<f64>)>,
@@ -58,7 +58,7 @@ pub struct GyroRange {
 
 impl GyroRange {
     /// Count the next sample (samples without gyro rates are skipped).
-    pub fn push(&mut self, s: &Sample) {
+    pub(crate) fn push(&mut self, s: &Sample) {
         let Some(w) = s.omega_rad_s else {
             self.previous = None;
             return;
@@ -92,7 +92,7 @@ impl GyroRange {
     }
 
     /// The axes at their range limit ([module docs](self)), in axis order.
-    pub fn clipped(&self) -> impl Iterator<Item = ClippedAxis> + '_ {
+    pub(crate) fn clipped(&self) -> impl Iterator<Item = ClippedAxis> + '_ {
         self.axes
             .iter()
             .enumerate()

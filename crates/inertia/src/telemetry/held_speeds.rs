@@ -26,7 +26,7 @@ pub(crate) const REGULAR: f64 = 0.8;
 
 /// Counts of the intervals between changes of `ρ`, in samples ([module docs](self)).
 #[derive(Debug, Clone)]
-pub struct HeldSpeeds {
+pub(crate) struct HeldSpeeds {
     last: Option<Vector3<f64>>,
     since: usize,
     changes: u32,

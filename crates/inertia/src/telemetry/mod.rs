@@ -8,8 +8,8 @@ pub mod convention;
 pub mod csv;
 pub mod gate;
 pub mod glitch;
-pub mod gyro_range;
-pub mod held_speeds;
+pub(crate) mod gyro_range;
+pub(crate) mod held_speeds;
 #[cfg(feature = "csv")]
 mod line_cap;
 #[cfg(feature = "csv")]

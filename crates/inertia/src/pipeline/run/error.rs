@@ -29,7 +29,7 @@ pub enum RunErrorKind {
         /// The estimator.
         estimator: &'static str,
     },
-    /// A sample the sample gate refuses ([`crate::telemetry::gate::Order`]): time not
+    /// A sample the sample gate refuses (`crate::telemetry::gate::Order`): time not
     /// increasing, gyro rates given for some samples and not for others.
     #[error(transparent)]
     Sample(SampleError),
@@ -46,7 +46,7 @@ pub enum RunErrorKind {
     TooFewSamples {
         /// The estimator.
         estimator: &'static str,
-        /// Its minimum ([`crate::pipeline::Capabilities::min_samples`]).
+        /// Its minimum (the estimator's capabilities in the registry).
         need: usize,
         /// Samples it saw (after resampling).
         got: usize,

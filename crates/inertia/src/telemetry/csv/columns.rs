@@ -48,7 +48,7 @@ impl Default for ColumnNames {
 
 impl ColumnNames {
     /// Rename one column, e.g. `rename("t", "time")`. Returns `false` for an unknown key.
-    pub fn rename(&mut self, key: &str, name: &str) -> bool {
+    pub(crate) fn rename(&mut self, key: &str, name: &str) -> bool {
         let d = Self::default();
         if key == d.t {
             self.t = name.into();
