@@ -37,8 +37,9 @@ pub struct Uncertainty {
     /// Its consider part from the rotor momentum's scale uncertainty, `r · |ĵ|`, kg m²
     /// (zero unless given, `Uncertainty::with_rotor_scale`).
     pub rotor_scale_kg_m2: [f64; 6],
-    /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m² (zero
-    /// unless one was estimated, `Uncertainty::with_time_tag`).
+    /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m²; or, in a
+    /// batch run without a time tag whose speeds are held between updates, the move of
+    /// `ĵ` for their mean lag (zero otherwise, `Uncertainty::with_time_tag`).
     pub time_tag_kg_m2: [f64; 6],
     /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
     /// unless given, `Uncertainty::with_rotor_inertia`).

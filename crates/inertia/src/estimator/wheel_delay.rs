@@ -40,6 +40,11 @@
 //! effect on the answer, the consider term, is `|∂ĵ/∂δ| σ_δ` per element, `∂ĵ/∂δ` from
 //! the same fit at `δ̂ ±` one grid step, as `d_k` (`DelayFit::consider_kg_m2`).
 //!
+//! Without a time tag, where the speeds are held between updates
+//! (`crate::telemetry::held_speeds`) a batch run's σ carries the move of the plain fit's
+//! `ĵ` for their mean lag instead (`held_lag_move`): a bias the data show and the answer
+//! keeps.
+//!
 //! What σ leaves out: the plain rows' own O(h²) bias (about −50 µs at 10 Hz, within 2σ
 //! on the slew), and the difference between this fit's `∂ĵ/∂δ` and the estimator's.
 //! The samples' times must increase strictly (the run's sample gate checks that). Cost:
@@ -441,6 +446,34 @@ pub(crate) fn estimate(
         half_range_s: half,
         dj_ds,
     })
+}
+
+/// The move of the profile's `ĵ` (its plain rows, [`rows`]) when the speeds are read
+/// `lag_s` later, per element, kg m²: the bias of an answer that reads at their time
+/// stamps speeds held between updates, late by `lag_s` on average
+/// ([`crate::telemetry::held_speeds`]). Both fits use the same rows: those whose samples
+/// keep `t + lag_s` inside their stretch between gaps. `None` where the rows do not
+/// determine `ĵ`.
+pub(crate) fn held_lag_move(
+    samples: &[Sample],
+    outside: &OutsideTorques,
+    lag_s: f64,
+) -> Option<[f64; 6]> {
+    if !(lag_s > 0.0) {
+        return None;
+    }
+    let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
+    let windows: Vec<Window> = segments(&t)
+        .into_iter()
+        .filter_map(|(a, b)| {
+            let hi = (a + t[a..=b].partition_point(|&x| x <= t[b] - lag_s)).checked_sub(1)?;
+            (hi >= a + 8).then_some((a, hi, a, b))
+        })
+        .collect();
+    let j = |d: f64| profile(samples, &windows, d, outside).map(|(_, f)| f.theta);
+    let (late, now) = (j(lag_s)?, j(0.0)?);
+    let out: [f64; 6] = core::array::from_fn(|k| (late[3 + k] - now[3 + k]).abs());
+    out.iter().all(|x| x.is_finite()).then_some(out)
 }
 
 #[cfg(test)]

@@ -190,7 +190,7 @@ pub struct Report {
     #[serde(skip)]
     wheel_delay_error: Option<crate::estimator::wheel_delay::DelayError>,
     #[serde(skip)]
-    held_speeds: Option<(usize, f64)>,
+    held_speeds: Option<(usize, f64, bool)>,
     #[serde(skip)]
     gyro_range: std::vec::Vec<crate::telemetry::gyro_range::ClippedAxis>,
     #[serde(skip)]
@@ -223,8 +223,9 @@ pub(crate) enum Warning {
     /// read as time-tagged.
     WheelDelayNotEstimated(crate::estimator::wheel_delay::DelayError),
     /// The wheel speeds change only every this many samples (held between updates of this
-    /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]).
-    HeldWheelSpeeds(usize, f64),
+    /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]);
+    /// `true` where σ carries the move their mean lag makes (a batch run).
+    HeldWheelSpeeds(usize, f64, bool),
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
@@ -336,13 +337,21 @@ impl fmt::Display for Warning {
             Warning::WheelDelayNotEstimated(e) => {
                 write!(f, "{e}; the wheel speeds are read as time-tagged")
             }
-            Warning::HeldWheelSpeeds(every, period_s) => write!(
+            Warning::HeldWheelSpeeds(every, period_s, in_sigma) => write!(
                 f,
                 "the wheel speeds change only every {every} samples (held for {} s between \
                  updates): read at their time stamps they lag by about {} s on average, which \
-                 biases J; the wheel-speed time tag (wheel_delay: estimate) corrects it",
+                 biases J{}; the wheel-speed time tag (wheel_delay: estimate) corrects it",
                 Num(*period_s),
-                Num(0.5 * period_s * (*every as f64 - 1.0) / *every as f64)
+                Num(crate::telemetry::held_speeds::mean_lag_s(
+                    *every,
+                    period_s / *every as f64
+                )),
+                if *in_sigma {
+                    " (σ carries the move of J for that lag)"
+                } else {
+                    ""
+                }
             ),
             Warning::RotorInertiaNotComputed(e, r) => write!(
                 f,
@@ -476,8 +485,8 @@ impl Report {
         if let Some(e) = self.wheel_delay_error {
             w.push(Warning::WheelDelayNotEstimated(e));
         }
-        if let Some((every, period_s)) = self.held_speeds {
-            w.push(Warning::HeldWheelSpeeds(every, period_s));
+        if let Some((every, period_s, in_sigma)) = self.held_speeds {
+            w.push(Warning::HeldWheelSpeeds(every, period_s, in_sigma));
         }
         w.extend(
             self.gyro_range
@@ -498,7 +507,7 @@ impl Report {
     /// tag was asked for ([`crate::telemetry::held_speeds`]).
     #[must_use]
     #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
-    pub(crate) fn with_held_speeds(mut self, held: Option<(usize, f64)>) -> Self {
+    pub(crate) fn with_held_speeds(mut self, held: Option<(usize, f64, bool)>) -> Self {
         self.held_speeds = held;
         self.refreshed()
     }

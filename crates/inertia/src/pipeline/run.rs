@@ -451,6 +451,16 @@ impl Run {
                 }
             }
         }
+        // Speeds held between updates and read at their time stamps: the batch answer's σ
+        // carries the move their mean lag makes (`wheel_delay::held_lag_move`); a streaming
+        // run, which keeps no samples, only warns.
+        if let Some(every) = self.held_speeds_period_samples() {
+            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.sample_period_s());
+            if let Mode::Batch { samples, out: None } = &self.mode {
+                self.config.wheel_delay_consider =
+                    wheel_delay::held_lag_move(samples, &self.config.outside, lag_s);
+            }
+        }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
             if self.config.calibrate_rotors {
                 self.check_calibration(0)
@@ -634,10 +644,13 @@ impl Run {
                 .with_wheel_delay(self.delay.as_ref())
                 .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
                 .with_rotor_calibration(self.calibration.as_ref(), self.calibration_not_made)
-                .with_held_speeds(
-                    self.held_speeds_period_samples()
-                        .map(|p| (p, p as f64 * self.sample_period_s())),
-                )
+                .with_held_speeds(self.held_speeds_period_samples().map(|p| {
+                    (
+                        p,
+                        p as f64 * self.sample_period_s(),
+                        self.config.wheel_delay_consider.is_some(),
+                    )
+                }))
                 .with_gyro_range(self.gyro_range.clipped().collect())
                 .with_input(super::report::InputSummary {
                     file: file.into(),

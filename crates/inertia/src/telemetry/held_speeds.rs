@@ -89,6 +89,14 @@ impl HeldSpeeds {
     }
 }
 
+/// The mean lag, s, of speeds held for `every` samples of `step_s` each and read at the
+/// samples' time stamps: `(every − 1)/2` steps (the value updated at one sample is read
+/// 0, 1, …, `every − 1` steps late).
+#[cfg_attr(not(feature = "std"), allow(dead_code))]
+pub(crate) fn mean_lag_s(every: usize, step_s: f64) -> f64 {
+    0.5 * step_s * every.saturating_sub(1) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

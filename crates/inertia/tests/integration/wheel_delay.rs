@@ -246,3 +246,52 @@ fn a_given_time_tag_is_the_shift_and_errors_name_the_same_sample() {
     assert_eq!(streamed, Some(bad), "the sample that ends the step");
     assert_eq!(error_at(WheelDelay::KnownS(0.03)), streamed);
 }
+
+/// Problem: the throw with only its speed telemetry's hold (seeds 1–3), read without a
+/// time tag, and the 10 Hz slew, whose speeds are not held. Reference: the simulated J.
+/// A batch run's σ carries the move of J for the held speeds' mean lag
+/// (`Uncertainty::time_tag_kg_m2`, the report's warning says so): on the throw it is of
+/// the size of the lag's bias (measured: the answer's error over the term's Frobenius
+/// norm 1.01–1.05) and the truth is within 3σ; a streaming run, which keeps no samples,
+/// and the slew carry none.
+#[test]
+fn a_batch_answer_carries_the_held_speeds_lag_in_sigma() {
+    for seed in 1..=3 {
+        let mut p = Preset::throw_without(&[
+            LabEffect::Vibration,
+            LabEffect::InertialTorque,
+            LabEffect::Drag,
+        ]);
+        p.common.seed = seed;
+        let out = p.simulate().expect("sim");
+        let truth = out.inertia_kg_m2;
+        let (batch, r) = run(&out.samples, WheelDelay::Off, true);
+        let u = batch.uncertainty.expect("σ");
+        let c = u.time_tag_kg_m2;
+        let term = (c[..3].iter().map(|x| x * x).sum::<f64>()
+            + 2.0 * c[3..].iter().map(|x| x * x).sum::<f64>())
+        .sqrt();
+        let ratio = (batch.inertia().expect("answer") - truth).norm() / term;
+        assert!(
+            (0.5..2.0).contains(&ratio),
+            "seed {seed}: error / term {ratio}"
+        );
+        assert_eq!(batch.within_3sigma(&truth), Some(true), "seed {seed}");
+        let report = r.report("throw.csv", &Default::default()).expect("report");
+        let w = report
+            .warnings
+            .iter()
+            .find(|w| w.kind == "held_wheel_speeds")
+            .expect("warning");
+        assert!(w.message.contains("σ carries"), "{}", w.message);
+        let (streaming, _) = run(&out.samples, WheelDelay::Off, false);
+        let u = streaming.uncertainty.expect("σ");
+        assert_eq!(u.time_tag_kg_m2, [0.0; 6]);
+    }
+    let slew = Scenario::slew()
+        .simulate(&Common::physical())
+        .expect("sim")
+        .samples;
+    let (e, _) = run(&slew, WheelDelay::Off, true);
+    assert_eq!(e.uncertainty.expect("σ").time_tag_kg_m2, [0.0; 6]);
+}
