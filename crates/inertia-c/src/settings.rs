@@ -1,6 +1,7 @@
-//! Settings from C: plain integers and numbers (no heap, no strings) validated into a
-//! [`Plan`], from which the heap engine's library settings or the fixed-size engine are
-//! built.
+//! Settings from C: plain integers and numbers (no heap, no strings) read into a
+//! [`Plan`] and checked by the library's `PipelineSettings::check` (the checks the CLI and
+//! Python get), from which the heap engine's library settings or the fixed-size engine
+//! are built. `0` means "none" for the optional numbers.
 //!
 //! The estimator and the solver backend are selected by id: `k ≥ 1` is entry `k − 1` of
 //! the library's registry ([`ESTIMATORS`], [`BACKENDS`]), 0 the library's default. The
@@ -168,30 +169,10 @@ pub(crate) struct Plan {
     glitches: GlitchPolicy,
 }
 
-fn finite(name: &str, v: f64) -> Result<(), InertiaStatus> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(fail(
-            InertiaStatus::NotFinite,
-            format_args!("setting `{name}` is {v}: expected a finite number"),
-        ))
-    }
-}
-
-/// `0` means none; anything else must be finite and > 0.
-fn optional_positive(name: &str, v: f64) -> Result<Option<f64>, InertiaStatus> {
-    finite(name, v)?;
-    if v == 0.0 {
-        Ok(None)
-    } else if v > 0.0 {
-        Ok(Some(v))
-    } else {
-        Err(fail(
-            InertiaStatus::InvalidSetting,
-            format_args!("setting `{name}` = {v} is invalid: expected 0 (none) or > 0"),
-        ))
-    }
+/// `0` means none; anything else is the value, which the library checks
+/// ([`PipelineSettings::check`]).
+fn optional(v: f64) -> Option<f64> {
+    (v != 0.0).then_some(v)
 }
 
 fn choice<T: Copy>(name: &str, v: u32, options: &[T]) -> Result<T, InertiaStatus> {
@@ -284,32 +265,15 @@ impl Plan {
                 sigma_kg_m2: s.prior_sigma_kg_m2,
             });
         }
-        if s.solve_every == 0 {
-            return Err(fail(
-                InertiaStatus::InvalidSetting,
-                format_args!("setting `solve_every` = 0 is invalid: expected at least 1"),
-            ));
-        }
-        let gyro_noise = {
-            let g = s.gyro_noise_deg_s_rthz;
-            finite("gyro_noise_deg_s_rthz", g)?;
-            if g < 0.0 {
-                return Err(fail(
-                    InertiaStatus::InvalidSetting,
-                    format_args!("setting `gyro_noise_deg_s_rthz` = {g} is invalid: expected >= 0"),
-                ));
-            }
-            (g > 0.0).then_some(g)
-        };
-        Ok(Plan {
+        let plan = Plan {
             estimator,
             backend,
             constraints,
             solve_every: s.solve_every as usize,
-            memory_s: optional_positive("memory_s", s.memory_s)?,
-            resample_s: optional_positive("resample_s", s.resample_s)?,
-            attitude_drift: optional_positive("attitude_drift_deg_rth", s.attitude_drift_deg_rth)?,
-            gyro_noise,
+            memory_s: optional(s.memory_s),
+            resample_s: optional(s.resample_s),
+            attitude_drift: optional(s.attitude_drift_deg_rth),
+            gyro_noise: optional(s.gyro_noise_deg_s_rthz),
             uncertainty: s.uncertainty != 0,
             torque_bias: s.torque_bias != 0,
             // 0: chosen from the data; k ≥ 1: the library's value k − 1.
@@ -327,13 +291,15 @@ impl Plan {
             },
             rho_model: library_choice("rho_model", s.rho_model)?,
             inertial_torque: library_choice("inertial_torque", s.inertial_torque)?,
-            rotor_scale_sigma: {
-                finite("rotor_scale_sigma", s.rotor_scale_sigma)?;
-                (s.rotor_scale_sigma != 0.0).then_some(s.rotor_scale_sigma)
-            },
-            max_chain_s: optional_positive("max_chain_s", s.max_chain_s)?,
+            rotor_scale_sigma: optional(s.rotor_scale_sigma),
+            max_chain_s: optional(s.max_chain_s),
             glitches: library_choice("glitches", s.glitches)?,
-        })
+        };
+        // Every value is the library's to check, as for the CLI and Python (no heap).
+        plan.settings(std::string::String::new(), std::string::String::new())
+            .check(plan.estimator)
+            .map_err(|e| pipeline_fail(&e))?;
+        Ok(plan)
     }
 
     fn name(&self) -> &'static str {
@@ -342,9 +308,18 @@ impl Plan {
 
     /// The library's settings (allocates: the estimator's name is a `String`).
     pub(crate) fn pipeline_settings(&self) -> PipelineSettings {
+        self.settings(self.estimator.name.into(), self.backend.name.into())
+    }
+
+    /// The library's settings with these names (empty names: no heap).
+    fn settings(
+        &self,
+        estimator: std::string::String,
+        solver: std::string::String,
+    ) -> PipelineSettings {
         PipelineSettings {
-            estimator: self.estimator.name.into(),
-            solver: self.backend.name.into(),
+            estimator,
+            solver,
             constraints: self.constraints,
             solve_every: self.solve_every,
             memory_s: self.memory_s,
@@ -376,8 +351,8 @@ impl Plan {
         }
     }
 
-    /// The fixed-size engine, validated as `PipelineSettings::validate` would, without
-    /// the heap.
+    /// The fixed-size engine (the settings' values were checked by the library's
+    /// `PipelineSettings::check` in [`Self::from_c`]): what it cannot run is refused.
     pub(crate) fn fixed_engine(&self) -> Result<Engine, InertiaStatus> {
         // The two estimators this crate implements in fixed-size state.
         let fd = match self.estimator.name {

@@ -51,6 +51,10 @@ pub(crate) fn fail(status: InertiaStatus, msg: core::fmt::Arguments<'_>) -> Iner
 
 pub(crate) fn status_of(e: &PipelineError) -> InertiaStatus {
     match e {
+        // A setting that is NaN or infinite, as the library's check finds it.
+        PipelineError::InvalidSetting { value, .. } if !value.is_finite() => {
+            InertiaStatus::NotFinite
+        }
         PipelineError::Estimator {
             source: EstimatorError::Solve(_),
             ..

@@ -266,6 +266,57 @@ fn bad_settings_name_the_setting() {
     }
 }
 
+/// Problem: settings the library refuses, given through C (heap and caller storage) and
+/// through `PipelineSettings::validate` (the CLI's and Python's path). Reference: the
+/// library's message. C keeps no checks of its own for these values: each is refused
+/// with the library's message, through both of C's constructors.
+#[test]
+fn bad_settings_get_the_library_message_in_c() {
+    use inertia::pipeline::PipelineSettings;
+    let lib = |f: fn(&mut PipelineSettings)| {
+        let mut p = PipelineSettings {
+            estimator: "variational".into(),
+            ..PipelineSettings::default()
+        };
+        f(&mut p);
+        p.validate().expect_err("refused").to_string()
+    };
+    /// The same bad value set in C's settings and in the library's.
+    type Case = (fn(&mut InertiaSettings), fn(&mut PipelineSettings));
+    let cases: Vec<Case> = vec![
+        (|s| s.solve_every = 0, |p| p.solve_every = 0),
+        (|s| s.memory_s = -1.0, |p| p.memory_s = Some(-1.0)),
+        (
+            |s| s.resample_s = f64::INFINITY,
+            |p| p.resample_s = Some(f64::INFINITY),
+        ),
+        (
+            |s| s.gyro_noise_deg_s_rthz = -2.0,
+            |p| p.gyro_noise_deg_s_rthz = Some(-2.0),
+        ),
+        (|s| s.max_chain_s = -3.0, |p| p.max_chain_s = Some(-3.0)),
+    ];
+    let mut storage = Box::new(Storage([0; 1 << 16]));
+    let size = inertia_estimator_size();
+    for (c, l) in cases {
+        let want = lib(l);
+        let mut s = variational();
+        c(&mut s);
+        let mut est = null_mut();
+        // SAFETY: valid pointers; the storage is valid for `size` bytes.
+        unsafe {
+            assert_ne!(inertia_estimator_new(&s, &mut est), InertiaStatus::Ok);
+            assert!(last_error().contains(&want), "{want} | {}", last_error());
+            let p: *mut u8 = storage.0.as_mut_ptr();
+            assert_ne!(
+                inertia_estimator_init(p.cast(), size, &s, &mut est),
+                InertiaStatus::Ok
+            );
+            assert!(last_error().contains(&want), "{want} | {}", last_error());
+        }
+    }
+}
+
 #[test]
 fn storage_must_fit_and_only_fixed_estimators_go_there() {
     let mut storage = Box::new(Storage([0; 1 << 16]));

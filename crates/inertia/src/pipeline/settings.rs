@@ -3,7 +3,7 @@
 
 use super::config::{InertialTorque, PipelineConfig};
 use super::error::PipelineError;
-use super::registry;
+use super::registry::{self, EstimatorEntry};
 use crate::constraints::ConstraintSet;
 use crate::estimator::momentum_rows::{OutsideTorques, RhoModel, RotationSource};
 use crate::estimator::observability::ObservabilitySettings;
@@ -117,6 +117,19 @@ impl Default for PipelineSettings {
         Self {
             estimator: Self::DEFAULT_ESTIMATOR.into(),
             solver: Self::DEFAULT_SOLVER.into(),
+            ..Self::unnamed()
+        }
+    }
+}
+
+impl PipelineSettings {
+    /// [`Self::default`] with empty estimator and solver names, built without the heap: for
+    /// [`Self::check`] where the registry entry is already chosen (the C API's).
+    #[must_use]
+    pub fn unnamed() -> Self {
+        Self {
+            estimator: std::string::String::new(),
+            solver: std::string::String::new(),
             constraints: ConstraintSet::physical(),
             solve_every: 1,
             memory_s: None,
@@ -163,6 +176,42 @@ impl PipelineSettings {
     pub fn validate(&self) -> Result<PipelineConfig, PipelineError> {
         let estimator = registry::estimator(&self.estimator)?;
         let backend = registry::backend(&self.solver)?;
+        self.check(estimator)?;
+        let constraints = self.constraints.validate()?;
+        Ok(PipelineConfig {
+            estimator,
+            backend,
+            constraints,
+            solve_every: self.solve_every,
+            memory_s: self.memory_s,
+            resample_s: self.resample_s,
+            gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
+            uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
+            rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
+            filter_cutoff_hz: self.filter_cutoff_hz,
+            observability: self.observability,
+            rotation_source: self.rotation_source,
+            rho_model: self.rho_model,
+            torque_bias: self.torque_bias,
+            inertial_torque: self.inertial_torque,
+            damping: self.damping,
+            calibrate_rotors: self.calibrate_rotors,
+            outside: self.outside,
+            max_chain_s: self.max_chain_s,
+            attitude_drift_deg_rth: self.attitude_drift_deg_rth,
+            glitches: self.glitches,
+            wheel_delay: self.wheel_delay,
+            wheel_delay_consider: None,
+            rotor_inertia_consider: None,
+            rotor_inertia_relative_sigma: 0.0,
+            pinned_chain_s: None,
+        })
+    }
+
+    /// Check every setting but the names against `estimator`'s capabilities, without the
+    /// heap (all of [`Self::validate`] but the registry look-ups and the constraint set's
+    /// phase-I search).
+    pub fn check(&self, estimator: &EstimatorEntry) -> Result<(), PipelineError> {
         if self.solve_every == 0 {
             return Err(PipelineError::InvalidSetting {
                 field: "solve_every",
@@ -244,7 +293,7 @@ impl PipelineSettings {
             });
         }
         if !estimator.capabilities.row_model {
-            let defaults = PipelineSettings::default();
+            let defaults = PipelineSettings::unnamed();
             for (setting, changed) in [
                 (
                     "rotation_source",
@@ -305,7 +354,6 @@ impl PipelineSettings {
                 expected: "finite and > 0",
             });
         }
-        let constraints = self.constraints.validate()?;
         // The observability thresholds are checked by the estimators' own settings.
         let o = &self.observability;
         if !(o.condition_threshold.is_finite() && o.condition_threshold > 1.0) {
@@ -322,34 +370,7 @@ impl PipelineSettings {
                 expected: "finite and > 0",
             });
         }
-        Ok(PipelineConfig {
-            estimator,
-            backend,
-            constraints,
-            solve_every: self.solve_every,
-            memory_s: self.memory_s,
-            resample_s: self.resample_s,
-            gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
-            uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
-            rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
-            filter_cutoff_hz: self.filter_cutoff_hz,
-            observability: self.observability,
-            rotation_source: self.rotation_source,
-            rho_model: self.rho_model,
-            torque_bias: self.torque_bias,
-            inertial_torque: self.inertial_torque,
-            damping: self.damping,
-            calibrate_rotors: self.calibrate_rotors,
-            outside: self.outside,
-            max_chain_s: self.max_chain_s,
-            attitude_drift_deg_rth: self.attitude_drift_deg_rth,
-            glitches: self.glitches,
-            wheel_delay: self.wheel_delay,
-            wheel_delay_consider: None,
-            rotor_inertia_consider: None,
-            rotor_inertia_relative_sigma: 0.0,
-            pinned_chain_s: None,
-        })
+        Ok(())
     }
 }
 
