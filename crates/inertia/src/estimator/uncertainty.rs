@@ -38,8 +38,8 @@ pub struct Uncertainty {
     /// (zero unless given, `Uncertainty::with_rotor_scale`).
     pub rotor_scale_kg_m2: [f64; 6],
     /// Its consider part from the wheel-speed time tag's σ, `|∂ĵ/∂δ| σ_δ`, kg m²; or, in a
-    /// batch run without a time tag whose speeds are held between updates, the move of
-    /// `ĵ` for their mean lag (zero otherwise, `Uncertainty::with_time_tag`).
+    /// run's final answer without a time tag whose speeds are held between updates, the
+    /// move of `ĵ` for their mean lag (zero otherwise, `Uncertainty::with_time_tag`).
     pub time_tag_kg_m2: [f64; 6],
     /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
     /// unless given, `Uncertainty::with_rotor_inertia`).

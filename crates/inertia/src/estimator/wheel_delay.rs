@@ -41,9 +41,9 @@
 //! the same fit at `δ̂ ±` one grid step, as `d_k` (`DelayFit::consider_kg_m2`).
 //!
 //! Without a time tag, where the speeds are held between updates
-//! (`crate::telemetry::held_speeds`) a batch run's σ carries the move of the plain fit's
-//! `ĵ` for their mean lag instead (`held_lag_move`): a bias the data show and the answer
-//! keeps.
+//! (`crate::telemetry::held_speeds`) the σ of a run's final answer carries the move of
+//! the plain fit's `ĵ` for their mean lag instead (`held_lag_move`): a bias the data show
+//! and the answer keeps.
 //!
 //! What σ leaves out: the plain rows' own O(h²) bias (about −50 µs at 10 Hz, within 2σ
 //! on the slew), and the difference between this fit's `∂ĵ/∂δ` and the estimator's.

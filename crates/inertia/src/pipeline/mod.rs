@@ -228,6 +228,16 @@ impl Pipeline {
         self.last.as_ref()
     }
 
+    /// The newest estimate widened by the wheel-speed time tag's term `c`
+    /// ([`status::widen_for_time_tag`]), which it becomes; `None` without an estimate.
+    pub(crate) fn widen_last_for_time_tag(&mut self, c: &[f64; 6]) -> Option<Estimate> {
+        let mut e = self.last?;
+        status::widen_for_time_tag(&mut e, c, &self.config);
+        self.config.wheel_delay_consider = Some(*c);
+        self.last = Some(e);
+        Some(e)
+    }
+
     /// What the estimator can say about the run at its latest estimate: gaps, excitation,
     /// row model, torque and residual tests (`Diagnostics`).
     #[must_use]

@@ -224,7 +224,7 @@ pub(crate) enum Warning {
     WheelDelayNotEstimated(crate::estimator::wheel_delay::DelayError),
     /// The wheel speeds change only every this many samples (held between updates of this
     /// period, s), and no time tag was asked for ([`crate::telemetry::held_speeds`]);
-    /// `true` where σ carries the move their mean lag makes (a batch run).
+    /// `true` where the answer's σ carries the move their mean lag makes.
     HeldWheelSpeeds(usize, f64, bool),
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).

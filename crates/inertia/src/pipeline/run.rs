@@ -77,6 +77,10 @@ fn locate(
         .map_or(index, |(_, i)| i)
 }
 
+/// Most samples a streaming run keeps for the held speeds' lag term (about 14 MB); a
+/// longer record gets none (its warning does not say that σ carries it).
+const KEEP_MAX: usize = 1 << 16;
+
 enum Mode {
     Streaming(std::boxed::Box<Pipeline>),
     Batch {
@@ -104,6 +108,9 @@ pub struct Run {
     delay: Option<Result<DelayFit, DelayError>>,
     /// Whether the wheel speeds look held between updates ([`HeldSpeeds`]).
     speeds: HeldSpeeds,
+    /// Streaming without a time tag: the samples so far, at most [`KEEP_MAX`] (dropped
+    /// beyond), for the held speeds' lag term at [`Self::finish`].
+    kept: Option<Vec<Sample>>,
     /// Whether a gyro axis stops at a range limit the attitude exceeds ([`GyroRange`]).
     gyro_range: GyroRange,
     /// The spacecraft file's rotors, whose speeds give each sample's rotor momentum.
@@ -164,6 +171,7 @@ impl Run {
             recent: VecDeque::with_capacity(RECENT),
             stopped: None,
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
+            kept: (!batch && config.wheel_delay == WheelDelay::Off).then(Vec::new),
             delay: None,
             speeds: HeldSpeeds::default(),
             gyro_range: GyroRange::default(),
@@ -390,6 +398,13 @@ impl Run {
             held.push(*s);
             return Ok(());
         }
+        if let Some(kept) = &mut self.kept {
+            if kept.len() < KEEP_MAX {
+                kept.push(*s);
+            } else {
+                self.kept = None;
+            }
+        }
         match &mut self.mode {
             Mode::Batch { samples, .. } => {
                 samples.push(*s);
@@ -452,8 +467,8 @@ impl Run {
             }
         }
         // Speeds held between updates and read at their time stamps: the batch answer's σ
-        // carries the move their mean lag makes (`wheel_delay::held_lag_move`); a streaming
-        // run, which keeps no samples, only warns.
+        // carries the move their mean lag makes (`wheel_delay::held_lag_move`; a streaming
+        // run's last answer below).
         if let Some(every) = self.held_speeds_period_samples() {
             let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.sample_period_s());
             if let Mode::Batch { samples, out: None } = &self.mode {
@@ -468,6 +483,20 @@ impl Run {
             } else if self.rotor_consider.is_none() {
                 let taken = samples.clone();
                 self.apply_rotor_consider(&taken);
+            }
+        }
+        // Streaming, speeds held and no time tag: the last answer, widened by the held
+        // speeds' lag term over the samples kept, is given once more.
+        if let (Some(kept), Some(every)) = (self.kept.take(), self.held_speeds_period_samples()) {
+            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.sample_period_s());
+            if let (Mode::Streaming(p), Some(c)) = (
+                &mut self.mode,
+                wheel_delay::held_lag_move(&kept, &self.config.outside, lag_s),
+            ) {
+                if let Some(e) = p.widen_last_for_time_tag(&c) {
+                    self.config.wheel_delay_consider = Some(c);
+                    on_estimate(&e);
+                }
             }
         }
         match &mut self.mode {
@@ -648,7 +677,8 @@ impl Run {
                     (
                         p,
                         p as f64 * self.sample_period_s(),
-                        self.config.wheel_delay_consider.is_some(),
+                        self.config.wheel_delay_consider.is_some()
+                            && self.last().is_some_and(|e| e.uncertainty.is_some()),
                     )
                 }))
                 .with_gyro_range(self.gyro_range.clipped().collect())

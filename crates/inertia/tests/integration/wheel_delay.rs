@@ -249,13 +249,19 @@ fn a_given_time_tag_is_the_shift_and_errors_name_the_same_sample() {
 
 /// Problem: the throw with only its speed telemetry's hold (seeds 1–3), read without a
 /// time tag, and the 10 Hz slew, whose speeds are not held. Reference: the simulated J.
-/// A batch run's σ carries the move of J for the held speeds' mean lag
-/// (`Uncertainty::time_tag_kg_m2`, the report's warning says so): on the throw it is of
-/// the size of the lag's bias (measured: the answer's error over the term's Frobenius
-/// norm 1.01–1.05) and the truth is within 3σ; a streaming run, which keeps no samples,
-/// and the slew carry none.
+/// The final answer's σ carries the move of J for the held speeds' mean lag
+/// (`Uncertainty::time_tag_kg_m2`, the report's warning says so), batch and streaming:
+/// on the throw it is of the size of the lag's bias (measured: the answer's error over
+/// the term's Frobenius norm 1.01–1.05 batch) and the truth is within 3σ. A streaming
+/// run gives its last answer once more, widened, at the end of the input (earlier
+/// answers carry no term). The slew carries none.
 #[test]
-fn a_batch_answer_carries_the_held_speeds_lag_in_sigma() {
+fn the_final_answer_carries_the_held_speeds_lag_in_sigma() {
+    let frobenius = |c: [f64; 6]| {
+        (c[..3].iter().map(|x| x * x).sum::<f64>()
+            + 2.0 * c[3..].iter().map(|x| x * x).sum::<f64>())
+        .sqrt()
+    };
     for seed in 1..=3 {
         let mut p = Preset::throw_without(&[
             LabEffect::Vibration,
@@ -267,10 +273,7 @@ fn a_batch_answer_carries_the_held_speeds_lag_in_sigma() {
         let truth = out.inertia_kg_m2;
         let (batch, r) = run(&out.samples, WheelDelay::Off, true);
         let u = batch.uncertainty.expect("σ");
-        let c = u.time_tag_kg_m2;
-        let term = (c[..3].iter().map(|x| x * x).sum::<f64>()
-            + 2.0 * c[3..].iter().map(|x| x * x).sum::<f64>())
-        .sqrt();
+        let term = frobenius(u.time_tag_kg_m2);
         let ratio = (batch.inertia().expect("answer") - truth).norm() / term;
         assert!(
             (0.5..2.0).contains(&ratio),
@@ -284,14 +287,32 @@ fn a_batch_answer_carries_the_held_speeds_lag_in_sigma() {
             .find(|w| w.kind == "held_wheel_speeds")
             .expect("warning");
         assert!(w.message.contains("σ carries"), "{}", w.message);
-        let (streaming, _) = run(&out.samples, WheelDelay::Off, false);
-        let u = streaming.uncertainty.expect("σ");
-        assert_eq!(u.time_tag_kg_m2, [0.0; 6]);
+        let mut r = new_run(WheelDelay::Off, false);
+        let mut answers = Vec::new();
+        for s in &out.samples {
+            r.push(s, |e| answers.push(*e)).expect("push");
+        }
+        let before = answers.len();
+        r.finish(|e| answers.push(*e)).expect("finish");
+        assert_eq!(answers.len(), before + 1, "seed {seed}");
+        let (previous, last) = (answers[before - 1], answers[before]);
+        assert_eq!(previous.uncertainty.expect("σ").time_tag_kg_m2, [0.0; 6]);
+        assert_eq!((last.t_s, last.j()), (previous.t_s, previous.j()));
+        let term = frobenius(last.uncertainty.expect("σ").time_tag_kg_m2);
+        let ratio = (last.inertia().expect("answer") - truth).norm() / term;
+        assert!(
+            (0.5..2.0).contains(&ratio),
+            "seed {seed}: streaming {ratio}"
+        );
+        assert_eq!(last.within_3sigma(&truth), Some(true), "seed {seed}");
+        assert_eq!(r.last(), Some(&last));
     }
     let slew = Scenario::slew()
         .simulate(&Common::physical())
         .expect("sim")
         .samples;
-    let (e, _) = run(&slew, WheelDelay::Off, true);
-    assert_eq!(e.uncertainty.expect("σ").time_tag_kg_m2, [0.0; 6]);
+    for batch in [true, false] {
+        let (e, _) = run(&slew, WheelDelay::Off, batch);
+        assert_eq!(e.uncertainty.expect("σ").time_tag_kg_m2, [0.0; 6]);
+    }
 }
