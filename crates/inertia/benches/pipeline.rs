@@ -8,6 +8,10 @@
 //! gyro-propagated attitude has been found to be the gyro's own integral and only the
 //! four gyro candidates are folded (`estimators/discrete_momentum/twins.rs`).
 //!
+//! A fourth runs the variational estimator through `Run` (the policy every front end
+//! shares: the sample gate, the held-speeds and gyro-range checks, and the samples a
+//! streaming run keeps for the held speeds' lag term), beside the bare `Pipeline` above.
+//!
 //! A `Pipeline` cannot be cloned, so each measurement builds one, feeds it the first
 //! 200 s (400 s) untimed, and times the samples after that (the estimate is determined
 //! and the state steady there), building a new one when they run out.
@@ -15,7 +19,7 @@
 //! Run: `cargo bench -p inertia --bench pipeline -- --warm-up-time 1 --measurement-time 3`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use inertia::pipeline::{Pipeline, PipelineSettings};
+use inertia::pipeline::{Pipeline, PipelineSettings, Run};
 use inertia::sim::scenario::{Common, Scenario};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -69,6 +73,35 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    let config = PipelineSettings {
+        estimator: "variational".into(),
+        ..PipelineSettings::default()
+    }
+    .validate()
+    .unwrap();
+    g.bench_function("variational_through_run", |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            let mut done = 0u64;
+            while done < iters {
+                let mut r = Run::new(config, false).unwrap();
+                for s in &run.samples[..2000] {
+                    r.push(s, |_| {}).unwrap();
+                }
+                let n = (iters - done).min((run.samples.len() - 2000) as u64) as usize;
+                let t0 = Instant::now();
+                for s in &run.samples[2000..2000 + n] {
+                    r.push(black_box(s), |e| {
+                        black_box(e);
+                    })
+                    .unwrap();
+                }
+                total += t0.elapsed();
+                done += n as u64;
+            }
+            total
+        })
+    });
     g.finish();
 }
 
