@@ -1,5 +1,6 @@
 //! The streaming estimator: samples pushed one at a time (or in blocks) into one
-//! `inertia::pipeline::Pipeline`, checked as the CSV reader checks rows.
+//! `inertia::pipeline::Run`, checked as the CSV reader checks rows; `finish` ends the
+//! input as `estimate()` does.
 
 use crate::errors::Failure;
 use crate::kwargs::Kwargs;
@@ -33,6 +34,16 @@ impl State {
         let mut produced = false;
         self.run
             .push(&s, |_| produced = true)
+            .map_err(|e| Origin::arrays().run_error(&e))?;
+        Ok(produced)
+    }
+
+    /// End of input: the run's last answer, widened by what only the whole input gives
+    /// (the held wheel speeds' lag term); `true` when that gave one more estimate.
+    fn finish(&mut self) -> Result<bool, Failure> {
+        let mut produced = false;
+        self.run
+            .finish(|_| produced = true)
             .map_err(|e| Origin::arrays().run_error(&e))?;
         Ok(produced)
     }
@@ -144,6 +155,13 @@ impl Stream {
             Ok(n)
         })
         .map_err(|f: Failure| f.into_py(py))
+    }
+
+    /// End of input (`State::finish`); `True` when it gave one more estimate.
+    fn finish(&self, py: Python<'_>) -> PyResult<bool> {
+        let mut guard = self.lock()?;
+        let st: &mut State = &mut guard;
+        py.allow_threads(|| st.finish()).map_err(|f| f.into_py(py))
     }
 
     /// `(report JSON, report text)` of the newest estimate, or None before one.

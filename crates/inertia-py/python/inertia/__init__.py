@@ -752,7 +752,8 @@ class Estimator:
     the input conventions (``scalar_first``, ``jpl``, ``conjugate``, ``gyro_unit``,
     ``negate_rho``, ``unit_tolerance``,
     ``period_tolerance``). Each sample is checked as a file's row is. Pushing the
-    samples of a file one by one gives the same estimate as :func:`estimate` on it.
+    samples of a file one by one, then :meth:`finish`, gives the same estimate as
+    :func:`estimate` on it.
     The GIL is released while a sample is processed.
     """
 
@@ -821,6 +822,14 @@ class Estimator:
         estimate after the block, or ``None`` when the block produced none."""
         n = self._native.push_many(*_arrays(t, q, rho, tau, w, r, b, f, dipole))
         return self.estimate if n else None
+
+    def finish(self) -> Optional[Estimate]:
+        """End of input: returns the final estimate, as :func:`estimate` gives it on the
+        same samples (where the wheel speeds are held between updates, its σ carries the
+        move of J for their mean lag, which only the whole input gives), or ``None``
+        before any estimate. Raises :class:`DataError` when the input was too short."""
+        self._native.finish()
+        return self.estimate
 
     @property
     def estimate(self) -> Optional[Estimate]:
