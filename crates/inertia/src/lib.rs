@@ -82,6 +82,7 @@
 
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 // Dead code is judged on the default build: with fewer features some helpers lose the
 // callers that the missing modules (pipeline, simulator, reader) hold.
 #![cfg_attr(

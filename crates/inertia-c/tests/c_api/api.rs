@@ -269,7 +269,7 @@ fn bad_settings_name_the_setting() {
 /// Problem: settings the library refuses, given through C (heap and caller storage) and
 /// through `PipelineSettings::validate` (the CLI's and Python's path). Reference: the
 /// library's message. C keeps no checks of its own for these values: each is refused
-/// with the library's message, through both of C's constructors.
+/// with the library's message, through both of C's constructors (NaN as `NOT_FINITE`).
 #[test]
 fn bad_settings_get_the_library_message_in_c() {
     use inertia::pipeline::PipelineSettings;
@@ -295,6 +295,18 @@ fn bad_settings_get_the_library_message_in_c() {
             |p| p.gyro_noise_deg_s_rthz = Some(-2.0),
         ),
         (|s| s.max_chain_s = -3.0, |p| p.max_chain_s = Some(-3.0)),
+        (
+            |s| s.rotor_scale_sigma = 1.5,
+            |p| p.rotor_scale_sigma = Some(1.5),
+        ),
+        (
+            |s| s.attitude_drift_deg_rth = -1.0,
+            |p| p.attitude_drift_deg_rth = Some(-1.0),
+        ),
+        (
+            |s| s.gyro_noise_deg_s_rthz = f64::NAN,
+            |p| p.gyro_noise_deg_s_rthz = Some(f64::NAN),
+        ),
     ];
     let mut storage = Box::new(Storage([0; 1 << 16]));
     let size = inertia_estimator_size();

@@ -30,14 +30,14 @@ pub(crate) mod normal_equations;
 pub mod observability;
 #[cfg(feature = "std")]
 pub(crate) mod plain_fit;
-pub(crate) mod prior;
+pub mod prior;
 pub mod qr;
 pub mod recursive;
 pub mod resample;
 #[cfg(feature = "std")]
 pub mod rotor_calibration;
 #[cfg(feature = "std")]
-pub(crate) mod rotor_inertia;
+pub mod rotor_inertia;
 pub mod rows;
 pub(crate) mod shared_qr;
 pub mod svd_tracker;

@@ -107,8 +107,6 @@ pub enum RotationSource {
     Gyro,
 }
 
-impl RotationSource {}
-
 /// What the telemetry's rotor momentum does between samples: which rows to use (the
 /// pipeline's setting; [`Stencil`] is what one row model does).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -127,8 +125,6 @@ pub enum RhoModel {
     /// Plain rows ([`Stencil::Plain`]), O(h²), whatever `ρ` does.
     Plain,
 }
-
-impl RhoModel {}
 
 /// The rows' stencil: one interval, or a Richardson combination of two intervals and
 /// their double step.

@@ -70,7 +70,7 @@ pub struct PriorFit {
 }
 
 impl PriorFit {
-    /// `true` when the prior and the data disagree past [`Self::threshold`].
+    /// `true` when the prior and the data disagree past `Self::threshold`.
     #[must_use]
     pub fn conflicts(&self) -> bool {
         self.rows > 0 && self.chi2 > self.threshold()

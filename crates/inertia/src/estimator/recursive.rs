@@ -155,7 +155,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     }
 
     /// Solve with the data so far, stamped `t_s`.
-    pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
+    pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
         self.solved = solved;

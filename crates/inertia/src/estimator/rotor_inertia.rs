@@ -29,7 +29,7 @@
 //! ```
 //!
 //! (one source: `|m_k|`, which with equal `s_i = r` and no known torque is `r |ĵ_k|`, the
-//! common scale's, [`super::uncertainty::Uncertainty::with_rotor_scale`]). Cost: one run of
+//! common scale's, `super::uncertainty::Uncertainty::with_rotor_scale`). Cost: one run of
 //! the estimator per source, plus one. What it leaves out: the curvature of `ĵ(z)` beyond
 //! one σ (`tests/integration/rotor_inertia.rs` measures the move over 0.1 σ against the one
 //! over 1σ).

@@ -38,7 +38,7 @@ pub struct Diagnostics {
     pub rotor_calibration: Option<crate::estimator::rotor_calibration::RotorFit>,
     /// The test for a constant disturbance torque at the last solve, where made: whether
     /// the torque was held at zero for want of evidence
-    /// ([`crate::estimator::discrete_momentum::torque_tested`]).
+    /// (`crate::estimator::discrete_momentum::torque_tested`).
     pub torque_test: Option<TorqueTest>,
     /// The span of the record whose residuals stand out most from the rest, with their
     /// variance ratio ([`crate::estimator::consistency`]; estimators that test their

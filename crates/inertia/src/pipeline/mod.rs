@@ -62,10 +62,10 @@ pub mod report;
 pub use crate::estimators::constrained::Constrained;
 pub use checks::AttitudeChecks;
 pub use config::{InertialTorque, PipelineConfig};
-pub(crate) use diagnostics::Diagnostics;
+pub use diagnostics::Diagnostics;
 pub use error::{PipelineError, MAX_RESAMPLE_FACTOR};
-pub(crate) use interface::BatchOutput;
 pub(crate) use interface::Estimator;
+pub use interface::{BatchOutput, Capabilities};
 pub use run::{check_first_step, Run, RunError, RunErrorKind, MIN_MOMENTUM_SIGNIFICANCE, RECENT};
 pub use settings::{parse_wheel_delay, PipelineSettings, DEFAULT_MAX_CHAIN_S};
 
@@ -84,6 +84,8 @@ pub struct Pipeline {
     input_samples: usize,
     estimator_samples: usize,
     last: Option<Estimate>,
+    /// The newest estimate before the status rules ([`status::apply`]).
+    last_unsettled: Option<Estimate>,
     checks: AttitudeChecks,
     /// The previous input sample's time and the step that ended at it.
     previous: Option<(f64, Option<f64>)>,
@@ -121,6 +123,7 @@ impl Pipeline {
             input_samples: 0,
             estimator_samples: 0,
             last: None,
+            last_unsettled: None,
             checks: AttitudeChecks::default(),
             previous: None,
         })
@@ -174,6 +177,7 @@ impl Pipeline {
             estimator,
             estimator_samples,
             last,
+            last_unsettled,
             checks,
             config,
             ..
@@ -187,6 +191,7 @@ impl Pipeline {
                     source,
                 })?;
             if let Some(mut e) = e {
+                *last_unsettled = Some(e);
                 status::apply(&mut e, config);
                 checks.estimate(index, &e)?;
                 *last = Some(e);
@@ -228,12 +233,16 @@ impl Pipeline {
         self.last.as_ref()
     }
 
-    /// The newest estimate widened by the wheel-speed time tag's term `c`
-    /// ([`status::widen_for_time_tag`]), which it becomes; `None` without an estimate.
+    /// The newest estimate with the status rules applied again as if the wheel-speed time
+    /// tag's term were `c` ([`status::apply`], as a batch run applies it), which it
+    /// becomes; `None` without an estimate with σ.
     pub(crate) fn widen_last_for_time_tag(&mut self, c: &[f64; 6]) -> Option<Estimate> {
-        let mut e = self.last?;
-        status::widen_for_time_tag(&mut e, c, &self.config);
-        self.config.wheel_delay_consider = Some(*c);
+        let mut e = self.last_unsettled.filter(|e| e.uncertainty.is_some())?;
+        let config = PipelineConfig {
+            wheel_delay_consider: Some(*c),
+            ..self.config
+        };
+        status::apply(&mut e, &config);
         self.last = Some(e);
         Some(e)
     }

@@ -17,6 +17,7 @@
 //! [`Observability::code`]: crate::estimator::observability::Observability::code
 
 mod text;
+pub use text::ReportText;
 
 use super::config::PipelineConfig;
 use super::diagnostics::Diagnostics;

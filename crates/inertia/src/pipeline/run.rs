@@ -171,7 +171,9 @@ impl Run {
             recent: VecDeque::with_capacity(RECENT),
             stopped: None,
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
-            kept: (!batch && config.wheel_delay == WheelDelay::Off).then(Vec::new),
+            // With a memory the answer forgets what the record's term would count.
+            kept: (!batch && config.wheel_delay == WheelDelay::Off && config.memory_s.is_none())
+                .then(Vec::new),
             delay: None,
             speeds: HeldSpeeds::default(),
             gyro_range: GyroRange::default(),
@@ -456,6 +458,11 @@ impl Run {
                     return Err(e);
                 }
             }
+            // Held for the rotors' consider term, read as time-tagged: the samples the
+            // held speeds' lag term needs.
+            if self.kept.is_some() {
+                self.kept = Some(held);
+            }
         }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
             if self.config.wheel_delay != WheelDelay::Off && self.delay.is_none() {
@@ -470,7 +477,7 @@ impl Run {
         // carries the move their mean lag makes (`wheel_delay::held_lag_move`; a streaming
         // run's last answer below).
         if let Some(every) = self.held_speeds_period_samples() {
-            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.sample_period_s());
+            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
             if let Mode::Batch { samples, out: None } = &self.mode {
                 self.config.wheel_delay_consider =
                     wheel_delay::held_lag_move(samples, &self.config.outside, lag_s);
@@ -488,7 +495,7 @@ impl Run {
         // Streaming, speeds held and no time tag: the last answer, widened by the held
         // speeds' lag term over the samples kept, is given once more.
         if let (Some(kept), Some(every)) = (self.kept.take(), self.held_speeds_period_samples()) {
-            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.sample_period_s());
+            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
             if let (Mode::Streaming(p), Some(c)) = (
                 &mut self.mode,
                 wheel_delay::held_lag_move(&kept, &self.config.outside, lag_s),
@@ -626,6 +633,11 @@ impl Run {
         &self.config
     }
 
+    /// The input's first step, s (the wheel speeds' hold is counted in input samples).
+    fn input_step_s(&self) -> f64 {
+        self.first_t_s[1] - self.first_t_s[0]
+    }
+
     /// The sample period, s: the resampling period where resampling, else the first step.
     #[must_use]
     #[cfg_attr(not(all(feature = "serde", feature = "csv")), allow(dead_code))] // used by the report
@@ -676,9 +688,10 @@ impl Run {
                 .with_held_speeds(self.held_speeds_period_samples().map(|p| {
                     (
                         p,
-                        p as f64 * self.sample_period_s(),
-                        self.config.wheel_delay_consider.is_some()
-                            && self.last().is_some_and(|e| e.uncertainty.is_some()),
+                        p as f64 * self.input_step_s(),
+                        self.last()
+                            .and_then(|e| e.uncertainty)
+                            .is_some_and(|u| u.time_tag_kg_m2.iter().any(|&x| x > 0.0)),
                     )
                 }))
                 .with_gyro_range(self.gyro_range.clipped().collect())

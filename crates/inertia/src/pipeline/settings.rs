@@ -227,6 +227,21 @@ impl PipelineSettings {
             self.attitude_drift_deg_rth,
             "a finite angle random walk > 0 deg/√h",
         )?;
+        if let Some(g) = self.gyro_noise_deg_s_rthz {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(PipelineError::InvalidSetting {
+                    field: "gyro_noise_deg_s_rthz",
+                    value: g,
+                    expected: "a finite density >= 0 deg/s/√Hz",
+                });
+            }
+            if !estimator.capabilities.compensation {
+                return Err(PipelineError::NotApplicable {
+                    setting: "gyro_noise_deg_s_rthz",
+                    estimator: estimator.name,
+                });
+            }
+        }
         if self.attitude_drift_deg_rth.is_some()
             && !self.gyro_noise_deg_s_rthz.is_some_and(|g| g > 0.0)
         {
@@ -267,21 +282,6 @@ impl PipelineSettings {
             if !estimator.capabilities.filter {
                 return Err(PipelineError::NotApplicable {
                     setting: "filter_cutoff_hz",
-                    estimator: estimator.name,
-                });
-            }
-        }
-        if let Some(g) = self.gyro_noise_deg_s_rthz {
-            if !(g.is_finite() && g >= 0.0) {
-                return Err(PipelineError::InvalidSetting {
-                    field: "gyro_noise_deg_s_rthz",
-                    value: g,
-                    expected: "a finite density >= 0 deg/s/√Hz",
-                });
-            }
-            if !estimator.capabilities.compensation {
-                return Err(PipelineError::NotApplicable {
-                    setting: "gyro_noise_deg_s_rthz",
                     estimator: estimator.name,
                 });
             }

@@ -116,22 +116,6 @@ pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     if let Some(c) = config.wheel_delay_consider {
         widen(e, threshold, |u, j| u.with_time_tag(j, &c));
     }
-    apply_rest(e, config);
-}
-
-/// Widen `e`, an answer already through [`apply`] without a time-tag term, by the
-/// wheel-speed time tag's term `c`, then [`settle`] again (a streaming run's last answer,
-/// once the end of the input gives the held speeds' lag term).
-pub(crate) fn widen_for_time_tag(e: &mut Estimate, c: &[f64; 6], config: &PipelineConfig) {
-    widen(e, config.observability.max_relative_sigma, |u, j| {
-        u.with_time_tag(j, c)
-    });
-    settle(e, config.constraints().set().consistency);
-}
-
-/// The rules of [`apply`] after the time tag's.
-fn apply_rest(e: &mut Estimate, config: &PipelineConfig) {
-    let threshold = config.observability.max_relative_sigma;
     if let Some(c) = config.rotor_inertia_consider {
         widen(e, threshold, |u, j| u.with_rotor_inertia(j, &c));
     }

@@ -34,10 +34,11 @@ pub mod rehearse;
 #[cfg(feature = "sim")]
 pub mod request;
 
-pub(crate) use design::Design;
+pub use design::{Atom, Design};
 pub use limits::{LimitUse, Limits, LimitsError, Wheel};
 pub use predict::{EstimatorModel, NoiseModel, Prediction};
 pub use profile::CommandProfile;
+pub use profile::ProfileError;
 
 use nalgebra::Matrix3;
 use std::string::String;
@@ -228,7 +229,7 @@ impl Vehicle {
 
 /// Plan the manoeuvre (module docs): stop at the end of the tour in which the
 /// information-matrix σ meets the target.
-pub(crate) fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
+pub fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
     let full = plan_full(v, s)?;
     let met = s.target_relative.and_then(|t| full.prediction.time_to(t));
     Ok(match met {

@@ -21,6 +21,7 @@
 //! ```
 
 mod file;
+pub use file::RunFileError;
 mod values;
 
 pub use values::{Bounds, ElementBound, Fraction, InertiaInput, PriorSigma};

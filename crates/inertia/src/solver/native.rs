@@ -10,7 +10,7 @@
 //! allocation, `no_std`-capable.
 
 use super::{Backend, Residuals, Solution, SolveError, SolveStatus};
-pub(crate) use crate::barrier::BarrierSettings;
+pub use crate::barrier::BarrierSettings;
 use crate::barrier::{self, Problem};
 use crate::constraints::Constraints;
 use crate::tensor::InertiaVector;

@@ -627,7 +627,7 @@ impl<R: Read> Iterator for TelemetryReader<R> {
 }
 
 mod columns;
-pub(crate) use columns::ColumnNames;
+pub use columns::ColumnNames;
 mod error;
 #[cfg(test)]
 mod tests;
