@@ -476,11 +476,9 @@ impl Run {
         // Speeds held between updates and read at their time stamps: the batch answer's σ
         // carries the move their mean lag makes (`wheel_delay::held_lag_move`; a streaming
         // run's last answer below).
-        if let Some(every) = self.held_speeds_period_samples() {
-            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
-            if let Mode::Batch { samples, out: None } = &self.mode {
-                self.config.wheel_delay_consider =
-                    wheel_delay::held_lag_move(samples, &self.config.outside, lag_s);
+        if let Mode::Batch { samples, out: None } = &self.mode {
+            if let Some(c) = self.held_lag_term(samples) {
+                self.config.wheel_delay_consider = Some(c);
             }
         }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
@@ -494,12 +492,8 @@ impl Run {
         }
         // Streaming, speeds held and no time tag: the last answer, widened by the held
         // speeds' lag term over the samples kept, is given once more.
-        if let (Some(kept), Some(every)) = (self.kept.take(), self.held_speeds_period_samples()) {
-            let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
-            if let (Mode::Streaming(p), Some(c)) = (
-                &mut self.mode,
-                wheel_delay::held_lag_move(&kept, &self.config.outside, lag_s),
-            ) {
+        if let Some(kept) = self.kept.take() {
+            if let (Some(c), Mode::Streaming(p)) = (self.held_lag_term(&kept), &mut self.mode) {
                 if let Some(e) = p.widen_last_for_time_tag(&c) {
                     self.config.wheel_delay_consider = Some(c);
                     on_estimate(&e);
@@ -631,6 +625,14 @@ impl Run {
     #[must_use]
     pub fn config(&self) -> &PipelineConfig {
         &self.config
+    }
+
+    /// The held speeds' lag term over `samples` (`wheel_delay::held_lag_move` at their
+    /// mean lag), where the speeds look held and no time tag was asked for.
+    fn held_lag_term(&self, samples: &[Sample]) -> Option<[f64; 6]> {
+        let every = self.held_speeds_period_samples()?;
+        let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
+        wheel_delay::held_lag_move(samples, &self.config.outside, lag_s)
     }
 
     /// The input's first step, s (the wheel speeds' hold is counted in input samples).
