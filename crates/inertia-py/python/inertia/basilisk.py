@@ -5,8 +5,8 @@ Basilisk (PyPI ``bsk``) records a spacecraft's attitude as modified Rodrigues pa
 message), the reaction-wheel speeds ``Omega`` (``RWSpeedMsgPayload.wheelSpeeds``) with each
 wheel's spin inertia ``Js`` and spin axis ``gsHat_B`` (``RWArrayConfigMsgPayload`` or the
 ``rwFactory`` that built them), and external torques in body axes (for example
-``ExtForceTorque.torqueRequestBody``, ``GravityGradientEffector``'s torque). Recorder times
-are integer nanoseconds.
+``ExtForceTorque.torqueRequestBody``; ``GravityGradientEffector``'s torque unless the orbit
+is given, below). Recorder times are integer nanoseconds.
 
 :func:`from_basilisk` turns them into what ``inertia.estimate`` (and the CLI's CSV,
 :func:`to_csv`) take: ``t`` (s), ``q`` (N, 4), ``rho`` (N, 3), ``tau`` (N, 3) and ``w``
@@ -17,6 +17,21 @@ are integer nanoseconds.
         rec_sc.times(), rec_sc.sigma_BN, rec_sc.omega_BN_B,
         wheel_speeds=rec_rw.wheelSpeeds[:, :n_wheels], Js=Js, gs_B=gs_B)
     est = inertia.estimate(d["t"], d["q"], d["rho"], tau=d["tau"], w=d["w"])
+
+For the spacecraft file's per-wheel telemetry (``--spacecraft``: each wheel's axis, spin
+inertia and σ, so that ``--calibrate-rotors`` and ``inertia plan`` can use them), pass
+``per_wheel=True`` and write the file with :func:`spacecraft_toml`; the outside torques'
+measurements become the CSV's ``r_*`` (``r_BN_N``: gravity gradient), ``b_*`` (``B_B`` or
+``B_N``: residual dipole), ``dipole_*`` (``mtb_dipoles``: torque rods) and ``f_*``
+(``thruster_forces_B``: centre of mass) columns::
+
+    d = basilisk.from_basilisk(
+        rec_sc.times(), rec_sc.sigma_BN, rec_sc.omega_BN_B, per_wheel=True,
+        wheel_speeds=rec_rw.wheelSpeeds[:, :n_wheels], Js=Js, gs_B=gs_B,
+        r_BN_N=rec_sc.r_BN_N)
+    basilisk.to_csv("flight.csv", d)
+    open("wheels.toml", "w").write(basilisk.spacecraft_toml(Js, gs_B))
+    # inertia estimate flight.csv --spacecraft wheels.toml
 
 The estimate is then the whole spacecraft's inertia about its centre of mass, wheels
 included. With Basilisk's default wheel model, ``BalancedWheels``, that is the hub's
@@ -110,15 +125,10 @@ __all__ = [
     "interval_rates",
     "from_basilisk",
     "to_csv",
+    "spacecraft_toml",
+    "speed_column",
+    "cell_means",
 ]
-
-#: Columns of the CLI's CSV, in the order :func:`to_csv` writes them.
-CSV_COLUMNS = (
-    "t", "q_x", "q_y", "q_z", "q_w",
-    "rho_x", "rho_y", "rho_z",
-    "tau_x", "tau_y", "tau_z",
-    "w_x", "w_y", "w_z",
-)
 
 
 def _array(name: str, value, shape_tail: tuple, n: Optional[int] = None) -> np.ndarray:
@@ -247,6 +257,16 @@ def from_basilisk(
     time_unit: str = "ns",
     rates: Optional[str] = "interval",
     wheel_momentum_kind: str = "relative",
+    per_wheel: bool = False,
+    wheel_names=None,
+    r_BN_N=None,
+    B_B=None,
+    B_N=None,
+    dipole_B=None,
+    mtb_dipoles=None,
+    mtb_axes_B=None,
+    thruster_forces_B=None,
+    thruster_locations_B=None,
 ) -> dict:
     """Convert Basilisk recordings to inertia's inputs (module docs for every convention).
 
@@ -265,11 +285,36 @@ def from_basilisk(
     rates : ``"interval"`` (default), ``"instant"`` or ``None`` (no ``w``).
     wheel_momentum_kind : ``"relative"`` (default: J is the spacecraft's total inertia) or
         ``"absolute"`` (J is the total less ``Σ Js gs gsᵀ``).
+    per_wheel : keep each wheel's speed (``wheel_speeds``, ``wheel_names``) in place of ρ,
+        for a spacecraft file (:func:`spacecraft_toml`) that states each wheel's axis and
+        spin inertia, so that ``--calibrate-rotors`` and ``inertia plan`` can use them.
+    wheel_names : (n,) names for the per-wheel columns (default ``rw1``, ``rw2``, ...).
+    r_BN_N : (N, 3) position, m, in N (``SCStatesMsgPayload.r_BN_N``, N centred on the
+        central body): the orbit columns ``r_*``, from which the estimator models the
+        gravity gradient (``GravityGradientEffector``'s torque; not also in ``tau_B``).
+    B_B : (N, 3) magnetic field, T, body axes (a magnetometer's ``tam_S`` with
+        ``dcm_SB`` the identity); or ``B_N`` (N, 3), inertial (``MagneticFieldMsgPayload
+        .magField_N``), turned to body axes with the attitude: ``B_B = [BN] B_N``. The
+        field columns ``b_*``: the estimator then estimates a residual dipole.
+    dipole_B : (N, 3) commanded magnetorquer dipole, A m², body axes; or ``mtb_dipoles``
+        (N, k) (``MTBCmdMsgPayload.mtbDipoleCmds[:k]``) with ``mtb_axes_B`` (k, 3), each
+        rod's axis (the columns of ``MtbEffector``'s ``GtMatrix_B``): ``Σ m_i g_i``. Needs
+        the field; ``MtbEffector``'s torque ``m × B`` is then known, not also in ``tau_B``.
+    thruster_forces_B : (N, k, 3) each thruster's force, N, body axes
+        (``THROutputMsgPayload.thrustForce_B``), with ``thruster_locations_B`` (k, 3), m,
+        from the body frame's origin B (``thrusterLocation``): the force columns ``f_*``
+        get ``Σ F_i`` and ``tau`` gets ``Σ r_i × F_i``, the torque about B; the estimator
+        then estimates the centre of mass (``hub.r_BcB_B``) with J. On/off thrusters
+        switch between samples: record them at the dynamics rate and pass their
+        :func:`cell_means` (so also for ``mtb_dipoles`` that change between samples).
 
     Returns
     -------
-    dict with ``t`` (N,) s, ``q`` (N, 4), ``rho`` (N, 3) N m s, ``tau`` (N, 3) N m and ``w``
-    (N, 3) rad/s or ``None``: the arguments of ``inertia.estimate``.
+    dict with ``t`` (N,) s, ``q`` (N, 4), ``rho`` (N, 3) N m s (``None`` with
+    ``per_wheel``), ``tau`` (N, 3) N m, ``w`` (N, 3) rad/s or ``None``: the arguments of
+    ``inertia.estimate``; and ``wheel_speeds`` (N, n) rad/s with ``wheel_names``, ``r``,
+    ``b``, ``dipole``, ``f`` (N, 3) where given (else ``None``): the further columns
+    :func:`to_csv` writes.
     """
     t = _seconds(times, time_unit)
     n = t.shape[0]
@@ -291,7 +336,67 @@ def from_basilisk(
         )
         if rho.shape[0] != n:
             raise ValueError(f"wheel_speeds: {rho.shape[0]} rows, expected {n} (one per time)")
+    speeds, names = None, None
+    if per_wheel:
+        if wheel_speeds is None:
+            raise ValueError("per_wheel: needs wheel_speeds, Js and gs_B")
+        if wheel_momentum_kind != "relative":
+            raise ValueError(
+                "per_wheel: the spacecraft file's speeds are relative to the body "
+                "(wheel_momentum_kind=\"relative\")"
+            )
+        n_wheels = np.atleast_1d(np.asarray(Js, dtype=float)).shape[0]
+        speeds = np.asarray(wheel_speeds, dtype=float).reshape(n, n_wheels)
+        names = _wheel_names(wheel_names, n_wheels)
+        rho = None
+    elif wheel_names is not None:
+        raise ValueError("wheel_names: given without per_wheel=True")
     tau = np.zeros((n, 3)) if tau_B is None else _array("tau_B", tau_B, (3,), n)
+    r = None if r_BN_N is None else _array("r_BN_N", r_BN_N, (3,), n)
+    if B_B is not None and B_N is not None:
+        raise ValueError("B_B, B_N: give the field in one frame")
+    if B_N is not None:
+        b_n = _array("B_N", B_N, (3,), n)
+        # [BN] x_N = R(q)ᵀ x_N, with R(q) the body -> inertial rotation of `q`.
+        b = np.einsum("kji,kj->ki", _rotations(q), b_n)
+    else:
+        b = None if B_B is None else _array("B_B", B_B, (3,), n)
+    if dipole_B is not None and mtb_dipoles is not None:
+        raise ValueError("dipole_B, mtb_dipoles: give the commanded dipole once")
+    if mtb_dipoles is not None:
+        if mtb_axes_B is None:
+            raise ValueError("mtb_dipoles: needs mtb_axes_B (each rod's axis, body axes)")
+        axes = np.atleast_2d(np.asarray(mtb_axes_B, dtype=float))
+        axes = _array("mtb_axes_B", axes, (3,))
+        m = np.asarray(mtb_dipoles, dtype=float).reshape(n, axes.shape[0])
+        dipole = _array("mtb_dipoles", m, (axes.shape[0],), n) @ axes
+    elif mtb_axes_B is not None:
+        raise ValueError("mtb_axes_B: given without mtb_dipoles")
+    else:
+        dipole = None if dipole_B is None else _array("dipole_B", dipole_B, (3,), n)
+    if dipole is not None and b is None:
+        raise ValueError("dipole_B: a commanded dipole's torque needs the field (B_B or B_N)")
+    f = None
+    if thruster_forces_B is not None:
+        if thruster_locations_B is None:
+            raise ValueError(
+                "thruster_forces_B: needs thruster_locations_B (each thruster's position "
+                "from the body frame's origin, m)"
+            )
+        loc = _array("thruster_locations_B", np.atleast_2d(thruster_locations_B), (3,))
+        forces = np.asarray(thruster_forces_B, dtype=float)
+        if forces.ndim == 2 and loc.shape[0] == 1:
+            forces = forces[:, None, :]
+        if forces.shape != (n, loc.shape[0], 3):
+            raise ValueError(
+                f"thruster_forces_B: shape {forces.shape}, expected ({n}, {loc.shape[0]}, 3)"
+            )
+        if not np.all(np.isfinite(forces)):
+            raise ValueError("thruster_forces_B: non-finite value")
+        f = forces.sum(axis=1)
+        tau = tau + np.cross(loc[None, :, :], forces).sum(axis=1)
+    elif thruster_locations_B is not None:
+        raise ValueError("thruster_locations_B: given without thruster_forces_B")
     if delta_angle_B is not None:
         d = _array("delta_angle_B", delta_angle_B, (3,), n)
         w = np.empty((n, 3))
@@ -307,20 +412,169 @@ def from_basilisk(
         w = omega.copy()
     else:
         raise ValueError(f"rates: {rates!r}, expected \"interval\", \"instant\" or None")
-    return {"t": t, "q": q, "rho": rho, "tau": tau, "w": w}
+    return {
+        "t": t, "q": q, "rho": rho, "tau": tau, "w": w,
+        "wheel_speeds": speeds, "wheel_names": names,
+        "r": r, "b": b, "dipole": dipole, "f": f,
+    }
+
+
+def cell_means(times, fine_times, fine_values, *, time_unit: str = "ns") -> np.ndarray:
+    """Means of a finely recorded signal over each sample's cell, for the known torque,
+    force and dipole columns of on/off actuators (thrusters, magnetorquers).
+
+    The estimator credits the known torque at sample k with the impulse from the middle
+    of the interval before it to the middle of the one after (``h̄_k τ_k``,
+    ``crates/inertia/src/estimator/momentum_rows.rs``). A smooth torque read at the sample
+    gives that impulse to O(h²); a thruster that switches between samples does not: read
+    at the samples, each edge misplaces up to half a step of its impulse. So record such
+    actuators at the dynamics rate (``fine_times`` (M,), ``fine_values`` (M, ...)) and
+    pass their mean over ``[(t_{k−1} + t_k)/2, (t_k + t_{k+1})/2]`` (the first and last
+    cells end at the first and last sample): the integral of the recording's linear
+    interpolant, exact for a recording fine enough to resolve each edge."""
+    t = _seconds(times, time_unit)
+    tf = _seconds(fine_times, time_unit)
+    v = np.asarray(fine_values, dtype=float)
+    if v.shape[:1] != tf.shape or not np.all(np.isfinite(v)):
+        raise ValueError(
+            f"fine_values: shape {v.shape} (finite values expected), one row per fine time "
+            f"({tf.shape[0]})"
+        )
+    if len(t) < 2 or tf[0] > t[0] or tf[-1] < t[-1]:
+        raise ValueError("fine_times: must span the samples' times (at least two samples)")
+    flat = v.reshape(len(tf), -1)
+    # Cumulative integral of the linear interpolant at the fine times ...
+    steps = np.diff(tf)[:, None]
+    cum = np.concatenate([np.zeros((1, flat.shape[1])),
+                          np.cumsum(0.5 * steps * (flat[1:] + flat[:-1]), axis=0)])
+
+    def integral(x):
+        # ... and at any time within them (the interpolant's quadratic piece).
+        i = np.clip(np.searchsorted(tf, x, side="right") - 1, 0, len(tf) - 2)
+        d = (x - tf[i])[:, None]
+        slope = (flat[i + 1] - flat[i]) / (tf[i + 1] - tf[i])[:, None]
+        return cum[i] + d * flat[i] + 0.5 * d * d * slope
+
+    edges = np.concatenate([[t[0]], 0.5 * (t[1:] + t[:-1]), [t[-1]]])
+    area = integral(edges)
+    means = (area[1:] - area[:-1]) / np.diff(edges)[:, None]
+    return means.reshape((len(t),) + v.shape[1:])
+
+
+def _wheel_names(names, n_wheels: int) -> list:
+    if names is None:
+        return [f"rw{i + 1}" for i in range(n_wheels)]
+    names = [str(x) for x in names]
+    if len(names) != n_wheels:
+        raise ValueError(f"wheel_names: {len(names)} names for {n_wheels} wheels")
+    for x in names:
+        if not x or not all(c.isalnum() or c in "_-" for c in x):
+            raise ValueError(f"wheel_names: {x!r}: use letters, digits, '_' and '-' only")
+    if len(set(names)) != len(names):
+        raise ValueError(f"wheel_names: not distinct: {names}")
+    return names
+
+
+def _rotations(q: np.ndarray) -> np.ndarray:
+    """(N, 3, 3) rotation matrices of Hamilton quaternions ``[x, y, z, w]`` (body -> inertial)."""
+    x, y, z, w = (q[:, i] for i in range(4))
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+    ], axis=1)
+
+
+def speed_column(name: str) -> str:
+    """The CSV column of a wheel's speed in rad/s, as :func:`to_csv` and
+    :func:`spacecraft_toml` name it."""
+    return f"{name}_rad_s"
+
+
+def spacecraft_toml(
+    Js,
+    gs_B,
+    *,
+    wheel_names=None,
+    Js_sigma=None,
+    axis_sigma_deg=None,
+    max_torque_nm=None,
+    max_speed_rad_s=None,
+) -> str:
+    """The spacecraft file (TOML, ``--spacecraft``) of Basilisk's wheels: one ``[[rotor]]``
+    per wheel with its spin axis ``gs_B`` (body axes) and spin inertia ``Js``, its speed
+    read from :func:`to_csv`'s per-wheel column in rad/s (relative to the body: Basilisk's
+    ``Omega``). Optional, each a scalar or one value per wheel: ``Js_sigma`` (kg m²) and
+    ``axis_sigma_deg``, the file's σ (what ``--calibrate-rotors`` estimates against, and
+    the consider term without it); ``max_torque_nm`` and ``max_speed_rad_s`` (Basilisk's
+    ``u_max`` and ``Omega_max``), the limits ``inertia plan`` keeps (the momentum limit is
+    ``Js · Omega_max``)."""
+    Js = np.atleast_1d(np.asarray(Js, dtype=float))
+    n_wheels = Js.shape[0]
+    gs = _array("gs_B", np.atleast_2d(gs_B), (3,), n_wheels)
+    gs = gs / np.linalg.norm(gs, axis=1)[:, None]
+    names = _wheel_names(wheel_names, n_wheels)
+
+    def per_wheel(name, value):
+        if value is None:
+            return [None] * n_wheels
+        v = np.broadcast_to(np.asarray(value, dtype=float), (n_wheels,))
+        if not np.all(np.isfinite(v)) or np.any(v < 0):
+            raise ValueError(f"{name}: finite values >= 0 expected, got {v}")
+        return [float(x) for x in v]
+
+    js_sigma = per_wheel("Js_sigma", Js_sigma)
+    tilt = per_wheel("axis_sigma_deg", axis_sigma_deg)
+    torque = per_wheel("max_torque_nm", max_torque_nm)
+    speed = per_wheel("max_speed_rad_s", max_speed_rad_s)
+    lines = ["# Basilisk's reaction wheels (inertia.basilisk.spacecraft_toml)"]
+    for i, name in enumerate(names):
+        lines += [
+            "",
+            "[[rotor]]",
+            f'name = "{name}"',
+            "axis = [" + ", ".join(repr(float(x)) for x in gs[i]) + "]",
+            f"spin_inertia_kg_m2 = {float(Js[i])!r}",
+        ]
+        if js_sigma[i] is not None:
+            lines.append(f"spin_inertia_sigma_kg_m2 = {js_sigma[i]!r}")
+        if tilt[i] is not None:
+            lines.append(f"spin_axis_sigma_deg = {tilt[i]!r}")
+        lines += [f'speed_column = "{speed_column(name)}"', 'speed_unit = "rad/s"']
+        if torque[i] is not None:
+            lines.append(f"max_torque_nm = {torque[i]!r}")
+        if speed[i] is not None:
+            lines.append(f"max_momentum_nms = {speed[i] * float(Js[i])!r}")
+    return "\n".join(lines) + "\n"
 
 
 def to_csv(path, data: dict) -> None:
     """Write :func:`from_basilisk`'s output as the CLI's CSV (``inertia estimate PATH``),
-    with every number in its shortest round-trip form."""
+    with every number in its shortest round-trip form: ``t``, ``q_*``, ``rho_*`` (or one
+    speed column per wheel, named by :func:`speed_column`, with ``per_wheel``), ``tau_*``,
+    then ``w_*``, ``r_*``, ``b_*``, ``dipole_*`` and ``f_*`` where present."""
     n = data["t"].shape[0]
-    has_w = data.get("w") is not None
-    cols = CSV_COLUMNS if has_w else CSV_COLUMNS[:11]
+    cols = ["t", "q_x", "q_y", "q_z", "q_w"]
+    blocks = [data["t"][:, None], data["q"]]
+    if data.get("rho") is not None:
+        cols += ["rho_x", "rho_y", "rho_z"]
+        blocks.append(data["rho"])
+    else:
+        names = data.get("wheel_names") or []
+        speeds = data.get("wheel_speeds")
+        if speeds is None:
+            raise ValueError("data: neither rho nor wheel_speeds")
+        cols += [speed_column(x) for x in names]
+        blocks.append(np.asarray(speeds, dtype=float).reshape(n, len(names)))
+    cols += ["tau_x", "tau_y", "tau_z"]
+    blocks.append(data["tau"])
+    for key, prefix in (("w", "w"), ("r", "r"), ("b", "b"), ("dipole", "dipole"), ("f", "f")):
+        if data.get(key) is not None:
+            cols += [f"{prefix}_{a}" for a in "xyz"]
+            blocks.append(data[key])
+    table = np.concatenate([np.asarray(b, dtype=float).reshape(n, -1) for b in blocks], axis=1)
     with open(path, "w", newline="") as f:
         out = _csv.writer(f, lineterminator="\n")
         out.writerow(cols)
-        for k in range(n):
-            row = [data["t"][k], *data["q"][k], *data["rho"][k], *data["tau"][k]]
-            if has_w:
-                row += list(data["w"][k])
+        for row in table:
             out.writerow([repr(float(v)) for v in row])
