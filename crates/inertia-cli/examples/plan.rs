@@ -18,14 +18,17 @@
 //! off by +8 %, −6 %, +5 % and products of 2 % of the mean moment, ±10 % (1σ); the
 //! margin on every limit is `min(0.9, 1/(1 + 3 · 0.1))`.
 //!
-//! **Profiles.** The plan (`plan_rehearsed`, target 1 % relative Frobenius at 3σ, 8
-//! rehearsal flights on the prior J) and every fixed profile of `inertia::plan::fixed`
-//! at horizons of 120 and 300 s, scaled to the same limits. All are flown on the same
-//! seeds; the best fixed profile is the one with the shortest *achieved* median time.
+//! **Profiles.** The plan (`inertia::plan::request::make`, as `inertia plan`: target 1 %
+//! relative Frobenius at 3σ, 8 rehearsal flights on the prior J, the estimator's chain
+//! chosen by rehearsal among 30, 60 and 120 s, or the second argument's) and every fixed
+//! profile of `inertia::plan::fixed` at horizons of 120 and 300 s, scaled to the same
+//! limits. All are flown on the same seeds. The fixed profiles are flown with the
+//! estimator's default 30 s chain and, where the plan chose another, with the plan's too;
+//! the best fixed profile at each is the one with the shortest *achieved* median time.
 //!
 //! **Flights.** Each profile for its own length (the plan until its end, a fixed profile
-//! for its horizon): the simulator with the true inertia, the estimator with its defaults (`discrete-momentum`, short chain 30 s,
-//! or the second argument), solved every 1 s. Time to target: the first estimate whose
+//! for its horizon): the simulator with the true inertia, the estimator with its defaults
+//! (`discrete-momentum`) and the chain above, solved every 1 s. Time to target: the first estimate whose
 //! reported σ gives `3 σ_F ≤ 1 %` (σ_F with the true ‖J‖). Predicted σ: the
 //! information-matrix σ_F at the plan's end, over the RMS of the final errors over seeds
 //! (the achieved error σ), and the rehearsal's median reported σ_F over the check
@@ -37,9 +40,10 @@
 
 use inertia::pipeline::PipelineSettings;
 use inertia::plan::rehearse::{fly, median_reported, Flight, FlightSettings};
+use inertia::plan::request::{make, Chain, Request};
 use inertia::plan::{
-    fixed_profiles, plan_rehearsed, CommandProfile, EstimatorModel, Limits, NoiseModel,
-    PlanSettings, Vehicle, Wheel,
+    fixed_profiles, CommandProfile, EstimatorModel, Limits, NoiseModel, PlanSettings, Vehicle,
+    Wheel,
 };
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -118,12 +122,17 @@ fn vehicle(s: &Sat) -> Vehicle {
     }
 }
 
-/// The estimator's short chain, s (the second argument; default 30).
-fn chain_s() -> f64 {
-    std::env::args()
-        .nth(2)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(inertia::pipeline::DEFAULT_MAX_CHAIN_S)
+/// The estimator's short chain (the second argument: a length in s, or `auto`, the
+/// default: `inertia plan`'s choice by rehearsal).
+fn chain() -> Chain {
+    match std::env::args().nth(2).as_deref() {
+        None | Some("auto") => Chain::Choose,
+        Some(x) => Chain::Fixed(Some(x.parse().expect("chain: a length in s or `auto`"))),
+    }
+}
+
+fn chain_label(c: Option<f64>) -> String {
+    c.map_or("one chain".into(), |c| format!("{c:.0} s chains"))
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -196,36 +205,38 @@ fn main() {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(20);
-    let settings = PlanSettings {
-        target_relative: Some(TARGET),
+    let request = Request {
+        target_relative: TARGET,
         max_duration_s: HORIZON_S,
-        estimator: EstimatorModel {
-            chain_s: Some(chain_s()),
-            ..EstimatorModel::default()
-        },
-        ..PlanSettings::default()
+        chain: chain(),
+        rehearsals: 8,
+        disturbance_nm_rthz: 1e-8,
+        ..Request::default()
     };
-    let fs = FlightSettings {
+    let flights_at = |chain_s: Option<f64>| FlightSettings {
         duration_s: HORIZON_S,
         disturbance_nm_rthz: 1e-8,
         estimator: PipelineSettings {
             solve_every: 10,
-            max_chain_s: Some(chain_s()),
+            max_chain_s: chain_s,
             ..PipelineSettings::default()
         },
     };
+    let default_chain = Some(inertia::pipeline::DEFAULT_MAX_CHAIN_S);
     println!(
-        "Seeds per profile: {seeds}; estimator short chain {} s.\n",
-        chain_s()
+        "Seeds per profile: {seeds}; estimator chain {:?}.\n",
+        request.chain
     );
     println!(
-        "| spacecraft | profile | time to 1 % (3σ), predicted: information / rehearsal | achieved: median [min, max] | reached | information σ_F / RMS error | rehearsal σ_F / reported σ_F | 3σ coverage | peak wheel momentum use | peak torque use |"
+        "| spacecraft | profile (estimator chain) | time to 1 % (3σ), predicted: information / rehearsal | achieved: median [min, max] | reached | information σ_F / RMS error | rehearsal σ_F / reported σ_F | 3σ coverage | peak wheel momentum use | peak torque use |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for s in sats() {
         let v = vehicle(&s);
-        let rp = plan_rehearsed(&v, &settings, &fs, 8).expect("plan");
-        let pl = &rp.plan;
+        let out = make(&v, &request).expect("plan");
+        let pl = &out.plan;
+        let (rehearsal_t, rehearsal_sigma) = &out.rehearsal;
+        let fs = flights_at(out.chain_s);
         let end = pl.profile.duration_s();
         let plan_row = row("plan".into(), &v, &s, &pl.profile, seeds, &fs);
         // Information σ_F at the plan's end against the RMS of the final errors.
@@ -255,8 +266,8 @@ fn main() {
         };
         // At the plan's end, or the rehearsal's, whichever is first (a rehearsal stops
         // where its target is met).
-        let end = end.min(rp.t_s.last().copied().unwrap_or(end));
-        let rehearsal_sf = at(&rp.t_s, &rp.median_reported_relative_sigma, end);
+        let end = end.min(rehearsal_t.last().copied().unwrap_or(end));
+        let rehearsal_sf = at(rehearsal_t, rehearsal_sigma, end);
         let (ct, cmed, _) = median_reported(&plan_row.flights, TARGET);
         let check_sf = at(&ct, &cmed, end);
         let cov = |r: &Row| {
@@ -264,11 +275,12 @@ fn main() {
         };
         let mom = |r: &Row| r.flights.iter().map(|f| f.momentum_use).fold(0.0, f64::max);
         println!(
-            "| {} | plan ({:.0} s) | {} / {} | {} [{:.0}, {:.0}] | {}/{} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            "| {} | plan, {:.0} s ({}) | {} / {} | {} [{:.0}, {:.0}] | {}/{} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
             s.name,
             pl.profile.duration_s(),
+            chain_label(out.chain_s),
             fmt_t(pl.target_met_s.unwrap_or(f64::INFINITY)),
-            fmt_t(rp.reported_target_met_s.unwrap_or(f64::INFINITY)),
+            fmt_t(out.reported_target_met_s.unwrap_or(f64::INFINITY)),
             fmt_t(plan_row.time),
             plan_row.lo,
             plan_row.hi,
@@ -280,41 +292,60 @@ fn main() {
             mom(&plan_row),
             plan_row.torque_use,
         );
+        let settings = PlanSettings {
+            target_relative: Some(TARGET),
+            max_duration_s: HORIZON_S,
+            estimator: EstimatorModel {
+                chain_s: out.chain_s,
+                ..EstimatorModel::default()
+            },
+            ..PlanSettings::default()
+        };
         let fixed = fixed_profiles(&v, &settings, &[120.0, 300.0]).expect("fixed");
-        let rows: Vec<(Row, Option<f64>)> = fixed
-            .iter()
-            .map(|f| {
-                (
-                    row(
-                        format!("{} ({:.0} s)", f.name, f.horizon_s),
-                        &v,
-                        &s,
-                        &f.profile,
-                        seeds,
-                        &fs,
-                    ),
-                    f.target_met_s,
-                )
-            })
-            .collect();
-        let (best, best_pred) = rows
-            .iter()
-            .min_by(|a, b| a.0.time.total_cmp(&b.0.time))
-            .expect("fixed profiles");
-        println!(
-            "| {} | best fixed: {} | {} / – | {} [{:.0}, {:.0}] | {}/{} | – | – | {:.2} | {:.2} | {:.2} |",
-            s.name,
-            best.label,
-            fmt_t(best_pred.unwrap_or(f64::INFINITY)),
-            fmt_t(best.time),
-            best.lo,
-            best.hi,
-            best.reached,
-            seeds,
-            cov(best),
-            mom(best),
-            best.torque_use,
-        );
+        // The fixed profiles with the estimator's default chain, and with the plan's.
+        let mut chains = std::vec![default_chain];
+        if out.chain_s != default_chain {
+            chains.push(out.chain_s);
+        }
+        let mut rows: Vec<(Row, Option<f64>)> = Vec::new();
+        for chain_s in chains {
+            let fs = flights_at(chain_s);
+            let at_chain: Vec<(Row, Option<f64>)> = fixed
+                .iter()
+                .map(|f| {
+                    (
+                        row(
+                            format!("{} {:.0} s ({})", f.name, f.horizon_s, chain_label(chain_s)),
+                            &v,
+                            &s,
+                            &f.profile,
+                            seeds,
+                            &fs,
+                        ),
+                        f.target_met_s,
+                    )
+                })
+                .collect();
+            let (best, best_pred) = at_chain
+                .iter()
+                .min_by(|a, b| a.0.time.total_cmp(&b.0.time))
+                .expect("fixed profiles");
+            println!(
+                "| {} | best fixed: {} | {} / – | {} [{:.0}, {:.0}] | {}/{} | – | – | {:.2} | {:.2} | {:.2} |",
+                s.name,
+                best.label,
+                fmt_t(best_pred.unwrap_or(f64::INFINITY)),
+                fmt_t(best.time),
+                best.lo,
+                best.hi,
+                best.reached,
+                seeds,
+                cov(best),
+                mom(best),
+                best.torque_use,
+            );
+            rows.extend(at_chain);
+        }
         eprintln!(
             "{}: shares {:?} (gap {:.1e}); every fixed profile, achieved median: {}",
             s.name,

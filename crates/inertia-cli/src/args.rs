@@ -59,9 +59,17 @@ pub struct PlanArgs {
     /// Longest plan, s.
     #[arg(long, value_name = "S", default_value_t = 1800.0)]
     pub max_duration: f64,
-    /// The estimator's short momentum chain, s (as `estimate --chain`; 0: none).
-    #[arg(long, value_name = "S", default_value_t = inertia::pipeline::DEFAULT_MAX_CHAIN_S)]
-    pub chain: f64,
+    /// The estimator's short momentum chain, s (as `estimate --chain`; 0: none), or
+    /// `auto`: rehearse the plans for chains of 30, 60 and 120 s and keep the one whose
+    /// rehearsal reports the target soonest (the default chain without rehearsals or with
+    /// --duration). The plan says which to give `estimate`.
+    #[arg(
+        long,
+        value_name = "S|auto",
+        default_value = "auto",
+        allow_hyphen_values = true
+    )]
+    pub chain: String,
     /// Rehearsal flights of the estimator on the prior J (0: the information matrix
     /// alone decides where the plan stops).
     #[arg(long, value_name = "N", default_value_t = 8)]

@@ -5,7 +5,7 @@ use crate::args::PlanArgs;
 use crate::error::{input, write_failed, CliError};
 use crate::output::{to_stdout, Pending};
 use crate::plot::{figure, register_font, Panel, Series, COLORS};
-use inertia::plan::request::{make, Request};
+use inertia::plan::request::{make, Chain, Request};
 use inertia::plan::Vehicle;
 use inertia::spacecraft::Spacecraft;
 use inertia::tensor::COMPONENT_NAMES;
@@ -18,17 +18,22 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
     let file = a.spacecraft.display().to_string();
     let sc = Spacecraft::load(&a.spacecraft).map_err(|e| input(e.to_string()))?;
     let v = Vehicle::from_spacecraft(&sc, &file).map_err(input)?;
-    if !(a.chain >= 0.0 && a.chain.is_finite()) {
-        return Err(input(format!(
-            "--chain {}: must be finite and >= 0",
-            Num(a.chain)
-        )));
-    }
+    let chain = match a.chain.trim() {
+        "auto" => Chain::Choose,
+        text => match text.parse::<f64>() {
+            Ok(c) if c.is_finite() && c >= 0.0 => Chain::Fixed((c > 0.0).then_some(c)),
+            _ => {
+                return Err(input(format!(
+                    "--chain {text:?}: expected a length in s (finite, >= 0; 0: none) or `auto`"
+                )))
+            }
+        },
+    };
     let request = Request {
         target_relative: a.target,
         duration_s: a.duration,
         max_duration_s: a.max_duration,
-        chain_s: (a.chain > 0.0).then_some(a.chain),
+        chain,
         rehearsals: a.rehearsals,
         disturbance_nm_rthz: a.disturbance,
     };
@@ -95,6 +100,27 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
         lines.push(format!(
             "rehearsal (estimator on the prior J, median of {seeds} flights): {}",
             t(*reported)
+        ));
+    }
+    let chain_text = |c: Option<f64>| c.map_or("none".to_string(), |c| format!("{} s", Num(c)));
+    let chain_flag = out.chain_s.map_or(0.0, |c| c);
+    if out.chain_trials.is_empty() {
+        lines.push(format!(
+            "estimator chain: {}; estimate with --chain {}",
+            chain_text(out.chain_s),
+            Num(chain_flag)
+        ));
+    } else {
+        let tried: Vec<String> = out
+            .chain_trials
+            .iter()
+            .map(|(c, t_met)| format!("{} → {}", chain_text(*c), t(*t_met)))
+            .collect();
+        lines.push(format!(
+            "estimator chain: {} (rehearsed {}); estimate with --chain {}",
+            chain_text(out.chain_s),
+            tried.join(", "),
+            Num(chain_flag)
         ));
     }
     if let Some(s) = plan.prediction.last() {

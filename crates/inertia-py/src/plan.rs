@@ -2,7 +2,7 @@
 //! the planning is in the library.
 
 use crate::errors::value_error;
-use inertia::plan::request::{make, Request};
+use inertia::plan::request::{make, Chain, Request};
 use inertia::plan::Vehicle;
 use inertia::spacecraft::Spacecraft;
 use pyo3::prelude::*;
@@ -11,7 +11,7 @@ use pyo3::types::PyDict;
 /// Plan the calibration manoeuvre for a spacecraft file (the Python wrapper documents the
 /// keys of the returned dict).
 #[pyfunction]
-#[pyo3(signature = (spacecraft, target, duration, max_duration, chain, rehearsals, disturbance))]
+#[pyo3(signature = (spacecraft, target, duration, max_duration, chain, choose_chain, rehearsals, disturbance))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
@@ -20,6 +20,7 @@ pub fn plan<'py>(
     duration: Option<f64>,
     max_duration: f64,
     chain: Option<f64>,
+    choose_chain: bool,
     rehearsals: u64,
     disturbance: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -28,7 +29,11 @@ pub fn plan<'py>(
         target_relative: target,
         duration_s: duration,
         max_duration_s: max_duration,
-        chain_s: chain,
+        chain: if choose_chain {
+            Chain::Choose
+        } else {
+            Chain::Fixed(chain)
+        },
         rehearsals,
         disturbance_nm_rthz: disturbance,
     };
@@ -97,5 +102,7 @@ pub fn plan<'py>(
     u.set_item("rate", p.limit_use.rate)?;
     d.set_item("limit_use", u)?;
     d.set_item("gap", p.design.gap)?;
+    d.set_item("chain_s", out.chain_s)?;
+    d.set_item("chain_trials", out.chain_trials.clone())?;
     Ok(d)
 }

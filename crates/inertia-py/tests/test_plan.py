@@ -36,3 +36,20 @@ def test_a_file_without_sensors_is_refused_by_key(tmp_path):
     bad.write_text(SAT1.read_text().split("[sensors]")[0])
     with pytest.raises(ValueError, match="sensors"):
         inertia.plan(bad)
+
+
+def test_the_chain_is_chosen_by_rehearsal_and_returned():
+    """``chain="auto"`` rehearses 30, 60 and 120 s chains and returns the one kept, as the
+    CLI prints it; without rehearsals it is the estimator's default; a fixed chain is kept
+    as given; anything else is refused."""
+    p = inertia.plan(SAT1)
+    trials = p["chain_trials"]
+    assert [c for c, _ in trials] == [30.0, 60.0, 120.0]
+    best = min(t for _, t in trials if t is not None)
+    assert p["reported_target_met_s"] == best
+    assert p["chain_s"] == next(c for c, t in trials if t == best)
+    assert inertia.plan(SAT1, rehearsals=0)["chain_s"] == 30.0
+    fixed = inertia.plan(SAT1, chain=45.0)
+    assert fixed["chain_s"] == 45.0 and fixed["chain_trials"] == []
+    with pytest.raises(ValueError, match="chain"):
+        inertia.plan(SAT1, chain="fast")

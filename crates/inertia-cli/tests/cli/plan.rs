@@ -110,6 +110,11 @@ fn a_plan_keeps_every_limit_and_its_flight_is_within_the_predicted_sigma() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(out.contains("information matrix"), "{out}");
+    // Without rehearsals `--chain auto` (the default) is the estimator's default chain.
+    assert!(
+        out.contains("estimator chain: 30 s; estimate with --chain 30"),
+        "{out}"
+    );
     for f in ["plan.prediction.csv", "plan.png", "plan.svg"] {
         assert!(d.path().join(f).exists(), "{f}");
     }
@@ -220,6 +225,26 @@ fn a_file_without_limits_or_sensors_is_refused_by_key() {
         assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
         assert!(stderr(&o).contains(key), "{key}: {}", stderr(&o));
         assert!(!d.path().join("p.csv").exists());
+    }
+    // A chain that is neither a length nor `auto` is refused, naming the option.
+    let sc = d.path().join("sc.toml");
+    std::fs::write(&sc, SC).unwrap();
+    for bad in ["fast", "-5", "inf"] {
+        let o = inertia(&[
+            "plan",
+            "--spacecraft",
+            sc.to_str().unwrap(),
+            "--chain",
+            bad,
+            "-o",
+            d.path().join("p.csv").to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(&format!("--chain \"{bad}\"")),
+            "{}",
+            stderr(&o)
+        );
     }
 }
 

@@ -911,7 +911,7 @@ def plan(
     target: float = 0.01,
     duration: Optional[float] = None,
     max_duration: float = 1800.0,
-    chain: Optional[float] = 30.0,
+    chain: Union[float, str, None] = "auto",
     rehearsals: int = 8,
     disturbance: float = 1e-8,
 ) -> Dict[str, Any]:
@@ -921,7 +921,10 @@ def plan(
     ``spacecraft`` is a spacecraft file whose rotors carry ``max_torque_nm`` and
     ``max_momentum_nms``, with ``[prior]``, ``[sensors]`` and optionally ``[limits]``.
     ``target`` is the relative Frobenius error at 3σ; ``duration`` (s) flies that long
-    instead; ``chain`` is the estimator's short momentum chain (s, ``None``: none);
+    instead; ``chain`` is the estimator's short momentum chain (s, ``None``: none), or
+    ``"auto"`` (default): the plans for chains of 30, 60 and 120 s are rehearsed and the
+    chain whose rehearsal reports the target soonest is kept (returned as ``chain_s``:
+    give it to ``estimate(..., chain=...)`` for the flight, 0 for None);
     ``rehearsals`` flights of the estimator on the prior J decide, with the information
     matrix, where the plan stops (0: the information matrix alone).
 
@@ -933,11 +936,17 @@ def plan(
     matrix) and ``reported_target_met_s`` (rehearsal), s or None; ``rehearsal_t`` and
     ``rehearsal_relative_sigma`` (the median σ the estimator reported); ``margin``,
     ``limit_use`` (``torque``, ``momentum``, ``rate``: the largest fraction of each limit
-    used) and ``gap`` (the A-optimality gap of the design). Raises ``ValueError`` naming
-    the file and key for a file that lacks what a plan needs.
+    used), ``gap`` (the A-optimality gap of the design), ``chain_s`` (the chain the plan
+    assumes, s, or None) and ``chain_trials`` (with ``"auto"``: each chain tried and when
+    its rehearsal reported the target, s or None). Raises ``ValueError`` naming the file
+    and key for a file that lacks what a plan needs.
     """
+    choose = isinstance(chain, str)
+    if choose and chain != "auto":
+        raise ValueError(f"chain: {chain!r}, expected a length in s, None or \"auto\"")
     return _inertia.plan(
         os.fspath(spacecraft), float(target),
         None if duration is None else float(duration), float(max_duration),
-        None if chain is None else float(chain), int(rehearsals), float(disturbance),
+        None if (choose or chain is None) else float(chain), choose, int(rehearsals),
+        float(disturbance),
     )

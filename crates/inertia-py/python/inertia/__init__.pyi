@@ -244,7 +244,7 @@ def plan(
     target: float = ...,
     duration: Optional[float] = ...,
     max_duration: float = ...,
-    chain: Optional[float] = ...,
+    chain: Union[float, str, None] = ...,
     rehearsals: int = ...,
     disturbance: float = ...,
 ) -> Dict[str, Any]: ...

@@ -85,6 +85,7 @@ def plan(
     duration: Optional[float],
     max_duration: float,
     chain: Optional[float],
+    choose_chain: bool,
     rehearsals: int,
     disturbance: float,
 ) -> Dict[str, Any]: ...
