@@ -339,6 +339,9 @@ impl Plan {
             // Every outside torque the samples' `InertiaExternal` gives is modelled.
             outside: Default::default(),
             rotor_scale_sigma: self.rotor_scale_sigma,
+            // The known torque's scale term needs the samples a `Run` keeps: not in the C
+            // API, which streams without them.
+            torque_scale_sigma: None,
             // The filter's cutoff is the estimator's own default (`InertiaSettings` has
             // none to give).
             filter_cutoff_hz: None,

@@ -488,6 +488,13 @@ pub struct EstimateArgs {
     /// σ then exceeds the threshold is not determined.
     #[arg(long, value_name = "P")]
     pub rotor_scale_sigma: Option<String>,
+    /// Relative standard deviation of the known torque's scale (`tau_*`, the spacecraft
+    /// file's thrusters, commanded magnetorquer dipoles: a thrust or a dipole known to ±P):
+    /// `2%` or `0.02`. The final answer's σ grows by P times the part of Ĵ the known torque
+    /// sets (all of it where no wheel moves), and an answer whose relative σ then exceeds
+    /// the threshold is not determined.
+    #[arg(long, value_name = "P")]
+    pub torque_scale_sigma: Option<String>,
     /// Low-pass cutoff, Hz, of the equation-error baseline's differentiating filter
     /// (default: a twentieth of the sample rate).
     #[arg(long, value_name = "HZ")]

@@ -197,6 +197,7 @@ pub fn description(a: &EstimateArgs) -> Result<RunDescription, CliError> {
     options.prior_sigma = parsed("--prior-sigma", a.prior_sigma.as_deref())?;
     options.products = a.products;
     options.rotor_scale_sigma = parsed("--rotor-scale-sigma", a.rotor_scale_sigma.as_deref())?;
+    options.torque_scale_sigma = parsed("--torque-scale-sigma", a.torque_scale_sigma.as_deref())?;
     options.filter_cutoff_hz = a.filter_cutoff_hz;
     options.every = a.every;
     options.memory = a.memory;

@@ -14,6 +14,8 @@ mod simulate_effects;
 mod simulate_options;
 #[path = "cli/spacecraft.rs"]
 mod spacecraft;
+#[path = "cli/torque_scale.rs"]
+mod torque_scale;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

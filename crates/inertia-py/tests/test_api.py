@@ -353,3 +353,28 @@ def test_wheel_delay_shifts_the_speeds_and_is_reported(slew):
         inertia.Estimator(wheel_delay=0.01)
     with pytest.raises(ValueError, match="whole record"):
         inertia._inertia.Stream(kwargs={"wheel_delay": 0.01})
+
+
+def test_torque_scale_sigma_widens_the_final_answer_as_the_cli(tmp_path, cli):
+    """A spacecraft whose wheels never move, excited by its thrusters: the known torque's
+    stated σ is that share of J in the final answer, as the CLI's."""
+    import json
+    import subprocess
+
+    (tmp_path / "zero.csv").write_text(
+        "t_s,rho_dot_x_nm,rho_dot_y_nm,rho_dot_z_nm\n0,0,0,0\n300,0,0,0\n"
+    )
+    subprocess.run(
+        [cli, "simulate", "--commands", tmp_path / "zero.csv", "--thrusters", "0.02",
+         "-o", tmp_path / "f.csv"], check=True, capture_output=True,
+    )
+    est = inertia.estimate(tmp_path / "f.csv", torque_scale_sigma=0.05)
+    term = np.array(est.report["torque_scale_sigma_kg_m2"])
+    assert np.allclose(term, 0.05 * np.abs(est.j), rtol=0.02)
+    out = subprocess.run(
+        [cli, "estimate", tmp_path / "f.csv", "--json", "--torque-scale-sigma", "5%"],
+        check=True, capture_output=True, text=True,
+    )
+    assert np.allclose(json.loads(out.stdout)["sigma"], est.sigma, rtol=1e-12)
+    with pytest.raises(ValueError, match="torque_scale_sigma"):
+        inertia.estimate(tmp_path / "f.csv", torque_scale_sigma=1.5)

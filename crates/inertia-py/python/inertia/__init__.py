@@ -115,9 +115,10 @@ class Estimate:
         j: ``[J11, J22, J33, J12, J13, J23]``, kg m² (products are tensor entries,
             ``J12 = −Σ m x y``).
         sigma: one standard deviation of each element of ``j``, kg m² (noise,
-            discretisation bias and, when ``rotor_scale_sigma`` was given, the wheels'
-            scale: ``report["rotor_scale_sigma_kg_m2"]``), or ``None`` for estimators
-            without an uncertainty model.
+            discretisation bias and, when ``rotor_scale_sigma`` or ``torque_scale_sigma``
+            was given, the wheels' or the known torque's scale:
+            ``report["rotor_scale_sigma_kg_m2"]``, ``report["torque_scale_sigma_kg_m2"]``),
+            or ``None`` for estimators without an uncertainty model.
         status: ``"determined"``, ``"from_prior"``, ``"not_observable"``,
             ``"unchecked"`` (no observability test, or no σ) or ``"model_check_failed"``
             (an answer with its σ that breaks J1 > 0 or J1 + J2 ≥ J3 beyond 3σ).
@@ -541,6 +542,7 @@ def estimate(
     calibrate_rotors: bool = False,
     outside: Optional[Mapping[str, Any]] = None,
     rotor_scale_sigma: Optional[float] = None,
+    torque_scale_sigma: Optional[float] = None,
     filter_cutoff_hz: Optional[float] = None,
     chain: float = 30.0,
     wheel_delay: Union[None, str, float] = None,
@@ -635,6 +637,9 @@ def estimate(
             ``report["outside"]`` (see :class:`Estimate`).
             rotor_scale_sigma: relative σ of the wheel momentum's scale (the wheels' spin
             inertia known to ±this, e.g. 0.02): widens σ by it times |Ĵ|.
+            torque_scale_sigma: relative σ of the known torque's scale (a thrust or a
+            dipole known to ±this, e.g. 0.02): widens the final answer's σ by it times
+            the part of Ĵ the known torque sets (``report["torque_scale_sigma_kg_m2"]``).
             filter_cutoff_hz: the equation-error baseline's low-pass cutoff, Hz.
             wheel_delay: the wheel speeds' time tag: ``None`` (off), the delay in s
             (the speeds are read that much later), or ``"estimate"`` (with σ, which widens
@@ -781,6 +786,7 @@ class Estimator:
         damping: bool = False,
         outside: Optional[Mapping[str, Any]] = None,
         rotor_scale_sigma: Optional[float] = None,
+        torque_scale_sigma: Optional[float] = None,
         filter_cutoff_hz: Optional[float] = None,
         chain: float = 30.0,
         glitches: str = "stop",

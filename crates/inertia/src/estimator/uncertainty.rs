@@ -44,6 +44,9 @@ pub struct Uncertainty {
     /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
     /// unless given, `Uncertainty::with_rotor_inertia`).
     pub rotor_inertia_kg_m2: [f64; 6],
+    /// Its consider part from the known torque's stated scale σ, `r |ĵ_τ|`, kg m² (zero
+    /// unless given, `Uncertainty::with_torque_scale`; [`crate::pipeline::PipelineSettings::torque_scale_sigma`]).
+    pub torque_scale_kg_m2: [f64; 6],
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
     pub principal_sigma_kg_m2: [f64; 3],
@@ -101,6 +104,17 @@ impl Uncertainty {
     pub(crate) fn with_rotor_inertia(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
         Uncertainty {
             rotor_inertia_kg_m2: *c,
+            ..self.with_consider(j, c)
+        }
+    }
+
+    /// This σ widened by the known torque's scale consider term `c` per element, kg m²
+    /// (`crate::estimator::torque_scale`): `√(σ² + c²)`, propagated to the principal
+    /// moments of `j` as [`with_bias`] does.
+    #[must_use]
+    pub(crate) fn with_torque_scale(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {
+        Uncertainty {
+            torque_scale_kg_m2: *c,
             ..self.with_consider(j, c)
         }
     }
@@ -208,6 +222,7 @@ pub(crate) fn with_bias_at(
         rotor_scale_kg_m2: [0.0; 6],
         time_tag_kg_m2: [0.0; 6],
         rotor_inertia_kg_m2: [0.0; 6],
+        torque_scale_kg_m2: [0.0; 6],
         principal_sigma_kg_m2: principal,
     }
 }

@@ -26,6 +26,8 @@ pub struct PipelineConfig {
     pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
     pub(crate) uncertainty: bool,
     pub(crate) rotor_scale_sigma: Option<f64>,
+    /// Relative σ of the known torque's scale ([`super::PipelineSettings::torque_scale_sigma`]).
+    pub(crate) torque_scale_sigma: Option<f64>,
     pub(crate) filter_cutoff_hz: Option<f64>,
     pub(crate) observability: ObservabilitySettings,
     pub(crate) rotation_source: Option<RotationSource>,
@@ -44,6 +46,9 @@ pub struct PipelineConfig {
     /// The rotors' spin-inertia consider term per element, kg m², once a run with a
     /// spacecraft file has computed it ([`crate::estimator::rotor_inertia`]).
     pub(crate) rotor_inertia_consider: Option<[f64; 6]>,
+    /// The known torque's scale consider term per element, kg m², once a run has computed
+    /// it for its final answer (`crate::estimator::torque_scale`).
+    pub(crate) torque_scale_consider: Option<[f64; 6]>,
     /// `√Σ_i s_i²` of a spacecraft file's rotors' relative spin-inertia σ (0 without).
     pub(crate) rotor_inertia_relative_sigma: f64,
     /// One chain length for the discrete momentum estimator's candidates (`Some(None)`:

@@ -308,6 +308,7 @@ mod tests {
             rotor_scale_kg_m2: [0.0; 6],
             time_tag_kg_m2: [0.0; 6],
             rotor_inertia_kg_m2: [0.0; 6],
+            torque_scale_kg_m2: [0.0; 6],
             principal_sigma_kg_m2: [0.0; 3],
         });
         let mut out = std::vec::Vec::new();

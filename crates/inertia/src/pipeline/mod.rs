@@ -233,13 +233,19 @@ impl Pipeline {
         self.last.as_ref()
     }
 
-    /// The newest estimate with the status rules applied again as if the wheel-speed time
-    /// tag's term were `c` ([`status::apply`], as a batch run applies it), which it
-    /// becomes; `None` without an estimate with σ.
-    pub(crate) fn widen_last_for_time_tag(&mut self, c: &[f64; 6]) -> Option<Estimate> {
+    /// The newest estimate with the status rules applied again with the final answer's
+    /// consider terms, the held wheel speeds' lag `time_tag` and the known torque's scale
+    /// `torque_scale` ([`status::apply`], as a batch run applies them), which it becomes;
+    /// `None` without an estimate with σ.
+    pub(crate) fn widen_last(
+        &mut self,
+        time_tag: Option<[f64; 6]>,
+        torque_scale: Option<[f64; 6]>,
+    ) -> Option<Estimate> {
         let mut e = self.last_unsettled.filter(|e| e.uncertainty.is_some())?;
         let config = PipelineConfig {
-            wheel_delay_consider: Some(*c),
+            wheel_delay_consider: time_tag.or(self.config.wheel_delay_consider),
+            torque_scale_consider: torque_scale,
             ..self.config
         };
         status::apply(&mut e, &config);

@@ -119,6 +119,9 @@ pub struct Report {
     /// Its part from the wheel momentum's stated scale uncertainty (a consider parameter,
     /// `rotor_scale_sigma`), kg m²; `null` without one.
     pub rotor_scale_sigma_kg_m2: Option<[f64; 6]>,
+    /// Its part from the known torque's stated scale uncertainty (a consider parameter,
+    /// `torque_scale_sigma`), kg m²; `null` without one.
+    pub torque_scale_sigma_kg_m2: Option<[f64; 6]>,
     /// The wheel-speed time tag applied ([`crate::estimator::wheel_delay`]): `δ` with its
     /// σ, whether estimated, and its consider part of `sigma` per element, kg m²;
     /// `null` without one.
@@ -420,6 +423,10 @@ impl Report {
             rotor_scale_sigma_kg_m2: estimate
                 .uncertainty
                 .map(|u| u.rotor_scale_kg_m2)
+                .filter(|p| p.iter().any(|&v| v > 0.0)),
+            torque_scale_sigma_kg_m2: estimate
+                .uncertainty
+                .map(|u| u.torque_scale_kg_m2)
                 .filter(|p| p.iter().any(|&v| v > 0.0)),
             principal_moments: pr.map(|(v, _)| [v[0], v[1], v[2]]),
             principal_moments_sigma: estimate.uncertainty.map(|u| u.principal_sigma_kg_m2),

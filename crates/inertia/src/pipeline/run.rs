@@ -21,6 +21,7 @@
 //!   [`Run::next_record`] between them: one J, each record its own time axis, initial
 //!   momenta and torques.
 
+mod consider;
 mod error;
 mod records;
 mod rotors;
@@ -171,9 +172,12 @@ impl Run {
             recent: VecDeque::with_capacity(RECENT),
             stopped: None,
             held: (!batch && config.wheel_delay != WheelDelay::Off).then(Vec::new),
-            // With a memory the answer forgets what the record's term would count.
-            kept: (!batch && config.wheel_delay == WheelDelay::Off && config.memory_s.is_none())
-                .then(Vec::new),
+            // With a memory the answer forgets what the record's terms would count. With a
+            // time tag the held samples are kept, for the known torque's scale.
+            kept: (!batch
+                && config.memory_s.is_none()
+                && (config.wheel_delay == WheelDelay::Off || config.torque_scale_sigma.is_some()))
+            .then(Vec::new),
             delay: None,
             speeds: HeldSpeeds::default(),
             gyro_range: GyroRange::default(),
@@ -474,12 +478,14 @@ impl Run {
             }
         }
         // Speeds held between updates and read at their time stamps: the batch answer's σ
-        // carries the move their mean lag makes (`wheel_delay::held_lag_move`; a streaming
-        // run's last answer below).
+        // carries the move their mean lag makes (`wheel_delay::held_lag_move`), and with a
+        // σ of the known torque's scale, the move that scale makes (`torque_scale`); a
+        // streaming run's last answer below.
         if let Mode::Batch { samples, out: None } = &self.mode {
             if let Some(c) = self.held_lag_term(samples) {
                 self.config.wheel_delay_consider = Some(c);
             }
+            self.config.torque_scale_consider = self.torque_scale_term(samples);
         }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
             if self.config.calibrate_rotors {
@@ -490,12 +496,17 @@ impl Run {
                 self.apply_rotor_consider(&taken);
             }
         }
-        // Streaming, speeds held and no time tag: the last answer, widened by the held
-        // speeds' lag term over the samples kept, is given once more.
+        // Streaming: the last answer, widened by the held speeds' lag term (speeds held, no
+        // time tag) and the known torque's scale term over the samples kept, is given once
+        // more.
         if let Some(kept) = self.kept.take() {
-            if let (Some(c), Mode::Streaming(p)) = (self.held_lag_term(&kept), &mut self.mode) {
-                if let Some(e) = p.widen_last_for_time_tag(&c) {
-                    self.config.wheel_delay_consider = Some(c);
+            let (lag, scale) = (self.held_lag_term(&kept), self.torque_scale_term(&kept));
+            if let (true, Mode::Streaming(p)) = (lag.is_some() || scale.is_some(), &mut self.mode) {
+                if let Some(e) = p.widen_last(lag, scale) {
+                    if lag.is_some() {
+                        self.config.wheel_delay_consider = lag;
+                    }
+                    self.config.torque_scale_consider = scale;
                     on_estimate(&e);
                 }
             }
@@ -625,14 +636,6 @@ impl Run {
     #[must_use]
     pub fn config(&self) -> &PipelineConfig {
         &self.config
-    }
-
-    /// The held speeds' lag term over `samples` (`wheel_delay::held_lag_move` at their
-    /// mean lag), where the speeds look held and no time tag was asked for.
-    fn held_lag_term(&self, samples: &[Sample]) -> Option<[f64; 6]> {
-        let every = self.held_speeds_period_samples()?;
-        let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
-        wheel_delay::held_lag_move(samples, &self.config.outside, lag_s)
     }
 
     /// The input's first step, s (the wheel speeds' hold is counted in input samples).

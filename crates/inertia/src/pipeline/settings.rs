@@ -44,6 +44,12 @@ pub struct PipelineSettings {
     /// since the momentum rows fix J's scale only as well as ρ's. `None` (default): ρ's
     /// scale taken as exact.
     pub rotor_scale_sigma: Option<f64>,
+    /// Relative standard deviation of the known torque's scale (`tau_*`, a spacecraft
+    /// file's thrusters, commanded magnetorquer dipoles: a thrust or a dipole known to
+    /// ±this): a consider parameter that widens σ by `this · |ĵ_τ|` per element, `ĵ_τ` the
+    /// part of the answer the known torque sets (`crate::estimator::torque_scale`), in a
+    /// run's final answer. `None` (default): the known torque taken as exact.
+    pub torque_scale_sigma: Option<f64>,
     /// The low-pass cutoff, Hz, of an estimator that differentiates filtered signals (the
     /// equation-error baseline). `None` (default): the estimator's own default.
     pub filter_cutoff_hz: Option<f64>,
@@ -136,6 +142,7 @@ impl PipelineSettings {
             resample_s: None,
             gyro_noise_deg_s_rthz: None,
             rotor_scale_sigma: None,
+            torque_scale_sigma: None,
             filter_cutoff_hz: None,
             uncertainty: true,
             observability: ObservabilitySettings::default(),
@@ -188,6 +195,7 @@ impl PipelineSettings {
             gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
             uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
             rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
+            torque_scale_sigma: self.torque_scale_sigma.filter(|&r| r > 0.0),
             filter_cutoff_hz: self.filter_cutoff_hz,
             observability: self.observability,
             rotation_source: self.rotation_source,
@@ -203,6 +211,7 @@ impl PipelineSettings {
             wheel_delay: self.wheel_delay,
             wheel_delay_consider: None,
             rotor_inertia_consider: None,
+            torque_scale_consider: None,
             rotor_inertia_relative_sigma: 0.0,
             pinned_chain_s: None,
         })
@@ -260,17 +269,21 @@ impl PipelineSettings {
                 why: "the weighted rows' answer is given unless the unweighted rows' bias σ exceeds their noise σ",
             });
         }
-        if let Some(r) = self.rotor_scale_sigma {
+        for (field, r) in [
+            ("rotor_scale_sigma", self.rotor_scale_sigma),
+            ("torque_scale_sigma", self.torque_scale_sigma),
+        ] {
+            let Some(r) = r else { continue };
             if !(r.is_finite() && (0.0..1.0).contains(&r)) {
                 return Err(PipelineError::InvalidSetting {
-                    field: "rotor_scale_sigma",
+                    field,
                     value: r,
                     expected: "a finite relative σ in [0, 1)",
                 });
             }
             if !(self.uncertainty && estimator.capabilities.uncertainty) {
                 return Err(PipelineError::NeedsSetting {
-                    setting: "rotor_scale_sigma",
+                    setting: field,
                     needs: "uncertainty",
                     requirement: "on",
                     why: "it widens σ, which the estimator must give",

@@ -109,7 +109,8 @@ pub(crate) fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 /// Apply every rule ([module docs](self)) to `e`, an answer of a run with `config`: the
 /// wheel-speed time tag's consider term where one was applied
 /// ([`crate::estimator::wheel_delay`]), the rotors' spin-inertia term of a spacecraft file
-/// ([`crate::estimator::rotor_inertia`]), the rotor scale's where one is given
+/// ([`crate::estimator::rotor_inertia`]), the known torque's scale term where a run has
+/// computed one (`crate::estimator::torque_scale`), the rotor scale's where one is given
 /// ([`widen_for_rotor_scale`]), then [`settle`].
 pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     let threshold = config.observability.max_relative_sigma;
@@ -118,6 +119,9 @@ pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     }
     if let Some(c) = config.rotor_inertia_consider {
         widen(e, threshold, |u, j| u.with_rotor_inertia(j, &c));
+    }
+    if let Some(c) = config.torque_scale_consider {
+        widen(e, threshold, |u, j| u.with_torque_scale(j, &c));
     }
     if let Some(r) = config.rotor_scale_sigma {
         widen_for_rotor_scale(e, r, threshold);

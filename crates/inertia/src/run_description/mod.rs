@@ -110,6 +110,8 @@ description! {
         products: ProductConvention,
         /// Relative σ of the rotor momentum's scale (`--rotor-scale-sigma`).
         rotor_scale_sigma: Fraction,
+        /// Relative σ of the known torque's scale (`--torque-scale-sigma`).
+        torque_scale_sigma: Fraction,
         /// The equation-error baseline's cutoff, Hz (`--filter-cutoff-hz`).
         filter_cutoff_hz: f64,
         /// Solve every this many samples (`--every`).
@@ -233,6 +235,7 @@ impl RunDescription {
             gyro_noise_deg_s_rthz: self.gyro_noise,
             uncertainty: self.uncertainty.unwrap_or(d.uncertainty),
             rotor_scale_sigma: self.rotor_scale_sigma.map(|f| f.0),
+            torque_scale_sigma: self.torque_scale_sigma.map(|f| f.0),
             filter_cutoff_hz: self.filter_cutoff_hz,
             observability: d.observability,
             rotation_source: self.rotation_source,

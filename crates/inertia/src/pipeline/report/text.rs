@@ -107,6 +107,9 @@ impl fmt::Display for ReportText<'_> {
             if r.rotor_scale_sigma_kg_m2.is_some() {
                 parts.push("the wheels' stated scale");
             }
+            if r.torque_scale_sigma_kg_m2.is_some() {
+                parts.push("the known torque's stated scale");
+            }
             let last = parts.pop().unwrap_or_default();
             let parts = format!("{} and {last}", parts.join(", "));
             writeln!(s, "elements, ± one standard deviation ({parts}) [kg m²]:")?;
