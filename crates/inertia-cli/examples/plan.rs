@@ -110,6 +110,7 @@ fn vehicle(s: &Sat) -> Vehicle {
                 })
                 .collect(),
             max_rate_rad_s: None,
+            max_angle_rad: None,
             margin: (1.0f64 / 1.3).min(0.9),
         },
         noise: NoiseModel {

@@ -47,7 +47,7 @@ pub enum Command {
 #[derive(Debug, Args)]
 pub struct PlanArgs {
     /// The spacecraft file (TOML): rotors with max_torque_nm and max_momentum_nms,
-    /// [prior], [sensors] and optionally [limits] max_rate_deg_s.
+    /// [prior], [sensors] and optionally [limits] max_rate_deg_s and max_angle_deg.
     #[arg(long, value_name = "FILE.toml")]
     pub spacecraft: PathBuf,
     /// Target: relative Frobenius error of J at 3σ.

@@ -79,8 +79,12 @@ pub fn run(a: &PlanArgs) -> Result<(), CliError> {
         Num(plan.horizon_s),
         plan.design.gap,
     ));
+    let angle = match v.limits.max_angle_rad {
+        Some(_) => format!(", angle {:.2}", plan.limit_use.angle),
+        None => String::new(),
+    };
     lines.push(format!(
-        "limits used (margin {:.2}): wheel torque {:.2}, wheel momentum {:.2}, rate {:.2}",
+        "limits used (margin {:.2}): wheel torque {:.2}, wheel momentum {:.2}, rate {:.2}{angle}",
         v.limits.margin, plan.limit_use.torque, plan.limit_use.momentum, plan.limit_use.rate
     ));
     let t = |x: Option<f64>| {

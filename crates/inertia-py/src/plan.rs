@@ -100,6 +100,7 @@ pub fn plan<'py>(
     u.set_item("torque", p.limit_use.torque)?;
     u.set_item("momentum", p.limit_use.momentum)?;
     u.set_item("rate", p.limit_use.rate)?;
+    u.set_item("angle", p.limit_use.angle)?;
     d.set_item("limit_use", u)?;
     d.set_item("gap", p.design.gap)?;
     d.set_item("chain_s", out.chain_s)?;

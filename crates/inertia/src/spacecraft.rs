@@ -52,6 +52,7 @@
 //! controller_hz = 1.0                 # wheel command rate (a whole fraction of it)
 //! [limits]
 //! max_rate_deg_s = 5.0                # body rate limit (optional)
+//! max_angle_deg = 20.0                # largest rotation from the start (optional)
 //! ```
 //!
 //! # Convention
@@ -238,6 +239,9 @@ pub struct Spacecraft {
     pub sensors: Option<Sensors>,
     /// Body rate limit, deg/s (`[limits] max_rate_deg_s`), if given.
     pub max_rate_deg_s: Option<f64>,
+    /// Largest rotation of the body from its attitude at the start of a plan, deg
+    /// (`[limits] max_angle_deg`, at most 180), if given.
+    pub max_angle_deg: Option<f64>,
     /// The thrusters (`[[thruster]]`, [`thrusters`]), in the file's order.
     pub thrusters: Vec<Thruster>,
 }
@@ -303,6 +307,8 @@ struct RawSensors {
 struct RawLimits {
     #[serde(default)]
     max_rate_deg_s: Option<toml::Spanned<f64>>,
+    #[serde(default)]
+    max_angle_deg: Option<toml::Spanned<f64>>,
 }
 
 #[cfg(feature = "spacecraft")]
@@ -621,6 +627,24 @@ impl Spacecraft {
             None => None,
             Some(r) => Some(positive(r, "limits.max_rate_deg_s", false)?),
         };
+        let max_angle_deg = match raw
+            .limits
+            .as_ref()
+            .and_then(|l| l.get_ref().max_angle_deg.as_ref())
+        {
+            None => None,
+            Some(a) => {
+                let x = positive(a, "limits.max_angle_deg", false)?;
+                if x > 180.0 {
+                    return Err(err(
+                        Some(a.span()),
+                        Some("limits.max_angle_deg".into()),
+                        format!("{} is more than 180°", crate::text::Num(x)),
+                    ));
+                }
+                Some(x)
+            }
+        };
         let columns: Vec<String> = rotors.iter().map(|r| r.speed_column.clone()).collect();
         let thrusters = thrusters::parse(&raw.thrusters, &columns, &err)?;
         Ok(Spacecraft {
@@ -629,6 +653,7 @@ impl Spacecraft {
             prior,
             sensors,
             max_rate_deg_s,
+            max_angle_deg,
             thrusters,
         })
     }

@@ -267,3 +267,113 @@ fn a_bad_command_file_is_refused_with_its_line() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("c.csv:3:"), "{}", stderr(&o));
 }
+
+/// The largest rotation from the first attitude of a telemetry file's quaternions, deg.
+fn max_angle_deg(csv: &Path) -> f64 {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| header.iter().position(|h| *h == n).unwrap();
+    let (x, y, z, w) = (col("q_x"), col("q_y"), col("q_z"), col("q_w"));
+    let q: Vec<nalgebra::UnitQuaternion<f64>> = lines
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|s| s.parse().unwrap()).collect();
+            nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                v[w], v[x], v[y], v[z],
+            ))
+        })
+        .collect();
+    q.iter()
+        .map(|qk| (q[0].inverse() * qk).angle().to_degrees())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn an_attitude_limit_is_kept_in_flight() {
+    // Without the limit the plan turns the body by more than 1°; with `max_angle_deg =
+    // 1` its flight on the prior J (the simulator's true attitude) stays within the
+    // margin of 1° of the start, and the plan reports that use.
+    let d = tempfile::tempdir().unwrap();
+    let fly = |sc_text: &str, name: &str| -> f64 {
+        let sc = d.path().join(format!("{name}.toml"));
+        std::fs::write(&sc, sc_text).unwrap();
+        let plan = d.path().join(format!("{name}.csv"));
+        let o = inertia(&[
+            "plan",
+            "--spacecraft",
+            sc.to_str().unwrap(),
+            "--rehearsals",
+            "0",
+            "-o",
+            plan.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let flight = d.path().join(format!("{name}_flight.csv"));
+        let o = inertia(&[
+            "simulate",
+            "--commands",
+            plan.to_str().unwrap(),
+            "--inertia",
+            "0.30:0.28:0.19:-0.005:0.004:0.002",
+            "--attitude",
+            "truth",
+            "--controller-hz",
+            "2",
+            "-o",
+            flight.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        max_angle_deg(&flight)
+    };
+    let free = fly(SC, "free");
+    assert!(free > 1.0, "the unconstrained plan turns {free}°");
+    let limited = SC.replace(
+        "max_rate_deg_s = 2.0",
+        "max_rate_deg_s = 2.0\nmax_angle_deg = 1.0",
+    );
+    let sc = d.path().join("limited.toml");
+    std::fs::write(&sc, &limited).unwrap();
+    let o = inertia(&[
+        "plan",
+        "--spacecraft",
+        sc.to_str().unwrap(),
+        "--rehearsals",
+        "0",
+        "-o",
+        d.path().join("limited_plan.csv").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let margin = 1.0 / (1.0 + 3.0 * 0.05 * 0.30 / 0.19);
+    let used: f64 = stdout(&o)
+        .split("angle ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .expect("the angle's use is reported")
+        .parse()
+        .unwrap();
+    assert!(used <= margin + 0.005, "{}", stdout(&o));
+    let angle = fly(&limited, "limited");
+    assert!(
+        angle <= margin * 1.01,
+        "flown {angle}° against 1° × margin {margin}"
+    );
+    // A limit beyond 180° is refused by key.
+    let bad = SC.replace(
+        "max_rate_deg_s = 2.0",
+        "max_rate_deg_s = 2.0\nmax_angle_deg = 200.0",
+    );
+    std::fs::write(&sc, bad).unwrap();
+    let o = inertia(&[
+        "plan",
+        "--spacecraft",
+        sc.to_str().unwrap(),
+        "-o",
+        d.path().join("bad.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("limits.max_angle_deg"),
+        "{}",
+        stderr(&o)
+    );
+}

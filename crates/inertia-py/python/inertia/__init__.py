@@ -941,8 +941,8 @@ def plan(
     ``relative_sigma`` (K,) the relative Frobenius σ; ``target_met_s`` (information
     matrix) and ``reported_target_met_s`` (rehearsal), s or None; ``rehearsal_t`` and
     ``rehearsal_relative_sigma`` (the median σ the estimator reported); ``margin``,
-    ``limit_use`` (``torque``, ``momentum``, ``rate``: the largest fraction of each limit
-    used), ``gap`` (the A-optimality gap of the design), ``chain_s`` (the chain the plan
+    ``limit_use`` (``torque``, ``momentum``, ``rate``, ``angle``: the largest fraction of
+    each limit used), ``gap`` (the A-optimality gap of the design), ``chain_s`` (the chain the plan
     assumes, s, or None) and ``chain_trials`` (with ``"auto"``: each chain tried and when
     its rehearsal reported the target, s or None). Raises ``ValueError`` naming the file
     and key for a file that lacks what a plan needs.

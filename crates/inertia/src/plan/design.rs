@@ -433,6 +433,7 @@ mod tests {
                 })
                 .collect(),
             max_rate_rad_s: Some(0.1),
+            max_angle_rad: None,
             margin: 0.9,
         }
     }

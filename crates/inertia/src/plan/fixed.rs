@@ -136,6 +136,7 @@ mod tests {
                 })
                 .collect(),
             max_rate_rad_s: Some(0.05),
+            max_angle_rad: None,
             margin: 0.9,
         };
         let j = Matrix3::from_diagonal(&Vector3::new(0.26, 0.26, 0.16));

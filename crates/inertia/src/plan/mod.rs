@@ -186,6 +186,7 @@ impl Vehicle {
             limits: Limits {
                 wheels,
                 max_rate_rad_s: sc.max_rate_deg_s.map(f64::to_radians),
+                max_angle_rad: sc.max_angle_deg.map(f64::to_radians),
                 margin: margin_for(r),
             },
             noise: NoiseModel {
@@ -295,7 +296,13 @@ pub(crate) fn plan_for_horizon(
         return Ok(None);
     }
     let design = design::design_over(atoms, j, &v.noise, p, s.estimator.chain_s, Some(horizon_s));
-    let (profile, order) = design::schedule(&design, p, s.max_duration_s);
+    let (mut profile, order) = design::schedule(&design, p, s.max_duration_s);
+    // Each manoeuvre keeps the angle limit alone and returns the rate to rest, but
+    // rotations do not commute: in sequence they may leave a net rotation that adds up.
+    // The whole plan is scaled down where it does.
+    if v.limits.max_angle_rad.is_some() && v.limits.use_of(&profile, j)?.worst() > v.limits.margin {
+        profile = profile.scaled(v.limits.scale_to_fit(&profile, j)?);
+    }
     let prediction = predict::predict(
         &profile,
         j,

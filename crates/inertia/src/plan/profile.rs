@@ -19,7 +19,7 @@
 //! of the profile with zero commands (its momentum is the final one). Reading needs only
 //! `t_s` and `rho_dot_*_nm`, evenly spaced; lines starting with `#` are comments.
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use std::format;
 use std::string::{String, ToString};
 use std::vec::Vec;
@@ -46,6 +46,9 @@ pub struct ProfileError {
     /// What is wrong.
     pub(crate) message: String,
 }
+
+/// Integration steps per command period of [`CommandProfile::max_angle_rad`].
+pub(crate) const ANGLE_SUBSTEPS: usize = 20;
 
 /// The body-axis command columns.
 pub(crate) const COLUMNS: [&str; 3] = ["rho_dot_x_nm", "rho_dot_y_nm", "rho_dot_z_nm"];
@@ -92,6 +95,28 @@ impl CommandProfile {
             out.push(rho);
         }
         out
+    }
+
+    /// The largest rotation of the body from its attitude at the start, rad, over the
+    /// profile flown from rest on the inertia whose inverse is `j_inv`
+    /// (`ω = −J⁻¹ρ`, [`super::limits`]). Within a command period `ρ`, hence `ω`, is
+    /// linear: the attitude is integrated in [`ANGLE_SUBSTEPS`] steps, each the rotation at
+    /// its midpoint rate (second order; 1e-6 of the angle at the rates of a plan).
+    #[must_use]
+    pub(crate) fn max_angle_rad(&self, j_inv: &Matrix3<f64>) -> f64 {
+        let dt = self.period_s / ANGLE_SUBSTEPS as f64;
+        let mut q = UnitQuaternion::identity();
+        let mut rho = Vector3::zeros();
+        let mut worst: f64 = 0.0;
+        for c in &self.torque_nm {
+            for i in 0..ANGLE_SUBSTEPS {
+                let mid = rho + c * (dt * (i as f64 + 0.5));
+                q *= UnitQuaternion::from_scaled_axis(-(j_inv * mid) * dt);
+                worst = worst.max(q.angle());
+            }
+            rho += c * self.period_s;
+        }
+        worst
     }
 
     /// Every command times `s`.

@@ -210,6 +210,7 @@ mod tests {
                     })
                     .collect(),
                 max_rate_rad_s: None,
+                max_angle_rad: None,
                 margin: 0.77,
             },
             noise: NoiseModel {
@@ -280,6 +281,7 @@ mod tests {
                     })
                     .collect(),
                 max_rate_rad_s: None,
+                max_angle_rad: None,
                 margin: 0.77,
             },
             noise: NoiseModel {

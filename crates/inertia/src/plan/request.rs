@@ -200,6 +200,7 @@ mod tests {
                     })
                     .collect(),
                 max_rate_rad_s: None,
+                max_angle_rad: None,
                 margin: 0.77,
             },
             noise: NoiseModel {

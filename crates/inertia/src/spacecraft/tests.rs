@@ -127,6 +127,7 @@ controller_hz = 1.0
 
 [limits]
 max_rate_deg_s = 5.0
+max_angle_deg = 20.0
 "#;
 
 #[test]
@@ -144,6 +145,7 @@ fn the_plan_keys_are_read() {
         (10.0, 1.0, 0.0)
     );
     assert_eq!(s.max_rate_deg_s, Some(5.0));
+    assert_eq!(s.max_angle_deg, Some(20.0));
     // The files without them read as before.
     let g = Spacecraft::parse(GOOD, "sc.toml").unwrap();
     assert!(g.prior.is_none() && g.sensors.is_none() && g.max_rate_deg_s.is_none());
@@ -182,6 +184,18 @@ fn bad_plan_keys_are_refused_with_line_and_key() {
             "max_rate_deg_s = nan",
             20,
             "limits.max_rate_deg_s",
+        ),
+        (
+            "max_angle_deg = 20.0",
+            "max_angle_deg = 181.0",
+            21,
+            "limits.max_angle_deg",
+        ),
+        (
+            "max_angle_deg = 20.0",
+            "max_angle_deg = -1.0",
+            21,
+            "limits.max_angle_deg",
         ),
         ("relative_sigma = 0.1", "", 11, "prior"),
     ];
