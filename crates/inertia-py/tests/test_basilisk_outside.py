@@ -108,6 +108,7 @@ def test_outside_columns_follow_basilisks_frames():
     t = np.arange(n) * 100_000_000
     for kw, msg in [
         (dict(mtb_dipoles=m), "mtb_axes_B"),
+        (dict(B_N=b_n, mtb_dipoles=m.T[:2], mtb_axes_B=rods), "mtb_dipoles"),
         (dict(dipole_B=m), "needs the field"),
         (dict(B_B=b_n, B_N=b_n), "one frame"),
         (dict(thruster_forces_B=forces), "thruster_locations_B"),

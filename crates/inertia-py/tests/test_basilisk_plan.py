@@ -113,7 +113,9 @@ def test_a_plan_flown_in_basilisk_meets_its_target_and_its_prediction(cli, tmp_p
     wheels = [
         {"name": f"rw{i + 1}", "axis": list(np.eye(3)[i]), "js": 1.0e-4} for i in range(3)
     ]
-    run_cli(cli, "plan", "--spacecraft", sc, "-o", tmp_path / "plan.csv")
+    out = run_cli(cli, "plan", "--spacecraft", sc, "-o", tmp_path / "plan.csv").stdout
+    # The flight is estimated with the chain the plan names.
+    chain = out.split("estimate with --chain ")[1].split()[0]
     flight = fly_in_basilisk(tmp_path / "plan.csv", wheels)
 
     # The export's convention: Basilisk's wheel momenta follow the plan's. The plan's is
@@ -140,7 +142,7 @@ def test_a_plan_flown_in_basilisk_meets_its_target_and_its_prediction(cli, tmp_p
         d = dict(base, w=w, q=propagate(base["q"][0], w, np.diff(base["t"])))
         bsk.to_csv(tmp_path / "flight.csv", d)
         r = cli_estimate(cli, tmp_path / "flight.csv", "--spacecraft", sc,
-                         "--gyro-noise", "0.00573")
+                         "--gyro-noise", "0.00573", "--chain", chain)
         J, s = np.array(r["inertia"]), np.array(r["sigma"])
         err = np.array([J[i] - TRUE_J[i] for i in ELEMENTS])
         inside += bool(np.all(np.abs(err) <= 3.0 * s))

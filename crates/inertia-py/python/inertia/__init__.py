@@ -928,7 +928,7 @@ def plan(
     ``max_momentum_nms``, with ``[prior]``, ``[sensors]`` and optionally ``[limits]``.
     ``target`` is the relative Frobenius error at 3σ; ``duration`` (s) flies that long
     instead; ``chain`` is the estimator's short momentum chain (s, ``None``: none), or
-    ``"auto"`` (default): the plans for chains of 30, 60 and 120 s are rehearsed and the
+    ``0`` as ``None``, or ``"auto"`` (default): the plans for chains of 30, 60 and 120 s are rehearsed and the
     chain whose rehearsal reports the target soonest is kept (returned as ``chain_s``:
     give it to ``estimate(..., chain=...)`` for the flight, 0 for None);
     ``rehearsals`` flights of the estimator on the prior J decide, with the information
@@ -953,6 +953,7 @@ def plan(
     return _inertia.plan(
         os.fspath(spacecraft), float(target),
         None if duration is None else float(duration), float(max_duration),
-        None if (choose or chain is None) else float(chain), choose, int(rehearsals),
+        None if (choose or chain is None or float(chain) == 0.0) else float(chain), choose,
+        int(rehearsals),
         float(disturbance),
     )

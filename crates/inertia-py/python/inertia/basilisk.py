@@ -368,7 +368,9 @@ def from_basilisk(
             raise ValueError("mtb_dipoles: needs mtb_axes_B (each rod's axis, body axes)")
         axes = np.atleast_2d(np.asarray(mtb_axes_B, dtype=float))
         axes = _array("mtb_axes_B", axes, (3,))
-        m = np.asarray(mtb_dipoles, dtype=float).reshape(n, axes.shape[0])
+        m = np.asarray(mtb_dipoles, dtype=float)
+        if m.ndim == 1 and axes.shape[0] == 1:
+            m = m[:, None]
         dipole = _array("mtb_dipoles", m, (axes.shape[0],), n) @ axes
     elif mtb_axes_B is not None:
         raise ValueError("mtb_axes_B: given without mtb_dipoles")
@@ -431,7 +433,9 @@ def cell_means(times, fine_times, fine_values, *, time_unit: str = "ns") -> np.n
     actuators at the dynamics rate (``fine_times`` (M,), ``fine_values`` (M, ...)) and
     pass their mean over ``[(t_{k−1} + t_k)/2, (t_k + t_{k+1})/2]`` (the first and last
     cells end at the first and last sample): the integral of the recording's linear
-    interpolant, exact for a recording fine enough to resolve each edge."""
+    interpolant, exact for a piecewise-linear recording. A recording of a signal held
+    between its steps (Basilisk's messages) reads as ramping over one fine step at each
+    edge: each edge's impulse is placed to half a fine step."""
     t = _seconds(times, time_unit)
     tf = _seconds(fine_times, time_unit)
     v = np.asarray(fine_values, dtype=float)
@@ -511,8 +515,13 @@ def spacecraft_toml(
     ``Js · Omega_max``)."""
     Js = np.atleast_1d(np.asarray(Js, dtype=float))
     n_wheels = Js.shape[0]
+    if Js.ndim != 1 or not np.all(np.isfinite(Js)) or not np.all(Js > 0):
+        raise ValueError(f"Js: spin inertias must be a 1-D array of finite values > 0, got {Js}")
     gs = _array("gs_B", np.atleast_2d(gs_B), (3,), n_wheels)
-    gs = gs / np.linalg.norm(gs, axis=1)[:, None]
+    norms = np.linalg.norm(gs, axis=1)
+    if np.any(np.abs(norms - 1.0) > 1e-3):
+        raise ValueError(f"gs_B: spin axes must be unit vectors (norms {norms})")
+    gs = gs / norms[:, None]
     names = _wheel_names(wheel_names, n_wheels)
 
     def per_wheel(name, value):

@@ -41,8 +41,6 @@ pub mod rotor_inertia;
 pub mod rows;
 pub(crate) mod shared_qr;
 pub mod svd_tracker;
-#[cfg(feature = "std")]
-pub(crate) mod torque_scale;
 pub(crate) mod trend_slot;
 pub mod uncertainty;
 pub(crate) mod unknowns;

@@ -44,8 +44,9 @@ pub struct Uncertainty {
     /// Its consider part from the rotors' spin-inertia σ of a spacecraft file, kg m² (zero
     /// unless given, `Uncertainty::with_rotor_inertia`).
     pub rotor_inertia_kg_m2: [f64; 6],
-    /// Its consider part from the known torque's stated scale σ, `r |ĵ_τ|`, kg m² (zero
-    /// unless given, `Uncertainty::with_torque_scale`; [`crate::pipeline::PipelineSettings::torque_scale_sigma`]).
+    /// Its consider part from the known torque's stated scale σ `r`: the move of `ĵ` for
+    /// the known torque scaled by `1 + r`, kg m² (zero unless given,
+    /// `Uncertainty::with_torque_scale`; [`crate::pipeline::PipelineSettings::torque_scale_sigma`]).
     pub torque_scale_kg_m2: [f64; 6],
     /// Standard deviation of the principal moments (ascending, like
     /// [`crate::tensor::principal`]), kg m².
@@ -109,7 +110,7 @@ impl Uncertainty {
     }
 
     /// This σ widened by the known torque's scale consider term `c` per element, kg m²
-    /// (`crate::estimator::torque_scale`): `√(σ² + c²)`, propagated to the principal
+    /// (a run's, `Run::torque_scale_term`): `√(σ² + c²)`, propagated to the principal
     /// moments of `j` as [`with_bias`] does.
     #[must_use]
     pub(crate) fn with_torque_scale(&self, j: &InertiaVector, c: &[f64; 6]) -> Uncertainty {

@@ -159,7 +159,7 @@ pub fn shift_rho(samples: &mut [Sample], delay_s: f64) {
 /// The stretches of samples between gaps ([`crate::sample::is_gap`]), first and last
 /// index of each: a time tag reads the speeds within a stretch, never across a gap (as
 /// between the records of a run).
-pub(crate) fn segments(t: &[f64]) -> Vec<(usize, usize)> {
+fn segments(t: &[f64]) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
     let mut start = 0;
     for k in 2..t.len() {
@@ -212,14 +212,9 @@ fn interpolate_from(t: &[f64], rho: &[Vector3<f64>], k: usize, x: f64) -> (Vecto
 
 /// A stretch of rows to fit: its first and last sample, and the first and last sample of
 /// the stretch between gaps that holds it ([`segments`]).
-pub(crate) type Window = (usize, usize, usize, usize);
+type Window = (usize, usize, usize, usize);
 
-pub(crate) fn rows(
-    samples: &[Sample],
-    windows: &[Window],
-    delay_s: f64,
-    outside: &OutsideTorques,
-) -> Rows {
+fn rows(samples: &[Sample], windows: &[Window], delay_s: f64, outside: &OutsideTorques) -> Rows {
     let t: Vec<f64> = samples.iter().map(|s| s.t_s).collect();
     let rho: Vec<Vector3<f64>> = samples.iter().map(|s| s.rho_nms).collect();
     let mut out = Rows {

@@ -47,7 +47,7 @@ pub struct PipelineConfig {
     /// spacecraft file has computed it ([`crate::estimator::rotor_inertia`]).
     pub(crate) rotor_inertia_consider: Option<[f64; 6]>,
     /// The known torque's scale consider term per element, kg m², once a run has computed
-    /// it for its final answer (`crate::estimator::torque_scale`).
+    /// it for its final answer (`Run::torque_scale_term`).
     pub(crate) torque_scale_consider: Option<[f64; 6]>,
     /// `√Σ_i s_i²` of a spacecraft file's rotors' relative spin-inertia σ (0 without).
     pub(crate) rotor_inertia_relative_sigma: f64,

@@ -128,6 +128,8 @@ pub struct Run {
     calibration_not_made: Option<crate::estimator::rotor_calibration::NotMade>,
     /// Several records ([`Self::next_record`]).
     records: records::Records,
+    /// Whether any sample carried a known torque (for the torque scale's term).
+    known_torque: bool,
 }
 
 impl core::fmt::Debug for Run {
@@ -187,6 +189,7 @@ impl Run {
             calibration: None,
             calibration_not_made: None,
             records: records::Records::default(),
+            known_torque: false,
         })
     }
 
@@ -399,6 +402,7 @@ impl Run {
         self.recent.push_back((s.t_s, index));
         self.input += 1;
         self.speeds.push(&s.rho_nms);
+        self.known_torque |= s.tau_nm.iter().any(|&x| x != 0.0);
         self.gyro_range.push(s);
         if let Some(held) = &mut self.held {
             held.push(*s);
@@ -497,11 +501,22 @@ impl Run {
             }
         }
         // Streaming: the last answer, widened by the held speeds' lag term (speeds held, no
-        // time tag) and the known torque's scale term over the samples kept, is given once
-        // more.
-        if let Some(kept) = self.kept.take() {
-            let (lag, scale) = (self.held_lag_term(&kept), self.torque_scale_term(&kept));
-            if let (true, Mode::Streaming(p)) = (lag.is_some() || scale.is_some(), &mut self.mode) {
+        // time tag) and the known torque's scale term over the samples kept (without them,
+        // its fallback on the last answer), is given once more.
+        let streaming = matches!(self.mode, Mode::Streaming(_));
+        let kept = self.kept.take();
+        let (lag, scale) = match (&kept, &self.mode) {
+            (Some(kept), _) => (self.held_lag_term(kept), self.torque_scale_term(kept)),
+            (None, Mode::Streaming(p)) => (
+                None,
+                p.last()
+                    .and_then(|e| e.j())
+                    .and_then(|j| self.torque_scale_fallback(&j)),
+            ),
+            _ => (None, None),
+        };
+        if streaming && (lag.is_some() || scale.is_some()) {
+            if let Mode::Streaming(p) = &mut self.mode {
                 if let Some(e) = p.widen_last(lag, scale) {
                     if lag.is_some() {
                         self.config.wheel_delay_consider = lag;

@@ -46,9 +46,10 @@ pub struct PipelineSettings {
     pub rotor_scale_sigma: Option<f64>,
     /// Relative standard deviation of the known torque's scale (`tau_*`, a spacecraft
     /// file's thrusters, commanded magnetorquer dipoles: a thrust or a dipole known to
-    /// ±this): a consider parameter that widens σ by `this · |ĵ_τ|` per element, `ĵ_τ` the
-    /// part of the answer the known torque sets (`crate::estimator::torque_scale`), in a
-    /// run's final answer. `None` (default): the known torque taken as exact.
+    /// ±this): a consider parameter that widens the final answer's σ of a run by the move
+    /// of `ĵ` for the known torque (and force) scaled by `1 + this` (`Run`'s batch
+    /// re-solve, pinned to the row model; `this · |ĵ|` where a streaming run could not
+    /// keep its samples). `None` (default): the known torque taken as exact.
     pub torque_scale_sigma: Option<f64>,
     /// The low-pass cutoff, Hz, of an estimator that differentiates filtered signals (the
     /// equation-error baseline). `None` (default): the estimator's own default.

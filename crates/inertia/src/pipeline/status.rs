@@ -110,7 +110,7 @@ pub(crate) fn physical_margin(e: &Estimate) -> Option<PhysicalMargin> {
 /// wheel-speed time tag's consider term where one was applied
 /// ([`crate::estimator::wheel_delay`]), the rotors' spin-inertia term of a spacecraft file
 /// ([`crate::estimator::rotor_inertia`]), the known torque's scale term where a run has
-/// computed one (`crate::estimator::torque_scale`), the rotor scale's where one is given
+/// computed one (`Run::torque_scale_term`), the rotor scale's where one is given
 /// ([`widen_for_rotor_scale`]), then [`settle`].
 pub(crate) fn apply(e: &mut Estimate, config: &PipelineConfig) {
     let threshold = config.observability.max_relative_sigma;

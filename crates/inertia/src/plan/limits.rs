@@ -237,13 +237,32 @@ impl Limits {
         }
         let mut s = self.margin / worst;
         if self.max_angle_rad.is_some() {
-            for _ in 0..20 {
-                let used = self.use_of(&profile.scaled(s), j_kg_m2)?.worst();
-                if used <= self.margin && used >= self.margin * (1.0 - 1e-6) {
-                    break;
+            let fits = |s: f64| -> Result<f64, LimitsError> {
+                Ok(self.use_of(&profile.scaled(s), j_kg_m2)?.worst())
+            };
+            // Secant steps from the linear guess, then bisection between a scale that fits
+            // and one that does not: the result always fits.
+            let (mut lo, mut hi) = (0.0, f64::INFINITY);
+            for _ in 0..60 {
+                let used = fits(s)?;
+                if used <= self.margin {
+                    lo = s;
+                    if used >= self.margin * (1.0 - 1e-6) {
+                        break;
+                    }
+                } else {
+                    hi = s;
                 }
-                s *= self.margin * (1.0 - 1e-7) / used;
+                let next = s * self.margin * (1.0 - 1e-7) / used;
+                s = if next > lo && next < hi {
+                    next
+                } else if hi.is_finite() {
+                    0.5 * (lo + hi)
+                } else {
+                    2.0 * s
+                };
             }
+            s = lo;
         }
         Ok(s)
     }

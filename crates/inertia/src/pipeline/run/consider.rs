@@ -2,8 +2,9 @@
 //! wheel speeds' lag and the known torque's scale (book, "Status and uncertainty").
 
 use super::Run;
-use crate::estimator::{torque_scale, wheel_delay};
+use crate::estimator::wheel_delay;
 use crate::sample::Sample;
+use std::vec::Vec;
 
 impl Run {
     /// The held speeds' lag term over `samples` (`wheel_delay::held_lag_move` at their
@@ -14,11 +15,50 @@ impl Run {
         wheel_delay::held_lag_move(samples, &self.config.outside, lag_s)
     }
 
-    /// The known torque's scale term over `samples`
-    /// (`torque_scale::torque_scale_move`), where its σ is given and the samples carry a
-    /// known torque.
+    /// The known torque's scale term over `samples`, where its σ `r` is given and the
+    /// samples carry a known torque: `|ĵ((1 + r) τ, (1 + r) F) − ĵ(τ, F)|` per element,
+    /// the run's batch solve of the samples as given and again with the known torque and
+    /// the force scaled, pinned to the row model the first chose (as the rotors' consider
+    /// term is, `rotor_inertia`), so that it measures the answer's sensitivity rather
+    /// than a switch of model. `None` where either solve gives no J.
     pub(super) fn torque_scale_term(&self, samples: &[Sample]) -> Option<[f64; 6]> {
         let r = self.config.torque_scale_sigma?;
-        torque_scale::torque_scale_move(samples, &self.config.outside, r)
+        if !(r > 0.0) || !samples.iter().any(|s| s.tau_nm.iter().any(|&x| x != 0.0)) {
+            return None;
+        }
+        let mut config = self.config.with_delay_applied();
+        config.calibrate_rotors = false;
+        let starts = self.records.starts.clone();
+        let first = crate::pipeline::batch_of_records(samples, &config, &starts).ok()?;
+        let j0 = first.estimate.j()?;
+        let pinned = config.pinned_to(first.diagnostics.row_model, first.diagnostics.torque_test);
+        let scaled: Vec<Sample> = samples
+            .iter()
+            .map(|s| {
+                let mut x = *s;
+                x.tau_nm *= 1.0 + r;
+                x.external.force_n = s.external.force_n.map(|f| f * (1.0 + r));
+                x
+            })
+            .collect();
+        let j1 = crate::pipeline::batch_of_records(&scaled, &pinned, &starts)
+            .ok()?
+            .estimate
+            .j()?;
+        let out: [f64; 6] = core::array::from_fn(|k| (j1[k] - j0[k]).abs());
+        out.iter().all(|x| x.is_finite()).then_some(out)
+    }
+
+    /// Where a streaming run could not keep its samples (a memory, or more than it keeps)
+    /// but saw a known torque: the term taken as `r |ĵ|` of its last answer, the whole
+    /// answer's scale (the known torque's share of it where no wheel moves, more than it
+    /// otherwise), never none.
+    pub(super) fn torque_scale_fallback(
+        &self,
+        j: &crate::tensor::InertiaVector,
+    ) -> Option<[f64; 6]> {
+        let r = self.config.torque_scale_sigma.filter(|&r| r > 0.0)?;
+        self.known_torque
+            .then(|| core::array::from_fn(|k| (r * j[k]).abs()))
     }
 }
