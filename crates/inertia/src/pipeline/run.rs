@@ -500,32 +500,7 @@ impl Run {
                 self.apply_rotor_consider(&taken);
             }
         }
-        // Streaming: the last answer, widened by the held speeds' lag term (speeds held, no
-        // time tag) and the known torque's scale term over the samples kept (without them,
-        // its fallback on the last answer), is given once more.
-        let streaming = matches!(self.mode, Mode::Streaming(_));
-        let kept = self.kept.take();
-        let (lag, scale) = match (&kept, &self.mode) {
-            (Some(kept), _) => (self.held_lag_term(kept), self.torque_scale_term(kept)),
-            (None, Mode::Streaming(p)) => (
-                None,
-                p.last()
-                    .and_then(|e| e.j())
-                    .and_then(|j| self.torque_scale_fallback(&j)),
-            ),
-            _ => (None, None),
-        };
-        if streaming && (lag.is_some() || scale.is_some()) {
-            if let Mode::Streaming(p) = &mut self.mode {
-                if let Some(e) = p.widen_last(lag, scale) {
-                    if lag.is_some() {
-                        self.config.wheel_delay_consider = lag;
-                    }
-                    self.config.torque_scale_consider = scale;
-                    on_estimate(&e);
-                }
-            }
-        }
+        self.widen_streaming_last(&mut on_estimate);
         match &mut self.mode {
             Mode::Streaming(p) => match p.last() {
                 Some(_) => Ok(()),

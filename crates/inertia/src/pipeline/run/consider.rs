@@ -1,8 +1,9 @@
 //! The final answer's consider terms computed over the samples a run keeps: the held
 //! wheel speeds' lag and the known torque's scale (book, "Status and uncertainty").
 
-use super::Run;
+use super::{Mode, Run};
 use crate::estimator::wheel_delay;
+use crate::estimator::Estimate;
 use crate::sample::Sample;
 use std::vec::Vec;
 
@@ -60,5 +61,35 @@ impl Run {
         let r = self.config.torque_scale_sigma.filter(|&r| r > 0.0)?;
         self.known_torque
             .then(|| core::array::from_fn(|k| (r * j[k]).abs()))
+    }
+
+    /// Streaming: the last answer, widened by the final consider terms, given once more.
+    pub(super) fn widen_streaming_last(&mut self, on_estimate: &mut impl FnMut(&Estimate)) {
+        // Streaming: the last answer, widened by the held speeds' lag term (speeds held, no
+        // time tag) and the known torque's scale term over the samples kept (without them,
+        // its fallback on the last answer), is given once more.
+        let streaming = matches!(self.mode, Mode::Streaming(_));
+        let kept = self.kept.take();
+        let (lag, scale) = match (&kept, &self.mode) {
+            (Some(kept), _) => (self.held_lag_term(kept), self.torque_scale_term(kept)),
+            (None, Mode::Streaming(p)) => (
+                None,
+                p.last()
+                    .and_then(|e| e.j())
+                    .and_then(|j| self.torque_scale_fallback(&j)),
+            ),
+            _ => (None, None),
+        };
+        if streaming && (lag.is_some() || scale.is_some()) {
+            if let Mode::Streaming(p) = &mut self.mode {
+                if let Some(e) = p.widen_last(lag, scale) {
+                    if lag.is_some() {
+                        self.config.wheel_delay_consider = lag;
+                    }
+                    self.config.torque_scale_consider = scale;
+                    on_estimate(&e);
+                }
+            }
+        }
     }
 }
