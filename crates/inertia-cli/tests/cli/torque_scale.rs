@@ -1,7 +1,8 @@
 //! `--torque-scale-sigma`: the known torque's stated scale σ in the final answer's σ
-//! (`inertia::estimator::torque_scale`). A thruster whose thrust is off by 5 %: without
-//! wheels J scales with it exactly, no residual sees it, and only the stated σ covers it;
-//! with wheels the term is the small part of J the torque sets.
+//! (`Run::torque_scale_term`: the batch re-solved with the known torque scaled). A
+//! thruster whose thrust is off by 5 %: without wheels J scales with it exactly, no
+//! residual sees it, and only the stated σ covers it; with wheels the term is the small
+//! part of J the torque sets, and the move such an error makes.
 
 use super::{inertia, json, stderr};
 use std::path::Path;
