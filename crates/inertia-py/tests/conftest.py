@@ -1,5 +1,6 @@
 """Shared fixtures: the command-line tool (to compare against) and simulated files."""
 
+import importlib.util
 import json
 import os
 import pathlib
@@ -8,6 +9,41 @@ import subprocess
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
+
+
+def load_basilisk_converter():
+    """``inertia/basilisk.py`` imported by path: it is pure numpy, so its tests need not
+    build the package."""
+    path = pathlib.Path(__file__).resolve().parents[1] / "python" / "inertia" / "basilisk.py"
+    spec = importlib.util.spec_from_file_location("inertia_basilisk", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def basilisk_wheels(sim, sc, axes, spin_inertias):
+    """Basilisk's balanced reaction wheels at B on spacecraft ``sc`` (one per axis and spin
+    inertia, at rest), in task ``"task"`` after the hub, commanded through one
+    ``ArrayMotorTorqueMsg``: returns the effector, the command payload and its message."""
+    from Basilisk.architecture import messaging
+    from Basilisk.simulation import reactionWheelStateEffector
+    from Basilisk.utilities import simIncludeRW
+
+    factory = simIncludeRW.rwFactory()
+    for g, js in zip(axes, spin_inertias):
+        factory.create("custom", [float(x) for x in g], Js=float(js), Omega=0.0,
+                       RWModel=messaging.BalancedWheels, rWB_B=[0.0, 0.0, 0.0],
+                       useMaxTorque=False)
+    rw = reactionWheelStateEffector.ReactionWheelStateEffector()
+    rw.ModelTag = "rw"
+    factory.addToSpacecraft("rw", rw, sc)
+    cmd = messaging.ArrayMotorTorqueMsgPayload()
+    cmd.motorTorque = [0.0] * 36
+    msg = messaging.ArrayMotorTorqueMsg().write(cmd)
+    rw.rwMotorCmdInMsg.subscribeTo(msg)
+    sim.AddModelToTask("task", rw, 2)
+    sim.AddModelToTask("task", sc, 1)
+    return rw, cmd, msg
 
 
 @pytest.fixture(scope="session")

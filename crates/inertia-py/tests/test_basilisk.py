@@ -10,7 +10,6 @@ needs ``pip install bsk``. Each is skipped, saying why, without them.
 """
 
 import functools
-import importlib.util
 import json
 import os
 import pathlib
@@ -19,13 +18,11 @@ import subprocess
 import numpy as np
 import pytest
 
+from conftest import basilisk_wheels, load_basilisk_converter
+
 HERE = pathlib.Path(__file__).resolve().parent
 REPO = HERE.parents[2]
-_spec = importlib.util.spec_from_file_location(
-    "inertia_basilisk", HERE.parent / "python" / "inertia" / "basilisk.py"
-)
-bsk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bsk)
+bsk = load_basilisk_converter()
 
 
 # ---------------------------------------------------------------- reference formulas
@@ -387,9 +384,8 @@ def basilisk_run(duration=120.0):
     """A tumbling spacecraft with three custom balanced reaction wheels whose motor
     torques change every 4 s; recorded at 10 Hz, with Basilisk's own total angular
     momentum."""
-    from Basilisk.architecture import messaging
-    from Basilisk.simulation import reactionWheelStateEffector, spacecraft
-    from Basilisk.utilities import SimulationBaseClass, macros, simIncludeRW
+    from Basilisk.simulation import spacecraft
+    from Basilisk.utilities import SimulationBaseClass, macros
 
     sim = SimulationBaseClass.SimBaseClass()
     proc = sim.CreateNewProcess("dyn")
@@ -401,21 +397,7 @@ def basilisk_run(duration=120.0):
     sc.hub.IHubPntBc_B = I_SC.tolist()
     sc.hub.sigma_BNInit = [[0.3], [-0.2], [0.5]]
     sc.hub.omega_BN_BInit = [[0.05], [-0.03], [0.08]]
-    factory = simIncludeRW.rwFactory()
-    for g, js in zip(GS, JS):
-        factory.create(
-            "custom", [float(x) for x in g], Js=float(js), Omega=0.0,
-            RWModel=messaging.BalancedWheels, rWB_B=[0.0, 0.0, 0.0], useMaxTorque=False,
-        )
-    rw = reactionWheelStateEffector.ReactionWheelStateEffector()
-    rw.ModelTag = "rw"
-    factory.addToSpacecraft("rw", rw, sc)
-    cmd = messaging.ArrayMotorTorqueMsgPayload()
-    cmd.motorTorque = [0.0] * 36
-    cmd_msg = messaging.ArrayMotorTorqueMsg().write(cmd)
-    rw.rwMotorCmdInMsg.subscribeTo(cmd_msg)
-    sim.AddModelToTask("task", rw, 2)
-    sim.AddModelToTask("task", sc, 1)
+    rw, cmd, cmd_msg = basilisk_wheels(sim, sc, GS, JS)
     rec_sc = sc.scStateOutMsg.recorder(macros.sec2nano(0.1))
     rec_rw = rw.rwSpeedOutMsg.recorder(macros.sec2nano(0.1))
     log = sc.logger(["totRotAngMomPntC_N"], macros.sec2nano(0.1))

@@ -8,20 +8,12 @@ converter's own arithmetic is checked first against Basilisk's formulas without 
 The Basilisk tests need ``pip install bsk`` and are skipped, saying why, without it.
 """
 
-import importlib.util
-import pathlib
-
 import numpy as np
 import pytest
 
-from conftest import cli_estimate, run_cli
+from conftest import basilisk_wheels, cli_estimate, load_basilisk_converter, run_cli
 
-HERE = pathlib.Path(__file__).resolve().parent
-_spec = importlib.util.spec_from_file_location(
-    "inertia_basilisk_outside", HERE.parent / "python" / "inertia" / "basilisk.py"
-)
-bsk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bsk)
+bsk = load_basilisk_converter()
 
 # The spacecraft: total inertia about its centre of mass (Basilisk's IHubPntBc_B with
 # balanced wheels), a four-wheel pyramid at 35.26° from +z.
@@ -162,10 +154,10 @@ def basilisk_flight(*, seed, duration=600.0, gravity_gradient=True, magnetorquer
     every 4 s (recorded at the dynamics rate, with the centre of mass off B)."""
     from Basilisk.architecture import messaging
     from Basilisk.simulation import (GravityGradientEffector, MtbEffector,
-                                     magneticFieldCenteredDipole, reactionWheelStateEffector,
+                                     magneticFieldCenteredDipole,
                                      spacecraft, thrusterDynamicEffector)
     from Basilisk.utilities import (SimulationBaseClass, macros, orbitalMotion,
-                                    simIncludeGravBody, simIncludeRW, simIncludeThruster,
+                                    simIncludeGravBody, simIncludeThruster,
                                     simSetPlanetEnvironment)
 
     ns = macros.sec2nano
@@ -186,20 +178,7 @@ def basilisk_flight(*, seed, duration=600.0, gravity_gradient=True, magnetorquer
     sc.hub.r_CN_NInit, sc.hub.v_CN_NInit = orbitalMotion.elem2rv(earth.mu, oe)
     sc.hub.sigma_BNInit = [[0.1], [0.2], [-0.1]]
     sc.hub.omega_BN_BInit = [[0.01], [-0.02], [0.015]]
-    factory = simIncludeRW.rwFactory()
-    for g, js in zip(GS, JS):
-        factory.create("custom", [float(x) for x in g], Js=float(js), Omega=0.0,
-                       RWModel=messaging.BalancedWheels, rWB_B=[0.0, 0.0, 0.0],
-                       useMaxTorque=False)
-    rw = reactionWheelStateEffector.ReactionWheelStateEffector()
-    rw.ModelTag = "rw"
-    factory.addToSpacecraft("rw", rw, sc)
-    rw_cmd = messaging.ArrayMotorTorqueMsgPayload()
-    rw_cmd.motorTorque = [0.0] * 36
-    rw_msg = messaging.ArrayMotorTorqueMsg().write(rw_cmd)
-    rw.rwMotorCmdInMsg.subscribeTo(rw_msg)
-    sim.AddModelToTask("task", rw, 2)
-    sim.AddModelToTask("task", sc, 1)
+    rw, rw_cmd, rw_msg = basilisk_wheels(sim, sc, GS, JS)
     recorders = {}
     if gravity_gradient:
         gg = GravityGradientEffector.GravityGradientEffector()

@@ -8,20 +8,13 @@ true J. Needs ``pip install bsk`` (skipped, saying why, without it).
 """
 
 import csv
-import importlib.util
-import pathlib
 
 import numpy as np
 import pytest
 
-from conftest import REPO, cli_estimate, run_cli
+from conftest import REPO, basilisk_wheels, cli_estimate, load_basilisk_converter, run_cli
 
-HERE = pathlib.Path(__file__).resolve().parent
-_spec = importlib.util.spec_from_file_location(
-    "inertia_basilisk_plan", HERE.parent / "python" / "inertia" / "basilisk.py"
-)
-bsk = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bsk)
+bsk = load_basilisk_converter()
 
 TRUE_J = np.diag([0.26, 0.26, 0.16])
 GYRO_RAD_S_RTHZ = 1e-4  # the file's 0.00573 deg/s/√Hz
@@ -38,9 +31,8 @@ def read_table(path):
 def fly_in_basilisk(plan_csv, wheels):
     """Each row's per-wheel motor torque held until the next row (``ArrayMotorTorqueMsg``,
     in the file's wheel order), on the true J from rest; recorded at the telemetry rate."""
-    from Basilisk.architecture import messaging
-    from Basilisk.simulation import reactionWheelStateEffector, spacecraft
-    from Basilisk.utilities import SimulationBaseClass, macros, simIncludeRW
+    from Basilisk.simulation import spacecraft
+    from Basilisk.utilities import SimulationBaseClass, macros
 
     header, table = read_table(plan_csv)
     torque = table[:, [header.index(f"{w['name']}_torque_nm") for w in wheels]]
@@ -53,20 +45,8 @@ def fly_in_basilisk(plan_csv, wheels):
     sc.hub.mHub = 24.0
     sc.hub.IHubPntBc_B = TRUE_J.tolist()
     sc.hub.sigma_BNInit = [[0.1], [-0.2], [0.3]]
-    factory = simIncludeRW.rwFactory()
-    for w in wheels:
-        factory.create("custom", w["axis"], Js=w["js"], Omega=0.0,
-                       RWModel=messaging.BalancedWheels, rWB_B=[0.0, 0.0, 0.0],
-                       useMaxTorque=False)
-    rw = reactionWheelStateEffector.ReactionWheelStateEffector()
-    rw.ModelTag = "rw"
-    factory.addToSpacecraft("rw", rw, sc)
-    cmd = messaging.ArrayMotorTorqueMsgPayload()
-    cmd.motorTorque = [0.0] * 36
-    msg = messaging.ArrayMotorTorqueMsg().write(cmd)
-    rw.rwMotorCmdInMsg.subscribeTo(msg)
-    sim.AddModelToTask("task", rw, 2)
-    sim.AddModelToTask("task", sc, 1)
+    rw, cmd, msg = basilisk_wheels(sim, sc, [w["axis"] for w in wheels],
+                                   [w["js"] for w in wheels])
     rec_sc = sc.scStateOutMsg.recorder(ns(TELEMETRY_S))
     rec_rw = rw.rwSpeedOutMsg.recorder(ns(TELEMETRY_S))
     sim.AddModelToTask("task", rec_sc)

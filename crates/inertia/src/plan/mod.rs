@@ -492,3 +492,38 @@ pub fn fixed_profiles(
     }
     Ok(out)
 }
+
+/// A test spacecraft as the peer's (`satellite-inertia-id`): prior `prior_kg_m2`, three
+/// orthogonal wheels of `torque_nm` and `momentum_nms`, its gyro (1e-4 rad/s/√Hz), 10 Hz
+/// telemetry, 1 Hz commands, margin 0.77.
+#[cfg(test)]
+pub(crate) fn peer_vehicle(
+    prior_kg_m2: Matrix3<f64>,
+    torque_nm: f64,
+    momentum_nms: f64,
+) -> Vehicle {
+    Vehicle {
+        prior_kg_m2,
+        prior_sigma_kg_m2: None,
+        limits: Limits {
+            wheels: (0..3)
+                .map(|i| Wheel {
+                    name: std::format!("rw{i}"),
+                    axis: nalgebra::Vector3::ith(i, 1.0),
+                    max_torque_nm: torque_nm,
+                    max_momentum_nms: momentum_nms,
+                })
+                .collect(),
+            max_rate_rad_s: None,
+            max_angle_rad: None,
+            margin: 0.77,
+        },
+        noise: NoiseModel {
+            gyro_rad_s_rthz: 1e-4,
+            wheel_nms: 0.0,
+            telemetry_period_s: 0.1,
+        },
+        controller_period_s: 1.0,
+        rotor_relative_sigma: 0.0,
+    }
+}

@@ -190,37 +190,13 @@ pub(crate) fn rehearse(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::limits::{Limits, Wheel};
-    use crate::plan::predict::NoiseModel;
     use crate::plan::{plan, PlanSettings};
 
     fn sat1() -> Vehicle {
-        Vehicle {
-            prior_kg_m2: Matrix3::new(
-                0.28, 0.0045, -0.0045, 0.0045, 0.244, 0.0045, -0.0045, 0.0045, 0.168,
-            ),
-            prior_sigma_kg_m2: None,
-            limits: Limits {
-                wheels: (0..3)
-                    .map(|i| Wheel {
-                        name: std::format!("rw{i}"),
-                        axis: Vector3::ith(i, 1.0),
-                        max_torque_nm: 0.01,
-                        max_momentum_nms: 0.046,
-                    })
-                    .collect(),
-                max_rate_rad_s: None,
-                max_angle_rad: None,
-                margin: 0.77,
-            },
-            noise: NoiseModel {
-                gyro_rad_s_rthz: 1e-4,
-                wheel_nms: 0.0,
-                telemetry_period_s: 0.1,
-            },
-            controller_period_s: 1.0,
-            rotor_relative_sigma: 0.0,
-        }
+        let prior = Matrix3::new(
+            0.28, 0.0045, -0.0045, 0.0045, 0.244, 0.0045, -0.0045, 0.0045, 0.168,
+        );
+        crate::plan::peer_vehicle(prior, 0.01, 0.046)
     }
 
     /// The prediction is honest: over 12 seeds on the true J, the root mean square of the
@@ -266,32 +242,7 @@ mod tests {
     #[test]
     fn a_planned_flight_keeps_the_limits_and_lands_within_its_sigma() {
         let truth = Matrix3::from_diagonal(&Vector3::new(0.26, 0.26, 0.16));
-        let v = Vehicle {
-            prior_kg_m2: Matrix3::new(
-                0.28, 0.0045, -0.0045, 0.0045, 0.244, 0.0045, -0.0045, 0.0045, 0.168,
-            ),
-            prior_sigma_kg_m2: None,
-            limits: Limits {
-                wheels: (0..3)
-                    .map(|i| Wheel {
-                        name: std::format!("rw{i}"),
-                        axis: Vector3::ith(i, 1.0),
-                        max_torque_nm: 0.01,
-                        max_momentum_nms: 0.046,
-                    })
-                    .collect(),
-                max_rate_rad_s: None,
-                max_angle_rad: None,
-                margin: 0.77,
-            },
-            noise: NoiseModel {
-                gyro_rad_s_rthz: 1e-4,
-                wheel_nms: 0.0,
-                telemetry_period_s: 0.1,
-            },
-            controller_period_s: 1.0,
-            rotor_relative_sigma: 0.0,
-        };
+        let v = sat1();
         let p = plan(&v, &PlanSettings::default()).unwrap();
         assert!(p.limit_use.worst() <= 0.77 + 1e-12, "{:?}", p.limit_use);
         let fs = FlightSettings {

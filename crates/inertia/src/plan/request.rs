@@ -176,8 +176,6 @@ fn make_for_chain(v: &Vehicle, r: &Request, chain_s: Option<f64>) -> Result<Outc
 #[cfg(all(test, feature = "sim"))]
 mod tests {
     use super::*;
-    use crate::plan::limits::{Limits, Wheel};
-    use crate::plan::predict::NoiseModel;
     use crate::plan::rehearse::fly;
     use nalgebra::{Matrix3, Vector3};
 
@@ -187,30 +185,7 @@ mod tests {
         let d = Vector3::new(6.53, 5.96, 4.53);
         let p = 0.02 * d.mean();
         let prior = Matrix3::new(1.08 * d.x, p, -p, p, 0.94 * d.y, p, -p, p, 1.05 * d.z);
-        let v = Vehicle {
-            prior_kg_m2: prior,
-            prior_sigma_kg_m2: None,
-            limits: Limits {
-                wheels: (0..3)
-                    .map(|i| Wheel {
-                        name: std::format!("rw{i}"),
-                        axis: Vector3::ith(i, 1.0),
-                        max_torque_nm: 0.1,
-                        max_momentum_nms: 1.8,
-                    })
-                    .collect(),
-                max_rate_rad_s: None,
-                max_angle_rad: None,
-                margin: 0.77,
-            },
-            noise: NoiseModel {
-                gyro_rad_s_rthz: 1e-4,
-                wheel_nms: 0.0,
-                telemetry_period_s: 0.1,
-            },
-            controller_period_s: 1.0,
-            rotor_relative_sigma: 0.0,
-        };
+        let v = crate::plan::peer_vehicle(prior, 0.1, 1.8);
         (v, Matrix3::from_diagonal(&d))
     }
 
