@@ -243,8 +243,12 @@ typedef struct InertiaSettings {
   // Resample onto a uniform grid of this period, s; 0 (default) for none. Heap only.
   double resample_s;
   // Gyro rate-noise density, deg/s/√Hz, for errors-in-variables compensation; 0
-  // (default) for none.
+  // (default): none stated (see `gyro_noise_estimate`).
   double gyro_noise_deg_s_rthz;
+  // Non-zero (default): with no density stated, the discrete momentum estimator
+  // estimates it from the rates where their differences are noise and compensates with
+  // it; 0: no compensation without a stated density.
+  uint8_t gyro_noise_estimate;
   // Non-zero (default): attach σ to each estimate.
   uint8_t uncertainty;
   // Non-zero (default): estimate an unknown constant torque (discrete momentum).

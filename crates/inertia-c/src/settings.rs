@@ -120,8 +120,12 @@ pub struct InertiaSettings {
     /// Resample onto a uniform grid of this period, s; 0 (default) for none. Heap only.
     pub resample_s: f64,
     /// Gyro rate-noise density, deg/s/√Hz, for errors-in-variables compensation; 0
-    /// (default) for none.
+    /// (default): none stated (see `gyro_noise_estimate`).
     pub gyro_noise_deg_s_rthz: f64,
+    /// Non-zero (default): with no density stated, the discrete momentum estimator
+    /// estimates it from the rates where their differences are noise and compensates with
+    /// it; 0: no compensation without a stated density.
+    pub gyro_noise_estimate: u8,
     /// Non-zero (default): attach σ to each estimate.
     pub uncertainty: u8,
     /// Non-zero (default): estimate an unknown constant torque (discrete momentum).
@@ -273,7 +277,11 @@ impl Plan {
             memory_s: optional(s.memory_s),
             resample_s: optional(s.resample_s),
             attitude_drift: optional(s.attitude_drift_deg_rth),
-            gyro_noise: optional(s.gyro_noise_deg_s_rthz),
+            // None stated: estimated (unset), or none (a stated 0).
+            gyro_noise: match optional(s.gyro_noise_deg_s_rthz) {
+                None if s.gyro_noise_estimate == 0 => Some(0.0),
+                g => g,
+            },
             uncertainty: s.uncertainty != 0,
             torque_bias: s.torque_bias != 0,
             // 0: chosen from the data; k ≥ 1: the library's value k − 1.
@@ -409,7 +417,10 @@ impl Plan {
                 "max_chain_s",
                 self.max_chain_s != Some(inertia::pipeline::DEFAULT_MAX_CHAIN_S),
             ),
-            ("gyro_noise_deg_s_rthz", fd && self.gyro_noise.is_some()),
+            (
+                "gyro_noise_deg_s_rthz",
+                fd && self.gyro_noise.is_some_and(|g| g > 0.0),
+            ),
             ("attitude_drift_deg_rth", self.attitude_drift.is_some()),
         ] {
             if changed {
@@ -465,6 +476,7 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         memory_s: 0.0,
         resample_s: 0.0,
         gyro_noise_deg_s_rthz: 0.0,
+        gyro_noise_estimate: 1,
         uncertainty: 1,
         torque_bias: 1,
         rotation_source: InertiaRotationSource::Auto as u32,

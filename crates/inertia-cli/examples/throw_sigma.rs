@@ -4,7 +4,8 @@
 //! those how many have an element beyond 3σ.
 //!
 //! `cargo run --release -p inertia-cli --example throw_sigma -- [THROWS]` (default 60,
-//! seeds from `FROM`, default 0). Results: the book, "What you tell the run: the wheel
+//! seeds from `FROM`, default 0; `WHEEL_DELAY=off|SECONDS|estimate` the wheel speeds'
+//! time tag, off when unset). Results: the book, "What you tell the run: the wheel
 //! speeds' time tag".
 
 use inertia::estimator::observability::Observability;
@@ -17,8 +18,12 @@ use nalgebra::Matrix3;
 use rayon::prelude::*;
 
 fn estimate(samples: &[Sample], batch: bool) -> Option<Estimate> {
+    let wheel_delay = std::env::var("WHEEL_DELAY").map_or(Default::default(), |v| {
+        inertia::pipeline::parse_wheel_delay(&v).unwrap_or_else(|e| panic!("WHEEL_DELAY: {e}"))
+    });
     let config = PipelineSettings {
         solve_every: 50,
+        wheel_delay,
         ..PipelineSettings::default()
     }
     .validate()

@@ -516,8 +516,10 @@ pub struct EstimateArgs {
     /// before estimating (keeps the rows' O(h⁴) accuracy on jittered time stamps; README).
     #[arg(long, value_name = "S")]
     pub resample: Option<f64>,
-    /// The gyro's rate-noise density, deg/s/√Hz: compensates the errors-in-variables bias
-    /// of the variational estimator (README). Without it, no compensation.
+    /// The gyro's rate-noise density, deg/s/√Hz: compensates the errors-in-variables
+    /// shrinkage of J (book, "Estimators"). Without it the discrete momentum estimator
+    /// estimates the density from the rates where their differences are noise (and says
+    /// so); the other estimators compensate nothing. 0: no compensation.
     #[arg(
         long,
         visible_alias = "gyro-noise-deg-s-rthz",

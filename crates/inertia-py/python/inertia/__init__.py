@@ -609,7 +609,9 @@ def estimate(
             product ``bounds``: ``"tensor"`` (J12 = −Σ m x y, default) or ``"cad"``
             (+Σ m x y).
         gyro_noise: the gyro's rate-noise density, deg/s/√Hz (errors-in-variables
-            compensation).
+            compensation). ``None`` (default): the discrete momentum estimator estimates
+            it from the rates where their differences are noise
+            (``report["gyro_noise_estimated_deg_s_rthz"]``); ``0``: no compensation.
         attitude_drift: the attitude's angle random walk, deg/√h, with ``gyro_noise``
             (``--attitude-drift``): for an attitude propagated from a gyro, its ARW; the
             momentum rows are weighted for the drift (``report["drift_weighted"]`` says

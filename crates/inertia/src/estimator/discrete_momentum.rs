@@ -421,6 +421,12 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         Ok(e)
     }
 
+    /// The gyro density of the errors-in-variables compensation at the next solves,
+    /// rad/s/√Hz (a run's estimate from the rates, `super::rate_noise`; `None`: none).
+    pub(crate) fn set_gyro_noise(&mut self, gyro_noise_rad_s_rthz: Option<f64>) {
+        self.settings.recursive.gyro_noise_rad_s_rthz = gyro_noise_rad_s_rthz;
+    }
+
     /// Least-squares standard deviation per element at the last solve.
     #[must_use]
     pub fn noise_sigma(&self) -> Option<[f64; 6]> {

@@ -32,6 +32,7 @@ pub mod observability;
 pub(crate) mod plain_fit;
 pub mod prior;
 pub mod qr;
+pub(crate) mod rate_noise;
 pub mod recursive;
 pub mod resample;
 #[cfg(feature = "std")]

@@ -49,6 +49,11 @@ pub struct Diagnostics {
     /// [`crate::estimator::consistency::DENSITY_OVERSTATED_RATIO`] the density is
     /// overstated).
     pub gyro_density_ratio: Option<f64>,
+    /// Where no gyro density was stated: the one estimated from the telemetered rates,
+    /// rad/s/√Hz, that the errors-in-variables compensation used at the last solve
+    /// (`crate::estimator::rate_noise`; `None` where the rates' differences show the
+    /// motion more than the noise, or without rates).
+    pub gyro_noise_estimated_rad_s_rthz: Option<f64>,
     /// With an attitude drift stated ([`super::PipelineSettings::attitude_drift_deg_rth`]):
     /// whether the last answer came from the rows weighted for it (`false`: from the
     /// unweighted rows, whose bias σ exceeded their noise σ, or no answer yet to weight

@@ -177,8 +177,14 @@ pub struct Report {
     pub glitches: Option<Glitches>,
     /// The span whose residuals stand out most from the rest.
     pub residual_consistency: Option<Worst>,
-    /// The residual variance over the part the stated gyro density alone implies.
+    /// The residual variance over the part the gyro density alone implies.
     pub gyro_density_ratio: Option<f64>,
+    /// Where no gyro density was stated: the density estimated from the telemetered rates,
+    /// deg/s/√Hz, that the errors-in-variables compensation used
+    /// (`crate::estimator::rate_noise`); `null` where none was stated and the rates'
+    /// differences show the motion more than the noise (nothing compensated), or where one
+    /// was stated.
+    pub gyro_noise_estimated_deg_s_rthz: Option<f64>,
     /// With an attitude drift stated (`attitude_drift_deg_rth`): whether the answer came
     /// from the rows weighted for it (`false`: the unweighted rows', whose bias outweighed
     /// their noise, or no answer yet to weight with); `null` without one.
@@ -449,6 +455,7 @@ impl Report {
             glitches: None,
             residual_consistency: None,
             gyro_density_ratio: None,
+            gyro_noise_estimated_deg_s_rthz: None,
             drift_weighted: None,
             attitude_is_gyro_integral: None,
             warnings: std::vec::Vec::new(),
@@ -679,6 +686,8 @@ impl Report {
         self.drift_weighted = d.drift_weighted;
         self.residual_consistency = d.residual_consistency;
         self.gyro_density_ratio = d.gyro_density_ratio;
+        self.gyro_noise_estimated_deg_s_rthz =
+            d.gyro_noise_estimated_rad_s_rthz.map(f64::to_degrees);
         self.refreshed()
     }
 

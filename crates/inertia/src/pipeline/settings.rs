@@ -245,7 +245,8 @@ impl PipelineSettings {
                     expected: "a finite density >= 0 deg/s/√Hz",
                 });
             }
-            if !estimator.capabilities.compensation {
+            // 0 (no compensation) applies to every estimator.
+            if g > 0.0 && !estimator.capabilities.compensation {
                 return Err(PipelineError::NotApplicable {
                     setting: "gyro_noise_deg_s_rthz",
                     estimator: estimator.name,

@@ -362,7 +362,8 @@ fn errors_in_variables_compensation_removes_the_noisy_gyro_bias() {
     // The small-satellite preset with its attitude propagated from a MEMS gyro (ARW
     // 0.15 deg/√h, no bias): the gyro noise in φ shrinks the estimate (errors in
     // variables), so the trace of Ĵ comes out low in every seed. Given the gyro's
-    // density, the compensated estimate is unbiased in the trace and closer overall.
+    // density, the compensated estimate is unbiased in the trace and closer overall; with
+    // none stated (the default), the density estimated from the rates does the same.
     let preset = inertia::sim::presets::Preset::small_sat();
     let mut common = preset.common.clone();
     common.realism = Realism {
@@ -372,8 +373,9 @@ fn errors_in_variables_compensation_removes_the_noisy_gyro_bias() {
         ..Default::default()
     };
     let seeds = 3;
-    // Mean relative Frobenius error and mean signed relative trace error.
-    let (mut plain, mut compensated) = ((0.0, 0.0), (0.0, 0.0));
+    // Mean relative Frobenius error and mean signed relative trace error: a density of 0
+    // (no compensation), the true one stated, none stated (estimated).
+    let (mut plain, mut compensated, mut estimated) = ((0.0, 0.0), (0.0, 0.0), (0.0, 0.0));
     for seed in 1..=seeds {
         let run = preset
             .scenario
@@ -396,31 +398,43 @@ fn errors_in_variables_compensation_removes_the_noisy_gyro_bias() {
             }
             let j = p.last().and_then(|e| e.inertia()).expect("answer");
             let trace = j.trace() / run.inertia_kg_m2.trace() - 1.0;
-            if gyro.is_none() {
+            if gyro == Some(0.0) {
                 assert!(trace < 0.0, "seed {seed}: shrunk, trace {trace:e}");
+            }
+            let estimated = p.diagnostics().gyro_noise_estimated_rad_s_rthz;
+            match gyro {
+                None => {
+                    let g = estimated.expect("estimated").to_degrees();
+                    let truth = common.gyro_noise_deg_s_rthz;
+                    assert!(
+                        (g / truth - 1.0).abs() < 0.05,
+                        "seed {seed}: {g} vs {truth}"
+                    );
+                }
+                Some(_) => assert_eq!(estimated, None),
             }
             (
                 relative_frobenius_error(&j, &run.inertia_kg_m2) / seeds as f64,
                 trace / seeds as f64,
             )
         };
-        let (e, t) = error(None);
-        (plain.0, plain.1) = (plain.0 + e, plain.1 + t);
-        let (e, t) = error(Some(common.gyro_noise_deg_s_rthz));
-        (compensated.0, compensated.1) = (compensated.0 + e, compensated.1 + t);
+        let add = |a: &mut (f64, f64), (e, t): (f64, f64)| (a.0, a.1) = (a.0 + e, a.1 + t);
+        add(&mut plain, error(Some(0.0)));
+        add(&mut compensated, error(Some(common.gyro_noise_deg_s_rthz)));
+        add(&mut estimated, error(None));
     }
     eprintln!(
-        "mean error, trace error: uncompensated {:.2e} {:+.2e}, compensated {:.2e} {:+.2e}",
-        plain.0, plain.1, compensated.0, compensated.1
+        "mean error, trace error: uncompensated {:.2e} {:+.2e}, compensated {:.2e} {:+.2e}, \
+         estimated density {:.2e} {:+.2e}",
+        plain.0, plain.1, compensated.0, compensated.1, estimated.0, estimated.1
     );
     // Measured: uncompensated 6.3e-4 with the trace 3.2e-4 low; compensated 4.9e-4,
     // the trace 0.6e-4 high.
-    assert!(
-        compensated.1.abs() < 0.35 * plain.1.abs(),
-        "trace: {compensated:?} vs {plain:?}"
-    );
-    assert!(
-        compensated.0 < 0.9 * plain.0,
-        "{compensated:?} vs {plain:?}"
-    );
+    for (what, c) in [("stated", compensated), ("estimated", estimated)] {
+        assert!(
+            c.1.abs() < 0.35 * plain.1.abs(),
+            "{what} trace: {c:?} vs {plain:?}"
+        );
+        assert!(c.0 < 0.9 * plain.0, "{what}: {c:?} vs {plain:?}");
+    }
 }

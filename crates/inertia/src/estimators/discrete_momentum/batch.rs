@@ -21,6 +21,7 @@ use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::observability::Observability;
 use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
+use crate::estimator::rate_noise::RateNoise;
 use crate::estimator::uncertainty::noise_sigma;
 use crate::estimator::{batch, Estimate, EstimatorError};
 use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
@@ -57,6 +58,18 @@ pub(super) fn run_batch(
             estimator: "discrete-momentum batch",
         });
     }
+    // Without a stated gyro density, the compensation's from the rates, as the recursive
+    // path has it at its last solve.
+    let estimated = c
+        .gyro_noise_rad_s_rthz
+        .is_none()
+        .then(|| RateNoise::of_record(samples))
+        .flatten();
+    let config = PipelineConfig {
+        gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz.or(estimated),
+        ..*c
+    };
+    let c = &config;
     let has_gyro = samples.first().is_some_and(|s| s.omega_rad_s.is_some());
     let mut reduced: Vec<(MomentumRowSettings, BatchReduction)> = Vec::new();
     // A record longer than [`SHORT_RECORD_S`] is no longer short: without the torque the
@@ -143,6 +156,7 @@ pub(super) fn run_batch(
             row_model: Some(*rows),
             torque_test,
             gyro_density_ratio,
+            gyro_noise_estimated_rad_s_rthz: estimated,
             damping_nms,
             outside,
             rotor_calibration,

@@ -141,10 +141,18 @@ pub(super) fn finish<V: Evidence>(
 /// The damping `D` at the answer with its σ ([`Evidence::damping`]: the larger of the
 /// least-squares and the jackknife σ, as `j`'s noise σ), and the model check on its sign:
 /// a `D` negative beyond [`NEGATIVE_DAMPING_Z`] of its σ fails it, since a drag cannot
-/// feed energy in, so the damping's column stands in for another effect.
+/// feed energy in, so the damping's column stands in for another effect. It names that
+/// effect, so it replaces a failed model or constraint check (whose answer the same
+/// stand-in bends).
 fn damping<V: Evidence>(e: &mut Estimate, evidence: &V) -> Option<(f64, Option<f64>)> {
     let (d, sigma) = evidence.damping(&e.j()?)?;
-    if let (Some(s), Observability::Determined { .. }) = (sigma, e.observability) {
+    if let (
+        Some(s),
+        Observability::Determined { .. }
+        | Observability::ModelCheckFailed(_)
+        | Observability::FromPrior(Unobservable::ConflictsWithConstraints { .. }),
+    ) = (sigma, e.observability)
+    {
         if d < -NEGATIVE_DAMPING_Z * s {
             e.observability = Observability::ModelCheckFailed(Unobservable::NegativeDamping {
                 damping_nms: d,

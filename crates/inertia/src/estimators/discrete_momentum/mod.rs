@@ -54,6 +54,7 @@ use crate::estimator::excitation::diagnose;
 use crate::estimator::external_torque::OutsideEstimates;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
 use crate::estimator::qr::RecursiveQr;
+use crate::estimator::rate_noise::RateNoise;
 use crate::estimator::{Estimate, EstimatorError};
 use crate::pipeline::config::EstimatorEntry;
 use crate::pipeline::config::{InertialTorque, PipelineConfig, SHORT_RECORD_S};
@@ -120,6 +121,10 @@ struct DiscreteMomentum {
     residuals: Vec<ResidualSegments>,
     /// The residuals' ratio to the stated gyro density at the last solve.
     density_ratio: Option<f64>,
+    /// Where no gyro density is stated: its estimate from the rates
+    /// ([`crate::estimator::rate_noise`]), which sets the compensation's density
+    /// (`config.gyro_noise_rad_s_rthz`) at each solve.
+    rate_noise: Option<Box<RateNoise>>,
     /// The damping at the last answer with its widened σ ([`finish`]).
     damping: Option<(f64, Option<f64>)>,
     /// The outside torques at the last answer, with its σ carried.
@@ -184,6 +189,7 @@ impl DiscreteMomentum {
             shadow: None,
             residuals: Vec::new(),
             density_ratio: None,
+            rate_noise: c.gyro_noise_rad_s_rthz.is_none().then(Box::default),
             damping: None,
             outside: None,
             samples: 0,
@@ -242,14 +248,37 @@ impl DiscreteMomentum {
             self.first_t_s = Some(s.t_s);
         }
         self.end_short_record(s.t_s);
+        if let Some(r) = self.rate_noise.as_deref_mut() {
+            r.push(s.t_s, s.omega_rad_s);
+        }
         let folded = self.fold(s)?;
         self.feed_shadow(s);
         self.samples += 1;
         if !folded || !self.count_block() {
             return Ok(None);
         }
+        self.refresh_gyro_noise();
         self.pick_candidate();
         self.solve(s.t_s)
+    }
+
+    /// Where no gyro density is stated, the compensation's density from the rates so far
+    /// ([`crate::estimator::rate_noise`]), for every candidate and the shadow.
+    fn refresh_gyro_noise(&mut self) {
+        let Some(r) = self.rate_noise.as_deref_mut() else {
+            return;
+        };
+        let g = r.density_rad_s_rthz();
+        if g == self.config.gyro_noise_rad_s_rthz {
+            return;
+        }
+        self.config.gyro_noise_rad_s_rthz = g;
+        for c in &mut self.candidates {
+            c.set_gyro_noise(g);
+        }
+        if let Some(s) = self.shadow.as_deref_mut() {
+            s.set_gyro_noise(g);
+        }
     }
 
     /// Past [`SHORT_RECORD_S`] from the first sample, a record is no longer short: the
@@ -552,6 +581,10 @@ impl Estimator for DiscreteMomentum {
             torque_test: chosen.and_then(|c| c.torque_test()),
             residual_consistency: g.residuals.get(g.chosen).and_then(|r| r.worst()),
             gyro_density_ratio: g.density_ratio,
+            gyro_noise_estimated_rad_s_rthz: g
+                .rate_noise
+                .as_ref()
+                .and(g.config.gyro_noise_rad_s_rthz),
             drift_weighted: self
                 .config
                 .attitude_drift_deg_rth

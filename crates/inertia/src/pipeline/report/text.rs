@@ -313,10 +313,21 @@ impl fmt::Display for ReportText<'_> {
                 )?;
             }
         }
+        if let Some(g) = r.gyro_noise_estimated_deg_s_rthz {
+            writeln!(
+                s,
+                "gyro noise: {g:.3e} deg/s/√Hz, estimated from the rates; its errors-in-variables shrinkage of J compensated (a stated density replaces it, 0 for none)"
+            )?;
+        }
+        let which = if r.gyro_noise_estimated_deg_s_rthz.is_some() {
+            "estimated"
+        } else {
+            "stated"
+        };
         if let Some(r) = r.gyro_density_ratio {
             writeln!(
                 s,
-                "residuals: {r:.2} times the variance the stated gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
+                "residuals: {r:.2} times the variance the {which} gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
             )?;
         }
         if let Some(x) = &r.excitation {
