@@ -245,10 +245,6 @@ typedef struct InertiaSettings {
   // Gyro rate-noise density, deg/s/√Hz, for errors-in-variables compensation; 0
   // (default): none stated (see `gyro_noise_estimate`).
   double gyro_noise_deg_s_rthz;
-  // Non-zero (default): with no density stated, the discrete momentum estimator
-  // estimates it from the rates where their differences are noise and compensates with
-  // it; 0: no compensation without a stated density.
-  uint8_t gyro_noise_estimate;
   // Non-zero (default): attach σ to each estimate.
   uint8_t uncertainty;
   // Non-zero (default): estimate an unknown constant torque (discrete momentum).
@@ -274,6 +270,10 @@ typedef struct InertiaSettings {
   // An `INERTIA_SOLVER_*` id (the library's registry, in order, from 1); 0 (default):
   // the library's default, native. Caller storage runs the native solver only.
   uint32_t solver;
+  // Non-zero (default): with no density stated (`gyro_noise_deg_s_rthz` 0), the
+  // discrete momentum estimator estimates it from the rates where their differences are
+  // noise and compensates with it; 0: no compensation without a stated density.
+  uint8_t gyro_noise_estimate;
 } InertiaSettings;
 
 // One telemetry sample at time `t_s` (README "Estimating your own telemetry").
@@ -385,7 +385,8 @@ extern "C" {
 #endif // __cplusplus
 
 // The default settings: the discrete momentum estimator, the physical constraint set,
-// no bounds, no memory, no resampling, no gyro-noise compensation, σ on, torque bias on,
+// no bounds, no memory, no resampling, the gyro's noise density estimated from the rates
+// (discrete momentum) and compensated, σ on, torque bias on,
 // chains of 30 s, glitches stop the run (the CLI's `estimate` defaults). For caller
 // storage set `estimator = INERTIA_ESTIMATOR_VARIATIONAL`.
 struct InertiaSettings inertia_settings_default(void);

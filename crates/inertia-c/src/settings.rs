@@ -122,10 +122,6 @@ pub struct InertiaSettings {
     /// Gyro rate-noise density, deg/s/√Hz, for errors-in-variables compensation; 0
     /// (default): none stated (see `gyro_noise_estimate`).
     pub gyro_noise_deg_s_rthz: f64,
-    /// Non-zero (default): with no density stated, the discrete momentum estimator
-    /// estimates it from the rates where their differences are noise and compensates with
-    /// it; 0: no compensation without a stated density.
-    pub gyro_noise_estimate: u8,
     /// Non-zero (default): attach σ to each estimate.
     pub uncertainty: u8,
     /// Non-zero (default): estimate an unknown constant torque (discrete momentum).
@@ -151,6 +147,10 @@ pub struct InertiaSettings {
     /// An `INERTIA_SOLVER_*` id (the library's registry, in order, from 1); 0 (default):
     /// the library's default, native. Caller storage runs the native solver only.
     pub solver: u32,
+    /// Non-zero (default): with no density stated (`gyro_noise_deg_s_rthz` 0), the
+    /// discrete momentum estimator estimates it from the rates where their differences are
+    /// noise and compensates with it; 0: no compensation without a stated density.
+    pub gyro_noise_estimate: u8,
 }
 
 /// What the C settings ask for, without the heap (no estimator name string).
@@ -460,7 +460,8 @@ impl Plan {
 }
 
 /// The default settings: the discrete momentum estimator, the physical constraint set,
-/// no bounds, no memory, no resampling, no gyro-noise compensation, σ on, torque bias on,
+/// no bounds, no memory, no resampling, the gyro's noise density estimated from the rates
+/// (discrete momentum) and compensated, σ on, torque bias on,
 /// chains of 30 s, glitches stop the run (the CLI's `estimate` defaults). For caller
 /// storage set `estimator = INERTIA_ESTIMATOR_VARIATIONAL`.
 #[no_mangle]
@@ -476,7 +477,6 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         memory_s: 0.0,
         resample_s: 0.0,
         gyro_noise_deg_s_rthz: 0.0,
-        gyro_noise_estimate: 1,
         uncertainty: 1,
         torque_bias: 1,
         rotation_source: InertiaRotationSource::Auto as u32,
@@ -487,5 +487,6 @@ pub extern "C" fn inertia_settings_default() -> InertiaSettings {
         inertial_torque: InertiaInertialTorque::Off as u32,
         rotor_scale_sigma: 0.0,
         solver: 0,
+        gyro_noise_estimate: 1,
     }
 }

@@ -186,6 +186,9 @@ pub struct DiscreteMomentumEstimator<B: Backend> {
     /// Whether the groups' σ joins the noise σ (else they serve the torque test only,
     /// [`Self::jackknife_for_torque_only`]).
     jackknife_in_sigma: bool,
+    /// Whether the compensation's gyro density is the run's estimate
+    /// (`Self::set_gyro_noise`), not a stated one.
+    gyro_noise_estimated: bool,
     svd: SvdTracker,
     sv: Vector6<f64>,
     reduced: RecursiveQr,
@@ -229,6 +232,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
                 .is_none()
                 .then(ChainGroups::default),
             jackknife_in_sigma: true,
+            gyro_noise_estimated: false,
             svd: SvdTracker::new(),
             sv: Vector6::zeros(),
             reduced: RecursiveQr::new(),
@@ -406,17 +410,37 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         let (solved, fit) = super::prior::augment(&self.reduced, &self.constraints);
         self.solved = solved;
         self.sv = self.svd.singular_values(&self.solved.r);
-        let e = estimate_from(
-            &mut self.backend,
-            &self.reduced,
-            &self.solved,
-            fit,
-            &self.sv,
-            &self.constraints,
-            &self.settings.recursive,
-            self.last.and_then(|e| e.j()).as_ref(),
-            t_s,
-        )?;
+        let warm = self.last.and_then(|e| e.j());
+        let (reduced, solved, sv, constraints) =
+            (&self.reduced, &self.solved, &self.sv, &self.constraints);
+        let backend = &mut self.backend;
+        let mut solve = |settings: &RecursiveSettings| {
+            estimate_from(
+                &mut *backend,
+                reduced,
+                solved,
+                fit,
+                sv,
+                constraints,
+                settings,
+                warm.as_ref(),
+                t_s,
+            )
+        };
+        let mut e = solve(&self.settings.recursive)?;
+        // An estimated density that outweighs the excitation is no reason to refuse the
+        // data: the answer is then the uncompensated one.
+        if self.gyro_noise_estimated
+            && e.observability
+                == super::observability::Observability::NotObservable(
+                    super::observability::Unobservable::NoiseDominated,
+                )
+        {
+            e = solve(&RecursiveSettings {
+                gyro_noise_rad_s_rthz: None,
+                ..self.settings.recursive
+            })?;
+        }
         self.last = Some(e);
         Ok(e)
     }
@@ -425,6 +449,7 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     /// rad/s/√Hz (a run's estimate from the rates, `super::rate_noise`; `None`: none).
     pub(crate) fn set_gyro_noise(&mut self, gyro_noise_rad_s_rthz: Option<f64>) {
         self.settings.recursive.gyro_noise_rad_s_rthz = gyro_noise_rad_s_rthz;
+        self.gyro_noise_estimated = gyro_noise_rad_s_rthz.is_some();
     }
 
     /// Least-squares standard deviation per element at the last solve.

@@ -18,23 +18,28 @@
 //! of density `N` (rad/s/√Hz) adds independent errors of variance `N²/h` to successive
 //! rates. Differences of order `p` of a smooth motion shrink like `(h ω_dyn)^p`, while
 //! those of the noise grow: `Var Δ²ω = 6 N²/h`, `Var Δ³ω = 20 N²/h`. With `m_p` the median
-//! of the squared differences (every axis pooled; the median of `χ²₁` is 0.4549, and a
-//! median ignores the steps where a command switches), `N_p² = m_p h / (0.4549 C_p)`
+//! of the squared differences times their step, `h (Δ^p ω)²` (every axis pooled, so that
+//! stretches at different rates count alike; the median of `χ²₁` is 0.4549, and a
+//! median ignores the steps where a command switches), `N_p² = m_p / (0.4549 C_p)`
 //! (`C_2 = 6`, `C_3 = 20`). Where the noise dominates, `N_2 = N_3`; where the motion
 //! shows in the second differences, `N_2 > N_3`, and neither is the noise. So the
 //! estimate is `N_3`, and only where `N_2 / N_3 ≤` [`AGREEMENT`] (noise-dominated third
 //! differences: the smooth part is at least `AGREEMENT²` smaller in them than in the
 //! second ones); otherwise there is none and nothing is compensated.
 //!
-//! Measured on the simulator's telemetry (true density in brackets): small-sat MEMS
-//! 2.52e-3 (2.5e-3), the lab throw at 4 kHz with its vibration 9.9e-3 (1e-2), the spin
-//! with a MEMS gyro at 10 Hz 2.46e-3 (2.5e-3, `N_2/N_3` = 1.09); the paper's slew and spin
-//! with the paper's gyro (1e-5) and every 1 Hz record: none (`N_2/N_3` ≥ 1.25; their
-//! shrinkage is negligible).
+//! Measured on the simulator's telemetry, in deg/s/√Hz (true density in brackets):
+//! small-sat MEMS 2.46–2.52e-3 over seeds (2.5e-3), the lab throw at 4 kHz with its
+//! vibration 9.9e-3 (1e-2), the spin with a MEMS gyro at 10 Hz 2.46e-3 (2.5e-3, `N_2/N_3`
+//! = 1.09); the paper's slew and spin with the paper's gyro (1e-5), at 10 Hz and at 1 Hz:
+//! none (`N_2/N_3` ≥ 1.25; their shrinkage is negligible).
 //!
-//! Only runs of four samples with equal steps (within [`STEP_TOLERANCE`]) count, so a gap,
-//! jitter or resampled stretch adds nothing. Fixed memory: two log-spaced histograms of
-//! the squared differences, [`BINS`] bins of 1/50 decade each (the median to within 2.3 %
+//! Only runs of samples with equal steps (within [`STEP_TOLERANCE`]) count: three for a
+//! second difference, four for a third, so a gap or jitter adds nothing, and a time that
+//! does not increase or a rate that is not finite starts a new run. Resampled rates are
+//! interpolated, which damps their noise: a run that resamples estimates nothing.
+//! Rates that take a few values only (quantised, or constant) put the median into a bin
+//! holding more than [`TIED`] of the differences: no estimate. Fixed memory: two
+//! log-spaced histograms, [`BINS`] bins of 1/50 decade each (the median to within 2.3 %
 //! in variance).
 
 use nalgebra::Vector3;
@@ -56,7 +61,11 @@ pub(crate) const AGREEMENT: f64 = 1.2;
 pub(crate) const STEP_TOLERANCE: f64 = 1e-3;
 
 /// Fewest squared third differences (three per sample) before there is an estimate.
-pub(crate) const MIN_DIFFERENCES: u32 = 300;
+pub(crate) const MIN_DIFFERENCES: u64 = 300;
+
+/// The largest share of the differences that the median's bin may hold; more, and the
+/// differences take a few values only (quantised or constant rates).
+pub(crate) const TIED: f64 = 0.1;
 
 /// Median of `χ²₁`.
 const CHI2_1_MEDIAN: f64 = 0.454_936_423_119_572_8;
@@ -68,13 +77,11 @@ pub(crate) struct RateNoise {
     last: [(f64, Vector3<f64>); 4],
     /// How many of `last` are filled (a run of equal steps).
     filled: usize,
-    second: [u32; BINS],
-    third: [u32; BINS],
-    /// Sum of the steps of the runs counted, s, and their number.
-    step_sum_s: f64,
-    steps: u32,
+    /// Histograms of `h (Δ²ω)²` and `h (Δ³ω)²`, per component.
+    second: [u64; BINS],
+    third: [u64; BINS],
     /// Squared third differences counted.
-    third_count: u32,
+    third_count: u64,
 }
 
 impl Default for RateNoise {
@@ -84,8 +91,6 @@ impl Default for RateNoise {
             filled: 0,
             second: [0; BINS],
             third: [0; BINS],
-            step_sum_s: 0.0,
-            steps: 0,
             third_count: 0,
         }
     }
@@ -103,17 +108,21 @@ fn bin(x: f64) -> usize {
     }
 }
 
-/// The median of a histogram's values, interpolated within its bin on the log scale.
-fn median(h: &[u32; BINS]) -> Option<f64> {
-    let n: u64 = h.iter().map(|&c| u64::from(c)).sum();
+/// The median of a histogram's values, interpolated within its bin on the log scale;
+/// `None` when empty or when the median's bin holds more than [`TIED`] of the values.
+fn median(h: &[u64; BINS]) -> Option<f64> {
+    let n: u64 = h.iter().sum();
     if n == 0 {
         return None;
     }
     let half = n as f64 / 2.0;
     let mut below = 0.0;
     for (i, &c) in h.iter().enumerate() {
-        let c = f64::from(c);
+        let c = c as f64;
         if below + c >= half {
+            if c > TIED * n as f64 {
+                return None;
+            }
             let frac = if c > 0.0 { (half - below) / c } else { 0.0 };
             return Some(libm::pow(
                 10.0,
@@ -162,18 +171,18 @@ impl RateNoise {
         let n = self.filled;
         if n >= 3 {
             let (a, b, c) = (self.last[n - 3].1, self.last[n - 2].1, self.last[n - 1].1);
+            let h = t_s - self.last[n - 2].0;
             let d2 = c - b * 2.0 + a;
             for x in d2.iter() {
-                self.second[bin(x * x)] += 1;
+                self.second[bin(h * x * x)] += 1;
             }
-            self.step_sum_s += t_s - self.last[n - 2].0;
-            self.steps += 1;
         }
         if n == 4 {
             let l = &self.last;
+            let h = l[3].0 - l[2].0;
             let d3 = l[3].1 - l[2].1 * 3.0 + l[1].1 * 3.0 - l[0].1;
             for x in d3.iter() {
-                self.third[bin(x * x)] += 1;
+                self.third[bin(h * x * x)] += 1;
             }
             self.third_count += 3;
         }
@@ -200,11 +209,10 @@ impl RateNoise {
 
     /// `(N_2, N_3)`, rad/s/√Hz, once there are enough differences.
     fn densities(&self) -> Option<(f64, f64)> {
-        if self.third_count < MIN_DIFFERENCES || self.steps == 0 {
+        if self.third_count < MIN_DIFFERENCES {
             return None;
         }
-        let h = self.step_sum_s / f64::from(self.steps);
-        let n = |m: f64, c: f64| libm::sqrt(m * h / (CHI2_1_MEDIAN * c));
+        let n = |m: f64, c: f64| libm::sqrt(m / (CHI2_1_MEDIAN * c));
         let (m2, m3) = (median(&self.second)?, median(&self.third)?);
         // The lowest bin holds exact zeros: rates that never change say nothing.
         if m3 <= libm::pow(10.0, LOWEST_DECADE + 1.0 / PER_DECADE) {
@@ -248,18 +256,99 @@ mod tests {
         r
     }
 
-    /// White noise on a slow motion: the density within 5 % over seeds, rates and sizes.
+    /// White noise on a slow motion: `N_2` and `N_3` (so both differences' constants)
+    /// each within 5 % of the density over seeds, rates and sizes.
     #[test]
     fn white_noise_gives_its_density() {
         for (seed, density, h) in [(1, 4.4e-5, 0.1), (2, 1.7e-4, 2.5e-4), (3, 1e-6, 0.01)] {
             let slow = |t: f64| Vector3::new(0.01 * libm::sin(0.05 * t), 0.02, -0.01);
             let r = feed(density, h, 6000, slow, seed);
-            let got = r.density_rad_s_rthz().expect("noise-dominated");
-            assert!(
-                (got / density - 1.0).abs() < 0.05,
-                "seed {seed}: {got} vs {density}"
+            let (n2, n3) = r.densities().expect("enough differences");
+            for (what, n) in [("N_2", n2), ("N_3", n3)] {
+                assert!(
+                    (n / density - 1.0).abs() < 0.05,
+                    "seed {seed} {what}: {n} vs {density}"
+                );
+            }
+            assert_eq!(r.density_rad_s_rthz(), Some(n3));
+        }
+    }
+
+    /// Two stretches at different rates (10 Hz, then 2 Hz after a gap) with the same
+    /// density: each difference is weighed by its own step, so the estimate is the
+    /// density, as it is for each stretch alone.
+    #[test]
+    fn stretches_at_different_rates_share_the_density() {
+        let density = 4.4e-5;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut r = RateNoise::default();
+        let mut t = 0.0;
+        for (h, n) in [(0.1, 3000), (0.5, 3000)] {
+            t += 10.0;
+            for _ in 0..n {
+                t += h;
+                let sd = density / libm::sqrt(h);
+                let w = Vector3::new(
+                    0.02 + sd * normal(&mut rng),
+                    sd * normal(&mut rng),
+                    sd * normal(&mut rng),
+                );
+                r.push(t, Some(w));
+            }
+        }
+        let got = r.density_rad_s_rthz().expect("noise-dominated");
+        assert!((got / density - 1.0).abs() < 0.05, "{got} vs {density}");
+    }
+
+    /// A time that does not increase or a rate that is not finite starts a new run: the
+    /// differences across it are not counted (each run of 3 samples adds one second and
+    /// no third difference).
+    #[test]
+    fn a_step_back_or_a_bad_rate_starts_a_new_run() {
+        let mut r = RateNoise::default();
+        let w = Some(Vector3::new(0.1, 0.2, 0.3));
+        for t in [0.0, 0.1, 0.2, 0.2, 0.3, 0.4] {
+            r.push(t, w);
+        }
+        assert_eq!(r.third_count, 0, "no run of four equal steps");
+        assert_eq!(r.second.iter().sum::<u64>(), 6, "two runs of three");
+        let mut r = RateNoise::default();
+        for (k, t) in [0.0, 0.1, 0.2, 0.3, 0.4, 0.5].into_iter().enumerate() {
+            let bad = k == 3;
+            r.push(
+                t,
+                if bad {
+                    Some(Vector3::new(f64::NAN, 0.0, 0.0))
+                } else {
+                    w
+                },
             );
         }
+        assert_eq!(r.third_count, 0);
+        assert_eq!(
+            r.second.iter().sum::<u64>(),
+            3,
+            "one run of three before the bad rate"
+        );
+    }
+
+    /// Rates quantised coarser than their noise take a few values: no estimate.
+    #[test]
+    fn quantised_rates_give_none() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
+        let (h, density, lsb) = (0.1, 4.4e-5, 1e-3);
+        let mut r = RateNoise::default();
+        for k in 0..6000 {
+            let sd = density / libm::sqrt(h);
+            let q = |x: f64| libm::round(x / lsb) * lsb;
+            let w = Vector3::new(
+                q(0.02 + sd * normal(&mut rng)),
+                q(sd * normal(&mut rng)),
+                q(-0.01 + sd * normal(&mut rng)),
+            );
+            r.push(k as f64 * h, Some(w));
+        }
+        assert_eq!(r.density_rad_s_rthz(), None);
     }
 
     /// A motion that shows in the second differences gives no estimate, however long.
@@ -284,14 +373,14 @@ mod tests {
             t += if k % 2 == 0 { 0.1 } else { 0.2 };
             r.push(t, Some(Vector3::new(k as f64, 0.0, 0.0)));
         }
-        assert_eq!(r.third.iter().sum::<u32>(), 0);
+        assert_eq!(r.third.iter().sum::<u64>(), 0);
         assert_eq!(r.density_rad_s_rthz(), None);
         let mut r = RateNoise::default();
         for k in 0..50 {
             r.push(k as f64 * 0.1, Some(Vector3::new(0.1, 0.0, 0.0)));
             r.push(k as f64 * 0.1 + 0.05, None);
         }
-        assert_eq!(r.third.iter().sum::<u32>(), 0);
+        assert_eq!(r.third.iter().sum::<u64>(), 0);
         let still = feed(0.0, 0.1, 2000, |_| Vector3::new(0.1, 0.2, 0.3), 5);
         assert_eq!(still.density_rad_s_rthz(), None);
         let short = feed(1e-4, 0.1, 50, |_| Vector3::zeros(), 6);

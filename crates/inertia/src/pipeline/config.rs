@@ -24,6 +24,10 @@ pub struct PipelineConfig {
     pub(crate) memory_s: Option<f64>,
     pub(crate) resample_s: Option<f64>,
     pub(crate) gyro_noise_rad_s_rthz: Option<f64>,
+    /// Whether `gyro_noise_rad_s_rthz` is the discrete momentum estimator's estimate from
+    /// the rates (`crate::estimator::rate_noise`), not a stated density: no answer is
+    /// withdrawn for it (the density-overstated test, a noise-dominated compensation).
+    pub(crate) gyro_noise_estimated: bool,
     pub(crate) uncertainty: bool,
     pub(crate) rotor_scale_sigma: Option<f64>,
     /// Relative σ of the known torque's scale ([`super::PipelineSettings::torque_scale_sigma`]).
@@ -59,6 +63,35 @@ pub struct PipelineConfig {
 }
 
 impl PipelineConfig {
+    /// The compensation's gyro density for rows whose rotation comes from `rotation`: a
+    /// stated density applies to every row (an attitude propagated from that gyro carries
+    /// its noise); an estimated one describes the telemetered rates, so only the
+    /// gyro-rotation rows.
+    #[must_use]
+    pub(crate) fn gyro_noise_for(
+        &self,
+        rotation: crate::estimator::momentum_rows::RotationSource,
+    ) -> Option<f64> {
+        match rotation {
+            crate::estimator::momentum_rows::RotationSource::Attitude
+                if self.gyro_noise_estimated =>
+            {
+                None
+            }
+            _ => self.gyro_noise_rad_s_rthz,
+        }
+    }
+
+    /// The density the rotation-source twins are compared at
+    /// (`crate::estimators::discrete_momentum::twins`): one for both, so that their
+    /// difference is the measurements', not the compensation's; none when estimated (it
+    /// would apply to one of them only, [`Self::gyro_noise_for`]).
+    #[must_use]
+    pub(crate) fn twin_gyro_noise(&self) -> Option<f64> {
+        self.gyro_noise_rad_s_rthz
+            .filter(|_| !self.gyro_noise_estimated)
+    }
+
     /// A wheel-speed time tag is applied by a [`super::Run`] alone, which holds the record
     /// ([`crate::estimator::wheel_delay`]); a [`super::Pipeline`] or a batch call given
     /// one refuses it rather than ignore it.

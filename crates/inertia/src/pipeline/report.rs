@@ -27,7 +27,7 @@ use crate::estimator::consistency::{Worst, DENSITY_OVERSTATED_RATIO, INCONSISTEN
 use crate::estimator::discrete_momentum::{TORQUE_CHI2, TORQUE_SHIFT_Z};
 use crate::estimator::excitation::Excitation;
 use crate::estimator::momentum_rows::MomentumRowSettings;
-use crate::estimator::observability::Observability;
+use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::Estimate;
 use crate::fix::{Fix, FixNames, Fixes};
 use crate::solver::SolveStatus;
@@ -479,10 +479,12 @@ impl Report {
     pub(crate) fn warning_list(&self) -> std::vec::Vec<Warning> {
         let mut w = std::vec::Vec::new();
         // A failed physicality check is the status line itself: not said twice.
-        if let Some(p) = self
-            .physical
-            .filter(|_| !matches!(self.observability, Observability::ModelCheckFailed(_)))
-        {
+        if let Some(p) = self.physical.filter(|_| {
+            !matches!(
+                self.observability,
+                Observability::ModelCheckFailed(Unobservable::Unphysical { .. })
+            )
+        }) {
             w.push(Warning::NotPhysical(p));
         }
         if let Some(v) = self.attitude_disagreement() {

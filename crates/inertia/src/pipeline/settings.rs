@@ -194,6 +194,7 @@ impl PipelineSettings {
             memory_s: self.memory_s,
             resample_s: self.resample_s,
             gyro_noise_rad_s_rthz: self.gyro_noise_deg_s_rthz.map(f64::to_radians),
+            gyro_noise_estimated: false,
             uncertainty: self.uncertainty && estimator.capabilities.uncertainty,
             rotor_scale_sigma: self.rotor_scale_sigma.filter(|&r| r > 0.0),
             torque_scale_sigma: self.torque_scale_sigma.filter(|&r| r > 0.0),

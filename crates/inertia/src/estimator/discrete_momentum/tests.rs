@@ -631,3 +631,40 @@ fn the_torque_tests_chi2_scale_matches_the_quantiles() {
         assert!(((ours - q) / q).abs() < 0.02, "k = {k}: {ours} against {q}");
     }
 }
+
+/// A stated density that outweighs the excitation leaves no answer (`NoiseDominated`);
+/// the same density as the run's estimate (`set_gyro_noise`) leaves the uncompensated
+/// answer instead, and a density that does not outweigh it is used either way.
+#[test]
+fn an_estimated_density_that_outweighs_the_excitation_leaves_the_plain_answer() {
+    use crate::estimator::observability::{Observability, Unobservable};
+    let run = slew_for(60.0, Common::paper());
+    let rows = MomentumRowSettings::default();
+    let last = |gyro: Option<f64>, estimated: bool| {
+        let mut e = estimator(rows);
+        if estimated {
+            e.set_gyro_noise(gyro);
+        } else {
+            e.settings.recursive.gyro_noise_rad_s_rthz = gyro;
+        }
+        let mut out = None;
+        for s in &run.samples {
+            out = e.push(s).expect("push").or(out);
+        }
+        out.expect("an estimate")
+    };
+    let plain = last(None, false);
+    let huge = 1.0; // rad/s/√Hz: far beyond the slew's excitation
+    let stated = last(Some(huge), false);
+    assert_eq!(
+        stated.observability,
+        Observability::NotObservable(Unobservable::NoiseDominated)
+    );
+    let estimated = last(Some(huge), true);
+    assert_eq!(estimated.j(), plain.j());
+    assert_eq!(estimated.observability, plain.observability);
+    let small = 2e-6;
+    let (s, e) = (last(Some(small), false), last(Some(small), true));
+    assert_eq!(s.j(), e.j());
+    assert_ne!(s.j(), plain.j());
+}

@@ -18,7 +18,7 @@ use crate::estimator::excitation::diagnose;
 use crate::estimator::external_torque::{Estimated3, OutsideEstimates};
 use crate::estimator::jackknife::robust_sigma;
 use crate::estimator::momentum_rows::{MomentumRowSettings, RotationSource};
-use crate::estimator::observability::Observability;
+use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::rate_noise::RateNoise;
@@ -60,13 +60,13 @@ pub(super) fn run_batch(
     }
     // Without a stated gyro density, the compensation's from the rates, as the recursive
     // path has it at its last solve.
-    let estimated = c
-        .gyro_noise_rad_s_rthz
-        .is_none()
+    // (Not on resampled rates, whose interpolation damps the noise.)
+    let estimated = (c.gyro_noise_rad_s_rthz.is_none() && c.resample_s.is_none())
         .then(|| RateNoise::of_record(samples))
         .flatten();
     let config = PipelineConfig {
         gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz.or(estimated),
+        gyro_noise_estimated: estimated.is_some(),
         ..*c
     };
     let c = &config;
@@ -271,15 +271,25 @@ impl BatchRun<'_> {
             b.jackknife_sigma_kg_m2,
             &c.constraints,
         );
-        let e = batch::solve_reduced(
-            &tested,
-            self.t_s,
-            &c.constraints,
-            &mut *self.backend,
-            &c.observability,
-            c.gyro_noise_rad_s_rthz,
-        )
-        .map_err(wrap)?;
+        let mut solve = |gyro: Option<f64>| {
+            batch::solve_reduced(
+                &tested,
+                self.t_s,
+                &c.constraints,
+                &mut *self.backend,
+                &c.observability,
+                gyro,
+            )
+            .map_err(wrap)
+        };
+        let mut e = solve(c.gyro_noise_for(rows.rotation))?;
+        // As the recursive estimator: an estimated density that outweighs the excitation
+        // leaves the uncompensated answer.
+        if c.gyro_noise_estimated
+            && e.observability == Observability::NotObservable(Unobservable::NoiseDominated)
+        {
+            e = solve(None)?;
+        }
         // With prior knowledge, σ is the least-squares one of the data and the prior
         // together, or the data's own jackknife σ where that is larger (the batch
         // jackknife's delete-one solves carry no prior: conservative).
@@ -327,11 +337,11 @@ impl Evidence for BatchRun<'_> {
             .filter(|&(i, (r, _))| {
                 i != self.chosen && in_running(r, self.from_s) && self.fits[i].0.is_finite()
             })
-            .map(|(_, (_, b))| b.qr);
+            .map(|(_, (r, b))| (b.qr, self.config.gyro_noise_for(r.rotation)));
+        let chosen = self.reduced[self.chosen].0.rotation;
         model_spread(
-            &self.tested,
+            (&self.tested, self.config.gyro_noise_for(chosen)),
             others,
-            self.config.gyro_noise_rad_s_rthz,
             &self.config.constraints,
         )
     }
@@ -374,9 +384,14 @@ impl Evidence for BatchRun<'_> {
             prior_mean: self.rotors.prior_mean.clone(),
             records: starts,
         };
-        match (self.reduced.first(), self.config.gyro_noise_rad_s_rthz) {
-            (Some((first, full)), gyro) => match reduce_batch(&half, first, &half_rotors) {
-                Ok(h) => discretisation_bias(&full.qr, &h.qr, gyro, &self.config.constraints),
+        match self.reduced.first() {
+            Some((first, full)) => match reduce_batch(&half, first, &half_rotors) {
+                Ok(h) => discretisation_bias(
+                    &full.qr,
+                    &h.qr,
+                    self.config.gyro_noise_for(first.rotation),
+                    &self.config.constraints,
+                ),
                 Err(_) => [0.0; 6],
             },
             _ => [0.0; 6],
@@ -438,7 +453,7 @@ pub(super) fn drop_batch_twins(
         return None;
     }
     let worst = twins::worst(pairs, |i| {
-        own_answer(&reduced[i].1.qr, c.gyro_noise_rad_s_rthz, &c.constraints)
+        own_answer(&reduced[i].1.qr, c.twin_gyro_noise(), &c.constraints)
     });
     // Every attitude candidate has a twin where the verdict is `Same` ([`twins::worst`]).
     let same = worst.is_some_and(|z| z <= twins::TWIN_Z);

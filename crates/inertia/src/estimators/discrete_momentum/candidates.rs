@@ -1,7 +1,8 @@
 //! The candidate row models of the discrete momentum estimator: one per rotation source and
 //! chain length that the settings leave open, each with its estimator settings; the
 //! whole-record candidate's chained siblings (whose jackknife σ is its noise σ); the row
-//! sources that candidates differing only in the chain length share.
+//! sources that candidates differing only in the chain length share; each candidate's
+//! errors-in-variables density as the run estimates it (`refresh_gyro_noise`).
 
 use crate::estimator::discrete_momentum::{DiscreteMomentumEstimator, MomentumEstimatorSettings};
 use crate::estimator::momentum_rows::{
@@ -120,7 +121,7 @@ pub(super) fn settings(c: &PipelineConfig, rows: MomentumRowSettings) -> Momentu
             solve_every: 1,
             observability: c.observability,
             memory_s: c.memory_s,
-            gyro_noise_rad_s_rthz: c.gyro_noise_rad_s_rthz,
+            gyro_noise_rad_s_rthz: c.gyro_noise_for(rows.rotation),
         },
     }
 }
@@ -146,4 +147,30 @@ pub(super) fn shared_sources(candidates: &[MomentumRowSettings]) -> Vec<SharedSo
         }
     }
     out
+}
+
+impl super::DiscreteMomentum {
+    /// Where no gyro density is stated, the compensation's density from the rates so far
+    /// ([`crate::estimator::rate_noise`]), for every candidate and the shadow, at each row
+    /// block; kept while within [`super::DENSITY_REFRESH`] of the new estimate (the estimate moves
+    /// with every sample; the answer with its square).
+    pub(super) fn refresh_gyro_noise(&mut self) {
+        let Some(r) = self.rate_noise.as_deref_mut() else {
+            return;
+        };
+        let g = r.density_rad_s_rthz();
+        let close = match (g, self.config.gyro_noise_rad_s_rthz) {
+            (Some(a), Some(b)) => (a / b - 1.0).abs() <= super::DENSITY_REFRESH,
+            (a, b) => a == b,
+        };
+        if close {
+            return;
+        }
+        self.config.gyro_noise_rad_s_rthz = g;
+        self.config.gyro_noise_estimated = g.is_some();
+        let config = self.config;
+        for c in self.candidates.iter_mut().chain(self.shadow.as_deref_mut()) {
+            c.set_gyro_noise(config.gyro_noise_for(c.row_settings().rotation));
+        }
+    }
 }

@@ -66,20 +66,29 @@ pub(super) const DISAGREE_Z: f64 = 5.0;
 /// either answer may be the right one: the difference joins the bias part of σ, so that
 /// the stated σ covers both. If σ then exceeds `max_relative_sigma · ‖Ĵ‖_F`, the answer
 /// is withdrawn ([`Unobservable::SourcesDisagree`]).
-/// `eig` are the eigenpairs of `e`'s `J` ([`crate::eigen3::symmetric_eigen3`]).
+/// `eig` are the eigenpairs of `e`'s `J` ([`crate::eigen3::symmetric_eigen3`]); `slack`, a
+/// difference the answers may have for a known reason, joins the answer's noise σ in the
+/// comparison (an estimated gyro density compensates the gyro's rows only).
 pub(super) fn reconcile(
     e: &mut Estimate,
     eig: &Eigen,
     others: &[(InertiaVector, [f64; 6])],
     max_relative_sigma: f64,
+    slack: Option<&[f64; 6]>,
 ) {
     let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
         return;
     };
     let mut bias = u.bias_kg_m2;
     let mut worst: f64 = 0.0;
+    // The answer's noise σ for the comparison, with a difference the answers may have for
+    // a known reason (`slack`) in quadrature.
+    let noise: [f64; 6] = match slack {
+        Some(s) => core::array::from_fn(|k| libm::hypot(u.noise_kg_m2[k], s[k])),
+        None => u.noise_kg_m2,
+    };
     for (jb, sigma) in others {
-        let Some(z) = disagreement_beyond(&j, &u.noise_kg_m2, jb, sigma, DISAGREE_Z) else {
+        let Some(z) = disagreement_beyond(&j, &noise, jb, sigma, DISAGREE_Z) else {
             continue;
         };
         worst = worst.max(z);

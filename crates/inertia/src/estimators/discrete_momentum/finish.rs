@@ -114,8 +114,14 @@ pub(super) fn finish<V: Evidence>(
     }
     // Without σ there is nothing to cross-check with (the answers' σ are not stated).
     if uncertainty && matches!(e.observability, Observability::Determined { .. }) {
+        // With an estimated density the gyro's rows are compensated and the attitude's
+        // are not: their answers may differ by the compensation's move, which is no
+        // disagreement of the measurements.
+        let slack = gyro
+            .filter(|_| evidence.config().gyro_noise_estimated)
+            .and_then(|g| compensation_move(evidence.data(), g, &evidence.config().constraints));
         let others = evidence.cross_check(e)?;
-        reconcile(e, &eig, others, max_relative_sigma);
+        reconcile(e, &eig, others, max_relative_sigma, slack.as_ref());
     }
     audit_at(
         e,
@@ -130,7 +136,9 @@ pub(super) fn finish<V: Evidence>(
         (Some(g), Some(j)) => evidence.density_ratio(&j, g),
         _ => None,
     };
-    consistency::check(e, evidence.residuals(e), density_ratio, stated);
+    // An estimated density is not the user's statement to refute: reported, not tested.
+    let tested = density_ratio.filter(|_| !evidence.config().gyro_noise_estimated);
+    consistency::check(e, evidence.residuals(e), tested, stated);
     let damping = damping(e, evidence);
     Ok(Finished::Checked {
         density_ratio,
@@ -142,14 +150,13 @@ pub(super) fn finish<V: Evidence>(
 /// least-squares and the jackknife σ, as `j`'s noise σ), and the model check on its sign:
 /// a `D` negative beyond [`NEGATIVE_DAMPING_Z`] of its σ fails it, since a drag cannot
 /// feed energy in, so the damping's column stands in for another effect. It names that
-/// effect, so it replaces a failed model or constraint check (whose answer the same
-/// stand-in bends).
+/// effect, so it replaces a failed constraint check (whose answer the same stand-in
+/// bends).
 fn damping<V: Evidence>(e: &mut Estimate, evidence: &V) -> Option<(f64, Option<f64>)> {
     let (d, sigma) = evidence.damping(&e.j()?)?;
     if let (
         Some(s),
         Observability::Determined { .. }
-        | Observability::ModelCheckFailed(_)
         | Observability::FromPrior(Unobservable::ConflictsWithConstraints { .. }),
     ) = (sigma, e.observability)
     {
@@ -161,4 +168,16 @@ fn damping<V: Evidence>(e: &mut Estimate, evidence: &V) -> Option<(f64, Option<f
         }
     }
     Some((d, sigma))
+}
+
+/// `|ĵ(g) − ĵ|` per element: the move of the unconstrained answer of `data` when it is
+/// compensated for a gyro density `g` ([`super::sigma::own_solution`]).
+fn compensation_move(
+    data: &crate::estimator::qr::RecursiveQr,
+    g: f64,
+    constraints: &crate::constraints::Constraints,
+) -> Option<[f64; 6]> {
+    let with = super::sigma::own_solution(data, Some(g), constraints)?;
+    let without = super::sigma::own_solution(data, None, constraints)?;
+    Some(core::array::from_fn(|k| (with[k] - without[k]).abs()))
 }

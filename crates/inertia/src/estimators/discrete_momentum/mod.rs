@@ -76,6 +76,10 @@ use std::boxed::Box;
 use std::vec::Vec;
 use twins::Twins;
 
+/// The relative change of the estimated gyro density below which the streaming
+/// estimator keeps the one it has (`DiscreteMomentum::refresh_gyro_noise`).
+const DENSITY_REFRESH: f64 = 0.01;
+
 /// Registry entry.
 pub(crate) const DISCRETE_MOMENTUM: EstimatorEntry = EstimatorEntry {
     name: "discrete-momentum",
@@ -189,7 +193,9 @@ impl DiscreteMomentum {
             shadow: None,
             residuals: Vec::new(),
             density_ratio: None,
-            rate_noise: c.gyro_noise_rad_s_rthz.is_none().then(Box::default),
+            // (Not on resampled rates, whose interpolation damps the noise.)
+            rate_noise: (c.gyro_noise_rad_s_rthz.is_none() && c.resample_s.is_none())
+                .then(Box::default),
             damping: None,
             outside: None,
             samples: 0,
@@ -257,28 +263,8 @@ impl DiscreteMomentum {
         if !folded || !self.count_block() {
             return Ok(None);
         }
-        self.refresh_gyro_noise();
         self.pick_candidate();
         self.solve(s.t_s)
-    }
-
-    /// Where no gyro density is stated, the compensation's density from the rates so far
-    /// ([`crate::estimator::rate_noise`]), for every candidate and the shadow.
-    fn refresh_gyro_noise(&mut self) {
-        let Some(r) = self.rate_noise.as_deref_mut() else {
-            return;
-        };
-        let g = r.density_rad_s_rthz();
-        if g == self.config.gyro_noise_rad_s_rthz {
-            return;
-        }
-        self.config.gyro_noise_rad_s_rthz = g;
-        for c in &mut self.candidates {
-            c.set_gyro_noise(g);
-        }
-        if let Some(s) = self.shadow.as_deref_mut() {
-            s.set_gyro_noise(g);
-        }
     }
 
     /// Past [`SHORT_RECORD_S`] from the first sample, a record is no longer short: the
@@ -374,6 +360,7 @@ impl DiscreteMomentum {
     /// Count a completed row block: rule candidates out ([`standing`], [`twins`]), age the
     /// cross-check's answers. Whether a solve is due (`solve_every`).
     fn count_block(&mut self) -> bool {
+        self.refresh_gyro_noise();
         self.rule_out();
         self.blocks += 1;
         if self.twins.due(self.blocks) {
@@ -454,17 +441,22 @@ impl DiscreteMomentum {
                     && in_running(c.row_settings(), self.from_s)
             })
             .map(|(_, c)| c);
-        let (gyro, constraints) = (self.config.gyro_noise_rad_s_rthz, &self.config.constraints);
+        let (config, constraints) = (&self.config, &self.config.constraints);
         let mut spread = outside_spread(
             &self.candidates[self.chosen],
             others,
-            (gyro, constraints),
+            (config, constraints),
             true,
         );
         // The discretisation bias, as j's: the first candidate's against its half-rate
         // shadow, |x(h) − x(2h)|/3.
         if let (Some(first), Some(shadow)) = (self.candidates.first(), self.shadow.as_deref()) {
-            let half = outside_spread(first, core::iter::once(shadow), (gyro, constraints), false);
+            let half = outside_spread(
+                first,
+                core::iter::once(shadow),
+                (config, constraints),
+                false,
+            );
             for (s, h) in spread.iter_mut().zip(half) {
                 for (s, h) in s.iter_mut().zip(h) {
                     *s = libm::sqrt(*s * *s + h * h / 9.0);
@@ -503,8 +495,7 @@ impl DiscreteMomentum {
     /// Compare the candidates that differ only in the rotation source ([`twins`]);
     /// once they are found to be one measurement, rule out the attitude's.
     fn check_twins(&mut self) {
-        let gyro = self.config.gyro_noise_rad_s_rthz;
-        let constraints = &self.config.constraints;
+        let (gyro, constraints) = (self.config.twin_gyro_noise(), &self.config.constraints);
         let answer = |c: &Candidate| own_answer(&c.qr().reduced(), gyro, constraints);
         let standing = &self.standing;
         let pairs = twins::pairs(&self.rows, |i| i == 0 || standing.live(i));
@@ -642,11 +633,14 @@ impl Evidence for Streaming<'_> {
                     && run.fits.get(i).is_some_and(|f| f.0.is_finite())
                     && in_running(c.row_settings(), run.from_s)
             })
-            .map(|(_, c)| c.qr().reduced());
+            .map(|(_, c)| {
+                let gyro = run.config.gyro_noise_for(c.row_settings().rotation);
+                (c.qr().reduced(), gyro)
+            });
+        let chosen = run.candidates[run.chosen].row_settings().rotation;
         model_spread(
-            self.chosen().reduced(),
+            (self.chosen().reduced(), run.config.gyro_noise_for(chosen)),
             others,
-            run.config.gyro_noise_rad_s_rthz,
             &run.config.constraints,
         )
     }
@@ -657,7 +651,7 @@ impl Evidence for Streaming<'_> {
             (Some(first), Some(shadow)) => discretisation_bias(
                 &first.qr().reduced(),
                 &shadow.qr().reduced(),
-                run.config.gyro_noise_rad_s_rthz,
+                run.config.gyro_noise_for(first.row_settings().rotation),
                 &run.config.constraints,
             ),
             _ => [0.0; 6],

@@ -14,6 +14,7 @@ use crate::estimator::observability::{Observability, Unobservable};
 use crate::estimator::prior;
 use crate::estimator::qr::RecursiveQr;
 use crate::estimator::Estimate;
+use crate::pipeline::config::PipelineConfig;
 use crate::sample::Sample;
 use crate::solver::unconstrained_minimiser;
 use crate::tensor::InertiaVector;
@@ -44,9 +45,8 @@ pub(super) fn sibling_jackknife(
 /// right, and the answer is uncertain by at least their difference. Zero when the chosen
 /// model fits significantly best.
 pub(super) fn model_spread(
-    best: &RecursiveQr,
-    others: impl Iterator<Item = RecursiveQr>,
-    gyro: Option<f64>,
+    (best, gyro): (&RecursiveQr, Option<f64>),
+    others: impl Iterator<Item = (RecursiveQr, Option<f64>)>,
     constraints: &Constraints,
 ) -> [f64; 6] {
     let mut out = [0.0; 6];
@@ -58,7 +58,7 @@ pub(super) fn model_spread(
     let ratio = 1.0 + 3.0 * libm::sqrt(2.0 / dof);
     // The chosen candidate's answer once another is comparable (none may be).
     let mut j_best: Option<Option<InertiaVector>> = None;
-    for qr in others {
+    for (qr, gyro_other) in others {
         if !(qr.residual_variance() <= ratio * v_best) {
             continue;
         }
@@ -66,7 +66,7 @@ pub(super) fn model_spread(
         else {
             return out;
         };
-        if let Some(j) = own_solution(&qr, gyro, constraints) {
+        if let Some(j) = own_solution(&qr, gyro_other, constraints) {
             for (o, (a, b)) in out.iter_mut().zip(j.iter().zip(j_best.iter())) {
                 *o = o.max((a - b).abs());
             }
@@ -84,10 +84,12 @@ pub(super) fn model_spread(
 pub(super) fn outside_spread<'a>(
     best: &Candidate,
     others: impl Iterator<Item = &'a Candidate>,
-    (gyro, constraints): (Option<f64>, &Constraints),
+    (config, constraints): (&PipelineConfig, &Constraints),
     comparable_only: bool,
 ) -> [[f64; 3]; 2] {
     let mut out = [[0.0; 3]; 2];
+    let gyro_for = |c: &Candidate| config.gyro_noise_for(c.row_settings().rotation);
+    let gyro = gyro_for(best);
     let reduced = best.qr().reduced();
     let dof = reduced.residual_dof();
     let Some(j) = (dof > 0.0)
@@ -106,7 +108,7 @@ pub(super) fn outside_spread<'a>(
         if comparable_only && !(qr.residual_variance() <= ratio * reduced.residual_variance()) {
             continue;
         }
-        let Some(jc) = own_solution(&qr, gyro, constraints) else {
+        let Some(jc) = own_solution(&qr, gyro_for(c), constraints) else {
             continue;
         };
         for (o, (a, b)) in out

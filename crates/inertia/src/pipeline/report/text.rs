@@ -319,16 +319,19 @@ impl fmt::Display for ReportText<'_> {
                 "gyro noise: {g:.3e} deg/s/√Hz, estimated from the rates; its errors-in-variables shrinkage of J compensated (a stated density replaces it, 0 for none)"
             )?;
         }
-        let which = if r.gyro_noise_estimated_deg_s_rthz.is_some() {
-            "estimated"
-        } else {
-            "stated"
-        };
+        let estimated = r.gyro_noise_estimated_deg_s_rthz.is_some();
         if let Some(r) = r.gyro_density_ratio {
-            writeln!(
-                s,
-                "residuals: {r:.2} times the variance the {which} gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
-            )?;
+            if estimated {
+                writeln!(
+                    s,
+                    "residuals: {r:.2} times the variance the estimated gyro density alone implies"
+                )?;
+            } else {
+                writeln!(
+                    s,
+                    "residuals: {r:.2} times the variance the stated gyro density alone implies (overstated below {DENSITY_OVERSTATED_RATIO})"
+                )?;
+            }
         }
         if let Some(x) = &r.excitation {
             let mut line = String::from("excitation: singular values of R");
