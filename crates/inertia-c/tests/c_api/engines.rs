@@ -109,20 +109,7 @@ fn finite_difference_slew() {
 #[test]
 fn settings_reach_the_estimator() {
     let run = Scenario::slew().simulate(&Common::paper()).unwrap();
-    let final_j = |s: &InertiaSettings| {
-        let est = new(s);
-        for x in &run.samples {
-            assert_eq!(
-                push(est, &c_sample(x)),
-                InertiaStatus::Ok,
-                "{}",
-                last_error()
-            );
-        }
-        let e = get(est);
-        free(est);
-        e
-    };
+    let final_j = |s: &InertiaSettings| final_estimate(s, &run.samples);
     let base = final_j(&variational());
     assert_eq!(base.has_answer, 1);
     for (name, s) in [
@@ -242,21 +229,11 @@ fn the_inertial_torque_reaches_the_discrete_momentum_estimator() {
     use inertia::pipeline::{InertialTorque, Pipeline, PipelineSettings};
     let run = Scenario::slew().simulate(&Common::paper()).unwrap();
     let c_final = |mode: InertiaInertialTorque| {
-        let est = new(&InertiaSettings {
+        let settings = InertiaSettings {
             inertial_torque: mode as u32,
             ..inertia_settings_default()
-        });
-        for x in &run.samples {
-            assert_eq!(
-                push(est, &c_sample(x)),
-                InertiaStatus::Ok,
-                "{}",
-                last_error()
-            );
-        }
-        let e = get(est);
-        free(est);
-        e.j
+        };
+        final_estimate(&settings, &run.samples).j
     };
     let mut p = Pipeline::new(&PipelineSettings {
         inertial_torque: InertialTorque::On,
@@ -387,22 +364,12 @@ fn the_gyro_density_estimate_reaches_the_discrete_momentum_estimator() {
         })
         .unwrap();
     let c_final = |estimate: u8| {
-        let est = new(&InertiaSettings {
+        let settings = InertiaSettings {
             gyro_noise_estimate: estimate,
             solve_every: 50,
             ..inertia_settings_default()
-        });
-        for x in &run.samples {
-            assert_eq!(
-                push(est, &c_sample(x)),
-                InertiaStatus::Ok,
-                "{}",
-                last_error()
-            );
-        }
-        let e = get(est);
-        free(est);
-        e.j
+        };
+        final_estimate(&settings, &run.samples).j
     };
     let library = |gyro: Option<f64>| {
         let mut p = Pipeline::new(&PipelineSettings {

@@ -15,6 +15,23 @@ pub fn c_sample(s: &Sample) -> InertiaSample {
     }
 }
 
+/// A heap estimator with `settings` fed every sample (each push must succeed), freed;
+/// its final estimate.
+pub fn final_estimate(settings: &InertiaSettings, samples: &[Sample]) -> InertiaEstimate {
+    let est = new(settings);
+    for x in samples {
+        assert_eq!(
+            push(est, &c_sample(x)),
+            InertiaStatus::Ok,
+            "{}",
+            last_error()
+        );
+    }
+    let e = get(est);
+    free(est);
+    e
+}
+
 /// Storage for one estimator in caller memory, aligned for it.
 #[repr(C, align(64))]
 pub struct Storage(pub [u8; 1 << 16]);
