@@ -329,9 +329,17 @@ def test_a_thrust_sigma_covers_basilisks_in_step_switching(cli, tmp_path):
     (``--torque-scale-sigma``) covers it."""
     pytest.importorskip("Basilisk", reason="Basilisk not installed (pip install bsk)")
     d = basilisk_flight(seed=3, thrusters=True, dynamics_step=0.01)
-    exact = z_scores(estimate(cli, tmp_path, d, "thr10"))
-    stated = z_scores(estimate(cli, tmp_path, d, "thr10", "--torque-scale-sigma", "0.5%"))
+    exact_report = estimate(cli, tmp_path, d, "thr10")
+    stated_report = estimate(cli, tmp_path, d, "thr10", "--torque-scale-sigma", "0.5%")
+    exact, stated = z_scores(exact_report), z_scores(stated_report)
+
+    def centre_z(report):
+        c = report["outside"]["centre_of_mass_m"]
+        return (np.array(c["value"]) - CENTRE_OF_MASS) / np.array(c["sigma"])
+
     print(f"Basilisk thrusters at 10 ms: worst |z| {np.abs(exact).max():.2f} taken as exact, "
-          f"{np.abs(stated).max():.2f} with a 0.5 % thrust σ")
+          f"{np.abs(stated).max():.2f} with a 0.5 % thrust σ; centre of mass |z| "
+          f"{np.abs(centre_z(exact_report)).max():.2f} and {np.abs(centre_z(stated_report)).max():.2f}")
     assert np.abs(exact).max() > 3.0, exact
     assert np.abs(stated).max() < 3.0, stated
+    assert np.abs(centre_z(stated_report)).max() < 3.0, centre_z(stated_report)

@@ -30,7 +30,7 @@ use nalgebra::{Matrix3, Matrix3x6, Vector3};
 
 /// Earth's gravitational parameter, m³/s² (WGS 84 / EGM96 value): the default μ of the
 /// gravity-gradient torque.
-pub const EARTH_MU_M3_S2: f64 = 3.986_004_418e14;
+pub(crate) const EARTH_MU_M3_S2: f64 = 3.986_004_418e14;
 
 /// Which torques of outside measurements the rows model, where the samples give the
 /// measurement (each on by default: a measurement given is a torque to model).
@@ -142,6 +142,45 @@ pub struct OutsideEstimates {
 }
 
 impl OutsideEstimates {
+    /// These estimates with consider terms added to their σ in quadrature, per component:
+    /// `moves[0]` the residual dipole's (A m²), `moves[1]` the centre of mass's (m). A
+    /// component without σ (not separated from the others) stays without.
+    #[must_use]
+    pub(crate) fn widened(mut self, moves: &[[f64; 3]; 2]) -> Self {
+        for (e, m) in [&mut self.residual_dipole_am2, &mut self.centre_of_mass_m]
+            .into_iter()
+            .zip(moves)
+        {
+            if let Some(e) = e.as_mut() {
+                for (sigma, m) in e.sigma.iter_mut().zip(m) {
+                    *sigma = sigma.map(|v| crate::math::sqrt(v * v + m * m));
+                }
+            }
+        }
+        self
+    }
+
+    /// The move of each estimate from `self` to `other`, per component (zero where either
+    /// lacks it): the dipole's and the centre of mass's, as [`Self::widened`] takes them.
+    #[must_use]
+    pub(crate) fn moves_to(&self, other: &Self) -> [[f64; 3]; 2] {
+        let d = |a: &Option<Estimated3>, b: &Option<Estimated3>| match (a, b) {
+            (Some(a), Some(b)) => core::array::from_fn(|k| {
+                let m = (b.value[k] - a.value[k]).abs();
+                if m.is_finite() {
+                    m
+                } else {
+                    0.0
+                }
+            }),
+            _ => [0.0; 3],
+        };
+        [
+            d(&self.residual_dipole_am2, &other.residual_dipole_am2),
+            d(&self.centre_of_mass_m, &other.centre_of_mass_m),
+        ]
+    }
+
     /// Whether there is anything to report.
     #[must_use]
     pub(crate) fn any(&self) -> bool {

@@ -155,7 +155,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
     }
 
     /// Solve with the data so far, stamped `t_s`.
-    pub fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
+    pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;
         let (solved, fit) = super::prior::augment(&self.qr, &self.constraints);
         self.solved = solved;
@@ -200,7 +200,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
 
     /// The latest estimate.
     #[must_use]
-    pub fn last(&self) -> Option<&Estimate> {
+    pub(crate) fn last(&self) -> Option<&Estimate> {
         self.last.as_ref()
     }
 

@@ -130,6 +130,9 @@ pub struct Run {
     records: records::Records,
     /// Whether any sample carried a known torque (for the torque scale's term).
     known_torque: bool,
+    /// The known torque's scale term of the residual dipole and the centre of mass, once
+    /// computed (`torque_scale_term`): added to their σ in the report.
+    outside_scale_move: Option<[[f64; 3]; 2]>,
 }
 
 impl core::fmt::Debug for Run {
@@ -190,6 +193,7 @@ impl Run {
             calibration_not_made: None,
             records: records::Records::default(),
             known_torque: false,
+            outside_scale_move: None,
         })
     }
 
@@ -489,7 +493,9 @@ impl Run {
             if let Some(c) = self.held_lag_term(samples) {
                 self.config.wheel_delay_consider = Some(c);
             }
-            self.config.torque_scale_consider = self.torque_scale_term(samples);
+            let scale = self.torque_scale_term(samples);
+            self.config.torque_scale_consider = scale.map(|s| s.0);
+            self.outside_scale_move = scale.map(|s| s.1);
         }
         if let Mode::Batch { samples, out: None } = &mut self.mode {
             if self.config.calibrate_rotors {
@@ -677,6 +683,7 @@ impl Run {
         };
         Some(
             report
+                .with_outside_consider(self.outside_scale_move)
                 .with_wheel_delay(self.delay.as_ref())
                 .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
                 .with_rotor_calibration(self.calibration.as_ref(), self.calibration_not_made)

@@ -133,7 +133,7 @@ impl PipelineSettings {
     /// [`Self::default`] with empty estimator and solver names, built without the heap: for
     /// [`Self::check`] where the registry entry is already chosen (the C API's).
     #[must_use]
-    pub fn unnamed() -> Self {
+    pub(crate) fn unnamed() -> Self {
         Self {
             estimator: std::string::String::new(),
             solver: std::string::String::new(),

@@ -230,7 +230,7 @@ impl Vehicle {
 
 /// Plan the manoeuvre (module docs): stop at the end of the tour in which the
 /// information-matrix σ meets the target.
-pub fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
+pub(crate) fn plan(v: &Vehicle, s: &PlanSettings) -> Result<Plan, PlanError> {
     let full = plan_full(v, s)?;
     let met = s.target_relative.and_then(|t| full.prediction.time_to(t));
     Ok(match met {
@@ -363,7 +363,7 @@ impl Plan {
 /// flights meet the target, and stops at the end of that tour.
 #[cfg(feature = "sim")]
 #[derive(Debug, Clone, PartialEq)]
-pub struct RehearsedPlan {
+pub(crate) struct RehearsedPlan {
     /// The plan (its `target_met_s` is the information-matrix time).
     pub plan: Plan,
     /// Estimate times of the rehearsal, s.
@@ -382,7 +382,7 @@ pub struct RehearsedPlan {
 /// soonest is kept, cut at the end of the manoeuvre in which both its information σ and
 /// its rehearsal meet the target.
 #[cfg(feature = "sim")]
-pub fn plan_rehearsed(
+pub(crate) fn plan_rehearsed(
     v: &Vehicle,
     s: &PlanSettings,
     flight: &rehearse::FlightSettings,

@@ -429,7 +429,7 @@ impl DiscreteMomentum {
 
     /// The outside torques' σ with their model spread in quadrature ([`outside_spread`]),
     /// over the candidates [`Evidence::model_spread`] takes for `j`.
-    fn widened_by_model_spread(&self, mut o: OutsideEstimates) -> OutsideEstimates {
+    fn widened_by_model_spread(&self, o: OutsideEstimates) -> OutsideEstimates {
         let others = self
             .candidates
             .iter()
@@ -463,17 +463,7 @@ impl DiscreteMomentum {
                 }
             }
         }
-        for (e, s) in [&mut o.residual_dipole_am2, &mut o.centre_of_mass_m]
-            .into_iter()
-            .zip(spread)
-        {
-            if let Some(e) = e.as_mut() {
-                for (sigma, s) in e.sigma.iter_mut().zip(s) {
-                    *sigma = sigma.map(|v| libm::sqrt(v * v + s * s));
-                }
-            }
-        }
-        o
+        o.widened(&spread)
     }
 
     /// Rule out the candidates the data have ruled out ([`standing`]). The first

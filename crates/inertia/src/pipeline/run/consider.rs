@@ -21,8 +21,13 @@ impl Run {
     /// the run's batch solve of the samples as given and again with the known torque and
     /// the force scaled, pinned to the row model the first chose (as the rotors' consider
     /// term is, `rotor_inertia`), so that it measures the answer's sensitivity rather
-    /// than a switch of model. `None` where either solve gives no J.
-    pub(super) fn torque_scale_term(&self, samples: &[Sample]) -> Option<[f64; 6]> {
+    /// than a switch of model. `None` where either solve gives no J. With it, the same
+    /// solves' move of the residual dipole and the centre of mass, where estimated
+    /// (`OutsideEstimates::moves_to`; zero where neither solve has them).
+    pub(super) fn torque_scale_term(
+        &self,
+        samples: &[Sample],
+    ) -> Option<([f64; 6], [[f64; 3]; 2])> {
         let r = self.config.torque_scale_sigma?;
         if !(r > 0.0) || !samples.iter().any(|s| s.tau_nm.iter().any(|&x| x != 0.0)) {
             return None;
@@ -42,12 +47,14 @@ impl Run {
                 x
             })
             .collect();
-        let j1 = crate::pipeline::batch_of_records(&scaled, &pinned, &starts)
-            .ok()?
-            .estimate
-            .j()?;
+        let second = crate::pipeline::batch_of_records(&scaled, &pinned, &starts).ok()?;
+        let j1 = second.estimate.j()?;
         let out: [f64; 6] = core::array::from_fn(|k| (j1[k] - j0[k]).abs());
-        out.iter().all(|x| x.is_finite()).then_some(out)
+        let outside = match (&first.diagnostics.outside, &second.diagnostics.outside) {
+            (Some(a), Some(b)) => a.moves_to(b),
+            _ => [[0.0; 3]; 2],
+        };
+        out.iter().all(|x| x.is_finite()).then_some((out, outside))
     }
 
     /// Where a streaming run could not keep its samples (a memory, or more than it keeps)
@@ -71,7 +78,11 @@ impl Run {
         let streaming = matches!(self.mode, Mode::Streaming(_));
         let kept = self.kept.take();
         let (lag, scale) = match (&kept, &self.mode) {
-            (Some(kept), _) => (self.held_lag_term(kept), self.torque_scale_term(kept)),
+            (Some(kept), _) => {
+                let scale = self.torque_scale_term(kept);
+                self.outside_scale_move = scale.map(|s| s.1);
+                (self.held_lag_term(kept), scale.map(|s| s.0))
+            }
             (None, Mode::Streaming(p)) => (
                 None,
                 p.last()
