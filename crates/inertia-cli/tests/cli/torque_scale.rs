@@ -175,7 +175,10 @@ fn with_wheels_the_term_is_the_part_of_j_the_torque_sets() {
         let (plain, stated) = (centre(&exact, k, "sigma"), centre(&e, k, "sigma"));
         let moved = (centre(&off, k, "value") - centre(&e, k, "value")).abs();
         assert!(plain < 1e-5 && stated > 100.0 * plain, "{plain} {stated}");
-        assert!(moved <= 3.0 * stated, "axis {k}: σ {stated}, the error's move {moved}");
+        assert!(
+            moved <= 3.0 * stated,
+            "axis {k}: σ {stated}, the error's move {moved}"
+        );
         assert!(centre(&off, k, "value").abs() <= 3.0 * centre(&off, k, "sigma"));
     }
     // Without a known torque there is nothing to scale: no term.
