@@ -30,7 +30,7 @@ use nalgebra::{Matrix3, Matrix3x6, Vector3};
 
 /// Earth's gravitational parameter, m³/s² (WGS 84 / EGM96 value): the default μ of the
 /// gravity-gradient torque.
-pub(crate) const EARTH_MU_M3_S2: f64 = 3.986_004_418e14;
+pub const EARTH_MU_M3_S2: f64 = 3.986_004_418e14;
 
 /// Which torques of outside measurements the rows model, where the samples give the
 /// measurement (each on by default: a measurement given is a torque to model).

@@ -27,7 +27,7 @@ pub enum Chain {
 }
 
 /// The chains [`Chain::Choose`] rehearses, s: the estimator's default and two longer.
-pub(crate) const CHAIN_CHOICES_S: [f64; 3] = [crate::pipeline::DEFAULT_MAX_CHAIN_S, 60.0, 120.0];
+pub const CHAIN_CHOICES_S: [f64; 3] = [crate::pipeline::DEFAULT_MAX_CHAIN_S, 60.0, 120.0];
 
 /// What the user asks for.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,8 +6,7 @@ use crate::attitude::Quaternion;
 use crate::sim::sensors::DEG;
 use nalgebra::{Matrix3, Vector3};
 
-/// Earth's gravitational parameter, m³/s² (WGS 84 / EGM96 value).
-pub const EARTH_MU_M3_S2: f64 = 3.986_004_418e14;
+pub use crate::estimator::external_torque::EARTH_MU_M3_S2;
 /// Earth's equatorial radius, m (WGS 84).
 pub const EARTH_RADIUS_M: f64 = 6_378_137.0;
 
