@@ -200,7 +200,7 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
 
     /// The latest estimate.
     #[must_use]
-    pub(crate) fn last(&self) -> Option<&Estimate> {
+    pub fn last(&self) -> Option<&Estimate> {
         self.last.as_ref()
     }
 
