@@ -505,7 +505,8 @@ pub struct EstimateArgs {
     /// `products_of_inertia` applies to that file (and must agree with this option).
     #[arg(long, value_name = "CONVENTION", value_parser = choice::<ProductConvention>())]
     pub products: Option<ProductConvention>,
-    /// Solve every N samples (recursive estimators) [default: 1].
+    /// Solve every N samples (recursive estimators) [default: 1]; the discrete momentum
+    /// estimator also answers at the end of the input.
     #[arg(long, value_name = "N")]
     pub every: Option<usize>,
     /// Forget old data with this time constant, s (exponential weighting, for an inertia

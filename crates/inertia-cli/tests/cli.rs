@@ -12,6 +12,8 @@ mod settings_file;
 mod simulate_effects;
 #[path = "cli/simulate_options.rs"]
 mod simulate_options;
+#[path = "cli/solve_every.rs"]
+mod solve_every;
 #[path = "cli/spacecraft.rs"]
 mod spacecraft;
 #[path = "cli/torque_scale.rs"]

@@ -13,6 +13,12 @@ pub(crate) trait Estimator: Send {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError>;
     /// What the estimator can say about its run at its latest estimate.
     fn diagnostics(&self) -> Diagnostics;
+    /// End of input: the answer at the last completed row block where rows came after
+    /// the last solve (`solve_every` > 1), so that a record's end has an answer; none by
+    /// default.
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        Ok(None)
+    }
 }
 
 /// What a batch run has besides its samples and settings.

@@ -213,6 +213,31 @@ impl Pipeline {
         }
     }
 
+    /// End of input: the estimator's answer at its last completed row block, where rows
+    /// came after its last solve (`solve_every` > 1; [`interface::Estimator::flush`]),
+    /// given to `on_estimate` as a pushed sample's would be.
+    pub(crate) fn flush(
+        &mut self,
+        mut on_estimate: impl FnMut(&Estimate),
+    ) -> Result<(), PipelineError> {
+        let e = self
+            .estimator
+            .flush()
+            .map_err(|source| PipelineError::Estimator {
+                sample: None,
+                source,
+            })?;
+        if let Some(mut e) = e {
+            self.last_unsettled = Some(e);
+            status::apply(&mut e, &self.config);
+            self.checks
+                .estimate(self.input_samples.saturating_sub(1), &e)?;
+            self.last = Some(e);
+            on_estimate(&e);
+        }
+        Ok(())
+    }
+
     /// The steps where the attitude jumped against the gyro, kept under
     /// [`GlitchPolicy::Keep`] ([`crate::telemetry::glitch`]).
     #[must_use]

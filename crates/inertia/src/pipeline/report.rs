@@ -693,17 +693,6 @@ impl Report {
         self.refreshed()
     }
 
-    /// With the known torque's scale term of the residual dipole and the centre of mass
-    /// (`Run::torque_scale_term`) added to their σ.
-    #[must_use]
-    #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
-    pub(crate) fn with_outside_consider(mut self, moves: Option<[[f64; 3]; 2]>) -> Self {
-        if let (Some(o), Some(m)) = (self.outside.as_mut(), moves) {
-            *o = o.widened(&m);
-        }
-        self
-    }
-
     /// With the glitches kept, if any.
     #[must_use]
     pub(crate) fn with_glitches(mut self, check: Option<&GlitchCheck>) -> Self {

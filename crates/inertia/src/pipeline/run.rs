@@ -24,6 +24,8 @@
 mod consider;
 mod error;
 mod records;
+#[cfg(all(feature = "serde", feature = "csv"))]
+mod report;
 mod rotors;
 
 pub use crate::estimator::rotor_calibration::MIN_MOMENTUM_SIGNIFICANCE;
@@ -506,6 +508,13 @@ impl Run {
                 self.apply_rotor_consider(&taken);
             }
         }
+        // A solve every N samples: the last rows after the last solve are answered too.
+        if let Mode::Streaming(p) = &mut self.mode {
+            p.flush(&mut on_estimate).map_err(|e| RunError {
+                sample: None,
+                kind: RunErrorKind::Pipeline(e),
+            })?;
+        }
         self.widen_streaming_last(&mut on_estimate);
         match &mut self.mode {
             Mode::Streaming(p) => match p.last() {
@@ -664,49 +673,5 @@ impl Run {
             Mode::Streaming(p) => Some(p),
             Mode::Batch { .. } => None,
         }
-    }
-
-    /// The report of the newest estimate (`None` before one), with the input summarised
-    /// as `file` with the reader's counts `stats`.
-    #[cfg(all(feature = "serde", feature = "csv"))]
-    #[must_use]
-    pub fn report(
-        &self,
-        file: &str,
-        stats: &crate::telemetry::csv::ReadStats,
-    ) -> Option<super::report::Report> {
-        let report = match &self.mode {
-            Mode::Streaming(p) => super::report::Report::of_pipeline(p)?,
-            Mode::Batch { samples, out } => {
-                super::report::Report::of_batch(out.as_ref()?, &self.config, samples.len())
-            }
-        };
-        Some(
-            report
-                .with_outside_consider(self.outside_scale_move)
-                .with_wheel_delay(self.delay.as_ref())
-                .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
-                .with_rotor_calibration(self.calibration.as_ref(), self.calibration_not_made)
-                .with_held_speeds(self.held_speeds_period_samples().map(|p| {
-                    (
-                        p,
-                        p as f64 * self.input_step_s(),
-                        self.last()
-                            .and_then(|e| e.uncertainty)
-                            .is_some_and(|u| u.time_tag_kg_m2.iter().any(|&x| x > 0.0)),
-                    )
-                }))
-                .with_gyro_range(self.gyro_range.clipped().collect())
-                .with_input(super::report::InputSummary {
-                    file: file.into(),
-                    sample_period_s: self.sample_period_s(),
-                    renormalised: stats.renormalised,
-                    sign_flips: stats.sign_flips,
-                    min_step_s: stats.min_step_s,
-                    max_step_s: stats.max_step_s,
-                    attitude_from_gyro: stats.attitude_from_gyro,
-                    records: self.records.count(),
-                }),
-        )
     }
 }

@@ -66,7 +66,7 @@ use crate::tensor::InertiaVector;
 use candidates::{candidates, chained_siblings, settings, shared_sources, Candidate, SharedSource};
 use cross_check::CrossCheck;
 use finish::{finish, Evidence, Finished};
-use select::{alternatives_from_s, in_running, pick, test_inertial_torque};
+use select::in_running;
 use sigma::{
     candidate_noise_sigma, discretisation_bias, double_step, model_spread, outside_spread,
     own_answer,
@@ -117,6 +117,8 @@ struct DiscreteMomentum {
     twins: Twins,
     chosen: usize,
     since_solve: usize,
+    /// The time of the last completed row block ([`Estimator::flush`]).
+    last_block_t_s: Option<f64>,
     /// Per candidate: its last own estimate and noise σ, and the row blocks since.
     checks: Vec<Option<CrossCheck>>,
     /// The first candidate's rows on every other sample, for the discretisation bias.
@@ -189,6 +191,7 @@ impl DiscreteMomentum {
             twins: Twins::default(),
             chosen: 0,
             since_solve: 0,
+            last_block_t_s: None,
             checks: Vec::new(),
             shadow: None,
             residuals: Vec::new(),
@@ -260,11 +263,27 @@ impl DiscreteMomentum {
         let folded = self.fold(s)?;
         self.feed_shadow(s);
         self.samples += 1;
-        if !folded || !self.count_block() {
+        if !folded {
+            return Ok(None);
+        }
+        self.last_block_t_s = Some(s.t_s);
+        if !self.count_block() {
             return Ok(None);
         }
         self.pick_candidate();
         self.solve(s.t_s)
+    }
+
+    /// The answer at the last completed row block, where blocks came after the last
+    /// solve ([`Estimator::flush`]).
+    fn flush_own(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        match self.last_block_t_s {
+            Some(t_s) if self.since_solve > 0 => {
+                self.pick_candidate();
+                self.solve(t_s)
+            }
+            _ => Ok(None),
+        }
     }
 
     /// Past [`SHORT_RECORD_S`] from the first sample, a record is no longer short: the
@@ -371,27 +390,6 @@ impl DiscreteMomentum {
         }
         self.since_solve += 1;
         self.since_solve >= self.config.solve_every
-    }
-
-    /// Choose the candidate to solve ([`pick`]) and the alternatives to it
-    /// ([`alternatives_from_s`]).
-    fn pick_candidate(&mut self) {
-        self.fits.clear();
-        for (i, c) in self.candidates.iter().enumerate() {
-            self.fits.push(self.fit(i, c));
-        }
-        test_inertial_torque(&mut self.fits, &self.rows);
-        let (candidates, standing) = (&mut self.candidates, &self.standing);
-        let (chosen, from_s) = pick(&self.fits, &self.rows, |i| {
-            candidates
-                .get_mut(i)
-                .filter(|_| standing.live(i))
-                .and_then(|c| c.jackknife_sigma())
-        });
-        self.chosen = chosen;
-        self.from_s = self.rows.get(chosen).map_or(from_s, |r| {
-            alternatives_from_s(r, from_s, self.config.max_chain_s)
-        });
     }
 
     /// Solve the chosen candidate at `t_s`, once it has rows for all six unknowns, and give
@@ -516,17 +514,6 @@ impl DiscreteMomentum {
             }
         }
     }
-
-    /// Per candidate `(residual variance, residual degrees of freedom, chain length)` for
-    /// [`select::choose`], a ruled-out one's variance infinite.
-    fn fit(&self, i: usize, c: &Candidate) -> (f64, f64, Option<f64>) {
-        let v = if self.standing.live(i) {
-            c.qr().residual_variance()
-        } else {
-            f64::INFINITY
-        };
-        (v, c.qr().residual_dof(), c.row_settings().max_chain_s)
-    }
 }
 
 impl Estimator for DiscreteMomentum {
@@ -535,6 +522,15 @@ impl Estimator for DiscreteMomentum {
         let e = self.push_sample(s)?;
         let twin = match self.unweighted.as_mut() {
             Some((t, _)) => t.push_sample(s)?,
+            None => None,
+        };
+        Ok(self.weigh_for_drift(e, twin))
+    }
+
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        let e = self.flush_own()?;
+        let twin = match self.unweighted.as_mut() {
+            Some((t, _)) => t.flush_own()?,
             None => None,
         };
         Ok(self.weigh_for_drift(e, twin))

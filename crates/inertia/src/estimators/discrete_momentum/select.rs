@@ -193,3 +193,41 @@ pub(super) fn test_inertial_torque(
         fits[loser].0 = f64::INFINITY;
     }
 }
+
+impl super::DiscreteMomentum {
+    /// Choose the candidate to solve ([`pick`]) and the alternatives to it
+    /// ([`alternatives_from_s`]).
+    pub(super) fn pick_candidate(&mut self) {
+        self.fits.clear();
+        for (i, c) in self.candidates.iter().enumerate() {
+            self.fits.push(self.fit(i, c));
+        }
+        test_inertial_torque(&mut self.fits, &self.rows);
+        let (candidates, standing) = (&mut self.candidates, &self.standing);
+        let (chosen, from_s) = pick(&self.fits, &self.rows, |i| {
+            candidates
+                .get_mut(i)
+                .filter(|_| standing.live(i))
+                .and_then(|c| c.jackknife_sigma())
+        });
+        self.chosen = chosen;
+        self.from_s = self.rows.get(chosen).map_or(from_s, |r| {
+            alternatives_from_s(r, from_s, self.config.max_chain_s)
+        });
+    }
+
+    /// Per candidate `(residual variance, residual degrees of freedom, chain length)` for
+    /// [`choose`], a ruled-out one's variance infinite.
+    pub(super) fn fit(
+        &self,
+        i: usize,
+        c: &super::candidates::Candidate,
+    ) -> (f64, f64, Option<f64>) {
+        let v = if self.standing.live(i) {
+            c.qr().residual_variance()
+        } else {
+            f64::INFINITY
+        };
+        (v, c.qr().residual_dof(), c.row_settings().max_chain_s)
+    }
+}
