@@ -55,10 +55,27 @@ pub struct TorqueTest {
     /// The largest shift of an element of the answer when the torque is held at zero,
     /// in the answer's jackknife σ; `None` where the χ² test decided alone.
     pub shift_z: Option<f64>,
-    /// That shift per element, `|ĵ − ĵ|τ_b=0|`, kg m², where the torque was held at zero
-    /// by it: the model uncertainty the held answer's σ carries.
+    /// Whether the answer's σ carries that shift as model uncertainty: where the torque
+    /// was held at zero by it, or kept while the two models' residual variances are ones
+    /// the data do not tell apart ([`models_told_apart`]).
+    pub shift_in_sigma: bool,
+    /// That shift per element, `|ĵ − ĵ|τ_b=0|`, kg m², where [`Self::shift_in_sigma`]:
+    /// the model uncertainty the answer's σ carries.
     #[cfg_attr(feature = "serde", serde(skip))]
-    pub held_shift_kg_m2: Option<[f64; 6]>,
+    pub model_shift_kg_m2: Option<[f64; 6]>,
+}
+
+/// Whether the residual variances with and without the torque differ by more than the
+/// data's own resolution, the rule by which the discrete momentum estimator's candidate
+/// row models are told apart: relative `1 + 3√(2/ν)` with `ν` residual degrees of
+/// freedom. Holding the torque adds `χ²` noise variances to `ρ²` and frees 3 degrees of
+/// freedom, so the variance grows by the factor `(1 + χ²/ν)(1 − 3/ν) ≈ 1 + (χ² − 3)/ν`,
+/// and the models are told apart where `χ² − 3 > 3√(2ν)`. It is looser than the χ²
+/// test, which assumes independent errors: errors correlated along the chain (vibration
+/// beating with held wheel speeds) raise `χ²` without a torque.
+#[must_use]
+pub fn models_told_apart(chi2: f64, dof: f64) -> bool {
+    chi2 - 3.0 > 3.0 * crate::math::sqrt(2.0 * dof.max(0.0))
 }
 
 /// The reduced state to solve, and the torque test: `with` has the disturbance torque
@@ -82,8 +99,14 @@ pub struct TorqueTest {
 /// torque is held at zero unless holding it moves some element of the answer by more than
 /// [`TORQUE_SHIFT_Z`] of that σ: the torque must matter to the answer, not only to the
 /// residuals. The held answer's σ then carries the move `|ĵ − ĵ|τ_b=0|`
-/// ([`TorqueTest::held_shift_kg_m2`]), the two models being ones the data do not tell
-/// apart. The move is taken with the prior knowledge of `constraints` stacked on, as the
+/// ([`TorqueTest::model_shift_kg_m2`]), the two models being ones the data do not tell
+/// apart. Where the torque moves the answer by more and is kept, its σ carries the same
+/// move unless the residual variances tell the two models apart
+/// ([`models_told_apart`]): the kept answer is then no better founded than the held
+/// one (on the lab throw whose vibration beats with its held wheel speeds, a spurious
+/// 1e-4 N m torque moved J12 by 5–6 of its jackknife σ, away from the truth). A real
+/// torque is told apart by far (the 1e-5 N m on the slew: χ²₃ > 1,600 against 400).
+/// The move is taken with the prior knowledge of `constraints` stacked on, as the
 /// answer is. (Measuring the move against its own jackknife σ instead fails where the
 /// torque is real: the delete-one answers without it then scatter with the torque's
 /// effect on each group, and a 1e-5 N m torque on the slew was dropped at 1e-2 error.)
@@ -108,14 +131,16 @@ pub(crate) fn torque_tested(
         chi2,
         held_at_zero: chi2 <= TORQUE_CHI2,
         shift_z: None,
-        held_shift_kg_m2: None,
+        shift_in_sigma: false,
+        model_shift_kg_m2: None,
     };
     if !test.held_at_zero {
         if let Some((d, z)) = sigma.and_then(|sd| shift(&with, &without, &sd, constraints)) {
             test.shift_z = Some(z);
-            if z <= TORQUE_SHIFT_Z {
-                test.held_at_zero = true;
-                test.held_shift_kg_m2 = Some(d.map(f64::abs));
+            test.held_at_zero = z <= TORQUE_SHIFT_Z;
+            if test.held_at_zero || !models_told_apart(chi2, with.residual_dof()) {
+                test.shift_in_sigma = true;
+                test.model_shift_kg_m2 = Some(d.map(f64::abs));
             }
         }
     }
@@ -476,8 +501,8 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
     }
 
     /// The noise σ per element: the larger of the least-squares and the jackknife σ
-    /// (`super::jackknife`), kg m² (the held torque's move is added by the caller,
-    /// [`Self::held_torque_shift`]).
+    /// (`super::jackknife`), kg m² (the torque test's move is added by the caller,
+    /// [`Self::torque_model_shift`]).
     pub fn robust_noise_sigma(&mut self) -> Option<[f64; 6]> {
         let ls = self.noise_sigma()?;
         Some(super::jackknife::robust_sigma(
@@ -486,12 +511,13 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         ))
     }
 
-    /// The move of the answer, kg m² per element, where the last solve's torque test held
-    /// the torque at zero for moving the answer too little (`torque_tested`): a model
-    /// uncertainty the answer's σ carries in quadrature, after every noise σ.
+    /// The move of the answer between the models with and without the torque, kg m² per
+    /// element, where the last solve's torque test could not choose between them
+    /// (`torque_tested`, [`TorqueTest::shift_in_sigma`]): a model uncertainty the
+    /// answer's σ carries in quadrature, after every noise σ.
     #[must_use]
-    pub fn held_torque_shift(&self) -> Option<[f64; 6]> {
-        self.torque_test.and_then(|t| t.held_shift_kg_m2)
+    pub fn torque_model_shift(&self) -> Option<[f64; 6]> {
+        self.torque_test.and_then(|t| t.model_shift_kg_m2)
     }
 
     /// The reduced least-squares state in `j` at the last solve.

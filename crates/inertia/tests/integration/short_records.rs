@@ -52,7 +52,7 @@ fn time_blocks_give_short_records_a_sigma_that_covers() {
             let truth = j_from_matrix(&run.inertia_kg_m2);
             let sigma_ls = e.noise_sigma().expect("σ");
             let noise = e.robust_noise_sigma().expect("σ");
-            let shift = e.held_torque_shift().unwrap_or([0.0; 6]);
+            let shift = e.torque_model_shift().unwrap_or([0.0; 6]);
             let sigma: [f64; 6] = core::array::from_fn(|k| noise[k].hypot(shift[k]));
             for k in 0..6 {
                 let err = (j[k] - truth[k]).abs();

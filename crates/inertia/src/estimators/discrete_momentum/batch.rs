@@ -7,7 +7,8 @@ use super::cross_check::COMPARABLE_FIT;
 use super::finish::{finish, Evidence, Finished};
 use super::select::{alternatives_from_s, in_running, pick, test_inertial_torque};
 use super::sigma::{
-    discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife, with_held_shift,
+    discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife,
+    with_torque_model_shift,
 };
 use super::standing::RULE_OUT_AFTER;
 use super::twins;
@@ -309,7 +310,8 @@ impl BatchRun<'_> {
         });
         // As the recursive estimator's: a torque held at zero for moving the answer too
         // little leaves that move in σ.
-        let noise = noise.map(|s| with_held_shift(s, test.and_then(|t| t.held_shift_kg_m2)));
+        let noise =
+            noise.map(|s| with_torque_model_shift(s, test.and_then(|t| t.model_shift_kg_m2)));
         Ok((e, noise))
     }
 }

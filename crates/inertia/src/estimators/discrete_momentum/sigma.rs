@@ -251,13 +251,17 @@ pub(super) fn candidate_noise_sigma(
         }
     }
     let noise = robust_sigma(&own, jackknife.as_ref());
-    Some(with_held_shift(noise, candidates[i].held_torque_shift()))
+    Some(with_torque_model_shift(
+        noise,
+        candidates[i].torque_model_shift(),
+    ))
 }
 
-/// `noise` with the move of a torque held at zero for moving the answer too little
+/// `noise` with the move between the models with and without the torque where the
+/// torque test could not choose between them
 /// ([`crate::estimator::discrete_momentum::torque_tested`]) in quadrature: the last step
 /// of the noise σ, recursive and batch alike.
-pub(super) fn with_held_shift(noise: [f64; 6], shift: Option<[f64; 6]>) -> [f64; 6] {
+pub(super) fn with_torque_model_shift(noise: [f64; 6], shift: Option<[f64; 6]>) -> [f64; 6] {
     match shift {
         Some(d) => quadrature(&noise, &d),
         None => noise,

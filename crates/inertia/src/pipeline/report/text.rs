@@ -247,6 +247,11 @@ impl fmt::Display for ReportText<'_> {
             let test = r
                 .torque_test
                 .map(|t| match t.shift_z {
+                    Some(z) if t.shift_in_sigma => format!(
+                        " (χ²₃ = {:.3e} > {TORQUE_CHI2}, and it moves the answer by {z:.3e} σ > {TORQUE_SHIFT_Z}, \
+                         but the residual variances with and without it do not tell the two apart: the move is in σ)",
+                        t.chi2
+                    ),
                     Some(z) => format!(
                         " (the data need it: χ²₃ = {:.3e} > {TORQUE_CHI2}, and it moves the answer by {z:.3e} σ > {TORQUE_SHIFT_Z})",
                         t.chi2
