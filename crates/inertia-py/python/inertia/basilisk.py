@@ -22,7 +22,8 @@ For the spacecraft file's per-wheel telemetry (``--spacecraft``: each wheel's ax
 inertia and σ, so that ``--calibrate-rotors`` and ``inertia plan`` can use them), pass
 ``per_wheel=True`` and write the file with :func:`spacecraft_toml`; the outside torques'
 measurements become the CSV's ``r_*`` (``r_BN_N``: gravity gradient), ``b_*`` (``B_B`` or
-``B_N``: residual dipole), ``dipole_*`` (``mtb_dipoles``: torque rods) and ``f_*``
+``B_N``: residual dipole), ``dipole_*`` (``mtb_dipoles``: torque rods, clipped at
+``mtb_max_dipoles`` as ``MtbEffector`` clips them) and ``f_*``
 (``thruster_forces_B``: centre of mass) columns::
 
     d = basilisk.from_basilisk(
@@ -128,6 +129,7 @@ __all__ = [
     "spacecraft_toml",
     "speed_column",
     "cell_means",
+    "mtb_dipoles_applied",
 ]
 
 
@@ -265,6 +267,7 @@ def from_basilisk(
     dipole_B=None,
     mtb_dipoles=None,
     mtb_axes_B=None,
+    mtb_max_dipoles=None,
     thruster_forces_B=None,
     thruster_locations_B=None,
 ) -> dict:
@@ -300,6 +303,12 @@ def from_basilisk(
         (N, k) (``MTBCmdMsgPayload.mtbDipoleCmds[:k]``) with ``mtb_axes_B`` (k, 3), each
         rod's axis (the columns of ``MtbEffector``'s ``GtMatrix_B``): ``Σ m_i g_i``. Needs
         the field; ``MtbEffector``'s torque ``m × B`` is then known, not also in ``tau_B``.
+    mtb_max_dipoles : (k,) each rod's limit, A m² (``MTBArrayConfigMsgPayload
+        .maxMtbDipoles[:k]``): ``MtbEffector`` clips each rod's command to ± its limit
+        before it acts, and so does this (:func:`mtb_dipoles_applied`). Clipping follows
+        averaging here, exact where no command crosses a limit within a sample interval;
+        for commands that switch between samples, clip the fine record with
+        :func:`mtb_dipoles_applied` before :func:`cell_means` instead.
     thruster_forces_B : (N, k, 3) each thruster's force, N, body axes
         (``THROutputMsgPayload.thrustForce_B``), with ``thruster_locations_B`` (k, 3), m,
         from the body frame's origin B (``thrusterLocation``): the force columns ``f_*``
@@ -371,9 +380,12 @@ def from_basilisk(
         m = np.asarray(mtb_dipoles, dtype=float)
         if m.ndim == 1 and axes.shape[0] == 1:
             m = m[:, None]
-        dipole = _array("mtb_dipoles", m, (axes.shape[0],), n) @ axes
-    elif mtb_axes_B is not None:
-        raise ValueError("mtb_axes_B: given without mtb_dipoles")
+        m = _array("mtb_dipoles", m, (axes.shape[0],), n)
+        if mtb_max_dipoles is not None:
+            m = mtb_dipoles_applied(m, mtb_max_dipoles)
+        dipole = m @ axes
+    elif mtb_axes_B is not None or mtb_max_dipoles is not None:
+        raise ValueError("mtb_axes_B, mtb_max_dipoles: given without mtb_dipoles")
     else:
         dipole = None if dipole_B is None else _array("dipole_B", dipole_B, (3,), n)
     if dipole is not None and b is None:
@@ -419,6 +431,24 @@ def from_basilisk(
         "wheel_speeds": speeds, "wheel_names": names,
         "r": r, "b": b, "dipole": dipole, "f": f,
     }
+
+
+def mtb_dipoles_applied(mtb_dipoles, mtb_max_dipoles) -> np.ndarray:
+    """The dipoles torque rods apply for their commands: ``MtbEffector`` clips each rod's
+    command (``MTBCmdMsgPayload.mtbDipoleCmds``, (N, k) A m²) to ± its limit
+    (``MTBArrayConfigMsgPayload.maxMtbDipoles[:k]``, (k,) A m², each ≥ 0)."""
+    m = np.asarray(mtb_dipoles, dtype=float)
+    if m.ndim != 2:
+        raise ValueError(f"mtb_dipoles: expected shape (N, k), got {m.shape}")
+    limit = np.asarray(mtb_max_dipoles, dtype=float).reshape(-1)
+    if limit.shape != (m.shape[1],):
+        raise ValueError(
+            f"mtb_max_dipoles: expected {m.shape[1]} limits (one per rod), got shape "
+            f"{np.shape(mtb_max_dipoles)}"
+        )
+    if not np.all(np.isfinite(limit) & (limit >= 0.0)):
+        raise ValueError(f"mtb_max_dipoles: each limit must be finite and >= 0, got {limit}")
+    return np.clip(m, -limit, limit)
 
 
 def cell_means(times, fine_times, fine_values, *, time_unit: str = "ns") -> np.ndarray:

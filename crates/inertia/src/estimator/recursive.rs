@@ -154,6 +154,16 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         self.solve_now(s.t_s).map(Some)
     }
 
+    /// At the end of the input: the estimate of the blocks since the last solve, stamped
+    /// with the last block's time (none where every block was solved or there are fewer
+    /// than 6 rows), so that `solve_every` never leaves rows unanswered.
+    pub(crate) fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        match self.last_block_t_s {
+            Some(t_s) if self.since_solve > 0 && self.qr.rows >= 6 => self.solve_now(t_s).map(Some),
+            _ => Ok(None),
+        }
+    }
+
     /// Solve with the data so far, stamped `t_s`.
     pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;

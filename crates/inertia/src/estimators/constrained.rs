@@ -123,9 +123,26 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
             let qr = self.main.qr();
             r.record(qr.rss, qr.residual_dof(), s.t_s);
         }
-        let Some(mut e) = pushed else {
+        Ok(pushed.map(|e| self.finish(e)))
+    }
+
+    /// At the end of the input, the answer to the rows since the last solve
+    /// ([`RecursiveEstimator::flush`]).
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        let Some(e) = self.main.flush()? else {
             return Ok(None);
         };
+        // The half-rate shadow's answer, for the discretisation bias: where its solve
+        // interval (half the main's, at least 8 blocks) left it none, its answer to the
+        // rows so far. Otherwise its last, as after a solve in `push`.
+        if let Some(half) = self.shadow.as_mut().filter(|h| h.last().is_none()) {
+            half.flush()?;
+        }
+        Ok(Some(self.finish(e)))
+    }
+
+    /// A solve's estimate with its σ, audit and consistency test.
+    fn finish(&mut self, mut e: Estimate) -> Estimate {
         if let (Some(half), Some(j), Some(noise)) = (&self.shadow, e.j(), self.main.noise_sigma()) {
             let j_half = half.last().and_then(|h| h.j());
             e.uncertainty = Some(combine(&noise, &j, j_half.as_ref()));
@@ -150,7 +167,7 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
             None,
             self.stated_relative_sigma,
         );
-        Ok(Some(e))
+        e
     }
 
     /// The span whose residuals stand out most.
@@ -190,6 +207,10 @@ fn build<S: RowSource + Default + Send + 'static>(
 impl<S: RowSource + Send, B: Backend + Send> Estimator for Constrained<S, B> {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         Constrained::push(self, s)
+    }
+
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        Constrained::flush(self)
     }
 
     fn diagnostics(&self) -> Diagnostics {

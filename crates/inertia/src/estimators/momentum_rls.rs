@@ -29,6 +29,8 @@ pub(crate) const MOMENTUM: EstimatorEntry = EstimatorEntry {
 struct Momentum {
     rls: MomentumRls,
     every: usize,
+    /// The last update's estimate where `every` held it back, for [`Estimator::flush`].
+    held: Option<Estimate>,
 }
 
 fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
@@ -40,13 +42,25 @@ fn build(c: &PipelineConfig) -> Result<Box<dyn Estimator>, PipelineError> {
     Ok(Box::new(Momentum {
         rls,
         every: c.solve_every,
+        held: None,
     }))
 }
 
 impl Estimator for Momentum {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         let e = self.rls.push(s)?;
-        Ok(e.filter(|_| self.rls.updates().is_multiple_of(self.every)))
+        if self.rls.updates().is_multiple_of(self.every) {
+            self.held = None;
+            return Ok(e);
+        }
+        if e.is_some() {
+            self.held = e;
+        }
+        Ok(None)
+    }
+
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        Ok(self.held.take())
     }
 
     fn diagnostics(&self) -> Diagnostics {

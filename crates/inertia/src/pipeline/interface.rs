@@ -1,5 +1,5 @@
-//! What the pipeline asks of an estimator: the [`Estimator`] trait (`push` and
-//! `diagnostics`), what it uses and needs ([`Capabilities`]) and a batch run's answer
+//! What the pipeline asks of an estimator: the [`Estimator`] trait (`push`,
+//! `diagnostics` and `flush`), what it uses and needs ([`Capabilities`]) and a batch run's answer
 //! ([`BatchOutput`]). Its registry entry is in [`super::config`], beside the validated
 //! settings it is built from; [`super::registry`] lists the entries.
 
@@ -14,11 +14,9 @@ pub(crate) trait Estimator: Send {
     /// What the estimator can say about its run at its latest estimate.
     fn diagnostics(&self) -> Diagnostics;
     /// End of input: the answer at the last completed row block where rows came after
-    /// the last solve (`solve_every` > 1), so that a record's end has an answer; none by
-    /// default.
-    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
-        Ok(None)
-    }
+    /// the last solve (`solve_every` > 1), so that a record's end has an answer; none
+    /// where the last block was answered.
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError>;
 }
 
 /// What a batch run has besides its samples and settings.

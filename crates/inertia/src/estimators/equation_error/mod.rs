@@ -123,6 +123,9 @@ pub(crate) struct EquationError {
     btb: f64,
     blocks: usize,
     samples: usize,
+    /// The time of the last sample that `solve_every` left unanswered, for
+    /// [`EquationError::flush`].
+    unanswered_t_s: Option<f64>,
 }
 
 impl EquationError {
@@ -141,6 +144,7 @@ impl EquationError {
             btb: 0.0,
             blocks: 0,
             samples: 0,
+            unanswered_t_s: None,
         }
     }
 
@@ -185,7 +189,15 @@ impl EquationError {
         let due = self
             .samples
             .is_multiple_of(self.settings.solve_every.max(1));
-        Ok((due && 3 * self.blocks > self.ata.nrows()).then(|| self.estimate(s.t_s)))
+        let ready = 3 * self.blocks > self.ata.nrows();
+        self.unanswered_t_s = (ready && !due).then_some(s.t_s);
+        Ok((due && ready).then(|| self.estimate(s.t_s)))
+    }
+
+    /// At the end of the input: the estimate at the last sample where `solve_every` left
+    /// it unanswered.
+    pub(crate) fn flush(&mut self) -> Option<Estimate> {
+        self.unanswered_t_s.take().map(|t_s| self.estimate(t_s))
     }
 
     /// The first step fixes the filter; every later one must equal it.
@@ -324,6 +336,10 @@ struct Streaming(EquationError);
 impl Estimator for Streaming {
     fn push(&mut self, s: &Sample) -> Result<Option<Estimate>, EstimatorError> {
         self.0.push(s)
+    }
+
+    fn flush(&mut self) -> Result<Option<Estimate>, EstimatorError> {
+        Ok(self.0.flush())
     }
 
     fn diagnostics(&self) -> Diagnostics {
