@@ -4,7 +4,7 @@
 //!   library (the default `discrete-momentum` among them). Built on the heap.
 //! * [`Engine::Fixed`]: the constrained least-squares estimators (`variational`,
 //!   `finite-difference`) with the native solver, in fixed-size state: the same steps the
-//!   pipeline's adapter takes (`estimators/constrained.rs`: the half-rate shadow for σ, the status
+//!   pipeline's adapter takes (`estimators/constrained.rs`: the σ shadows at 2h and 4h, the status
 //!   audit, the residual test, the status rule (`inertia::pipeline::status`), the glitch, convention and reversed-momentum checks), on concrete types with
 //!   no box. It can live in caller storage, and neither its construction nor a push
 //!   allocates (`tests/no_alloc.rs` counts). `tests/c_api/engines.rs` checks that it gives the

@@ -66,7 +66,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("eigen3_via_combine", |b| {
         b.iter(|| {
             k = (k + 1) % estimates.len();
-            black_box(combine(&noise, black_box(&estimates[k]), None))
+            black_box(combine(&noise, black_box(&estimates[k]), None, None))
         })
     });
     g.finish();

@@ -214,7 +214,7 @@ impl core::fmt::Display for Unobservable {
                 if relative_sigma.is_finite() {
                     write!(
                         f,
-                        "relative standard deviation of J {relative_sigma:.2e} > {threshold}: the data barely excite the dynamics, or a stated uncertainty (the wheels' scale) exceeds it"
+                        "relative standard deviation of J {relative_sigma:.2e} > {threshold}: the data barely excite the dynamics, the answer moves with the sample step beyond its noise (attitude noise in the paper's estimator), or a stated uncertainty (the wheels' scale) exceeds it"
                     )
                 } else {
                     write!(

@@ -164,6 +164,12 @@ impl<S: RowSource, B: Backend> RecursiveEstimator<S, B> {
         }
     }
 
+    /// Blocks folded since the last solve.
+    #[must_use]
+    pub(crate) fn unsolved_blocks(&self) -> usize {
+        self.since_solve
+    }
+
     /// Solve with the data so far, stamped `t_s`.
     pub(crate) fn solve_now(&mut self, t_s: f64) -> Result<Estimate, EstimatorError> {
         self.since_solve = 0;

@@ -50,6 +50,9 @@ pub(crate) const FINITE_DIFFERENCE: EstimatorEntry = EstimatorEntry {
     batch: Some(run_batch::<FiniteDifferenceRows>),
 };
 
+/// The fewest samples a shadow takes between its solves ([`Constrained::new`]).
+const SHADOW_SOLVE_BLOCKS: usize = 8;
+
 /// The recursive constrained least-squares estimator as the pipeline runs it: the
 /// estimator, its half-rate shadow for the uncertainty model, the status audit and the
 /// residual test, after every solve. Generic over the backend so that a fixed-size build
@@ -58,7 +61,10 @@ pub(crate) const FINITE_DIFFERENCE: EstimatorEntry = EstimatorEntry {
 #[derive(Debug, Clone)]
 pub struct Constrained<S: RowSource, B: Backend> {
     main: RecursiveEstimator<S, B>,
+    /// The shadows on every other and every fourth sample (steps 2h and 4h), for the
+    /// step-size bias ([`crate::estimator::uncertainty`]).
     shadow: Option<RecursiveEstimator<S, B>>,
+    quarter: Option<RecursiveEstimator<S, B>>,
     samples: usize,
     /// The main estimator's residual record (none under forgetting).
     residuals: Option<ResidualSegments>,
@@ -70,10 +76,14 @@ pub struct Constrained<S: RowSource, B: Backend> {
 
 impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
     /// The estimator with `settings` under `constraints`, each solve by a backend from
-    /// `backend`. With `uncertainty`, a shadow on every other sample measures the
-    /// discretisation bias (twice the step, the same memory in seconds; it measures only
-    /// the slowly varying bias, so it solves every 8th of its samples, a bias estimate at
-    /// most 1.6 s old at h = 0.1 s). With `residual_test`, the residuals are recorded for
+    /// `backend`. With `uncertainty`, shadows on every other and every fourth sample
+    /// measure the bias that changes with the step (twice and four times the step, the
+    /// same memory in seconds). They solve with the main estimator, on the same span of
+    /// the record, but at most every `SHADOW_SOLVE_BLOCKS` of their own samples (they
+    /// measure only a slowly varying bias: at a solve on every sample and h = 0.1 s, a bias
+    /// estimate at most 1.6 s and 3.2 s old), and at the end of the input always, so
+    /// that the final σ does not depend on how often the main estimator solved.
+    /// With `residual_test`, the residuals are recorded for
     /// [`crate::estimator::consistency`] (not under forgetting).
     pub fn new(
         constraints: crate::constraints::Constraints,
@@ -83,23 +93,27 @@ impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
         mut backend: impl FnMut() -> B,
     ) -> Result<Self, EstimatorError> {
         let main = RecursiveEstimator::new(S::default(), constraints, backend(), settings)?;
-        let shadow = if uncertainty {
+        let mut shadow = || -> Result<_, EstimatorError> {
+            if !uncertainty {
+                return Ok(None);
+            }
+            // Solved by `Self::push` and `Self::flush`, never by their own pushes.
             let s = RecursiveSettings {
-                solve_every: settings.solve_every.div_ceil(2).max(8),
+                solve_every: usize::MAX,
                 ..settings
             };
-            Some(RecursiveEstimator::new(
+            Ok(Some(RecursiveEstimator::new(
                 S::default(),
                 constraints,
                 backend(),
                 s,
-            )?)
-        } else {
-            None
+            )?))
         };
+        let (half, quarter) = (shadow()?, shadow()?);
         Ok(Self {
             main,
-            shadow,
+            shadow: half,
+            quarter,
             samples: 0,
             residuals: residual_test.then(ResidualSegments::new),
             observability: settings.observability,
@@ -117,13 +131,22 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
                 half.push(s)?;
             }
         }
+        if let Some(quarter) = self.quarter.as_mut() {
+            if self.samples.is_multiple_of(4) {
+                quarter.push(s)?;
+            }
+        }
         self.samples += 1;
         let pushed = self.main.push(s)?;
         if let Some(r) = self.residuals.as_mut() {
             let qr = self.main.qr();
             r.record(qr.rss, qr.residual_dof(), s.t_s);
         }
-        Ok(pushed.map(|e| self.finish(e)))
+        let Some(e) = pushed else {
+            return Ok(None);
+        };
+        self.solve_shadows(SHADOW_SOLVE_BLOCKS)?;
+        Ok(Some(self.finish(e)))
     }
 
     /// At the end of the input, the answer to the rows since the last solve
@@ -132,20 +155,31 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
         let Some(e) = self.main.flush()? else {
             return Ok(None);
         };
-        // The half-rate shadow's answer, for the discretisation bias: where its solve
-        // interval (half the main's, at least 8 blocks) left it none, its answer to the
-        // rows so far. Otherwise its last, as after a solve in `push`.
-        if let Some(half) = self.shadow.as_mut().filter(|h| h.last().is_none()) {
-            half.flush()?;
-        }
+        // The shadows on the same rows as the main estimator's final answer.
+        self.solve_shadows(1)?;
         Ok(Some(self.finish(e)))
+    }
+
+    /// Solve each shadow that has taken at least `blocks` samples since its last solve
+    /// (or has never answered).
+    fn solve_shadows(&mut self, blocks: usize) -> Result<(), EstimatorError> {
+        for shadow in [self.shadow.as_mut(), self.quarter.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            if shadow.unsolved_blocks() >= blocks || shadow.last().is_none() {
+                shadow.flush()?;
+            }
+        }
+        Ok(())
     }
 
     /// A solve's estimate with its σ, audit and consistency test.
     fn finish(&mut self, mut e: Estimate) -> Estimate {
         if let (Some(half), Some(j), Some(noise)) = (&self.shadow, e.j(), self.main.noise_sigma()) {
             let j_half = half.last().and_then(|h| h.j());
-            e.uncertainty = Some(combine(&noise, &j, j_half.as_ref()));
+            let j_quarter = self.quarter.as_ref().and_then(|q| q.last()?.j());
+            e.uncertainty = Some(combine(&noise, &j, j_half.as_ref(), j_quarter.as_ref()));
         }
         audit(
             &mut e,
@@ -245,18 +279,36 @@ fn run_batch<S: RowSource + Default>(
     };
     let qr = batch::reduce(samples, &mut source).map_err(wrap)?;
     let mut backend = c.backend.build();
-    let mut estimate = batch::solve_reduced(
-        &qr,
-        samples.last().map_or(0.0, |s| s.t_s),
-        &c.constraints,
-        &mut *backend,
-        &c.observability,
-        c.gyro_noise_rad_s_rthz,
-    )
-    .map_err(wrap)?;
+    let t_s = samples.last().map_or(0.0, |s| s.t_s);
+    let mut solve = |qr: &crate::estimator::qr::RecursiveQr| {
+        batch::solve_reduced(
+            qr,
+            t_s,
+            &c.constraints,
+            &mut *backend,
+            &c.observability,
+            c.gyro_noise_rad_s_rthz,
+        )
+    };
+    let mut estimate = solve(&qr).map_err(wrap)?;
+    let solved = crate::estimator::prior::augment(&qr, &c.constraints).0;
+    // σ as the recursive run has it: the least-squares σ and the step-size bias from the
+    // same record at twice and four times the step (`crate::estimator::uncertainty`).
+    if c.uncertainty && c.estimator.capabilities.uncertainty {
+        let mut at_step = |every: usize| -> Option<crate::tensor::InertiaVector> {
+            let thinned: std::vec::Vec<Sample> = samples.iter().step_by(every).copied().collect();
+            let qr = batch::reduce(&thinned, &mut S::default()).ok()?;
+            solve(&qr).ok()?.j()
+        };
+        let (half, quarter) = (at_step(2), at_step(4));
+        let noise = diagnose(&solved, &c.observability).element_sigma;
+        if let (Some(j), Some(noise)) = (estimate.j(), noise) {
+            estimate.uncertainty = Some(combine(&noise, &j, half.as_ref(), quarter.as_ref()));
+        }
+    }
     audit(
         &mut estimate,
-        &crate::estimator::prior::augment(&qr, &c.constraints).0,
+        &solved,
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
         c.stated_relative_sigma(),

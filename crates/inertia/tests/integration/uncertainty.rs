@@ -5,9 +5,11 @@
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::batch;
 use inertia::estimator::excitation::diagnose;
+use inertia::estimator::observability::Observability;
 use inertia::estimator::observability::ObservabilitySettings;
 use inertia::estimator::rows::VariationalRows;
 use inertia::estimator::uncertainty::combine;
+use inertia::pipeline::{Pipeline, PipelineSettings};
 use inertia::sample::Sample;
 use inertia::sim::scenario::{Common, Scenario};
 use inertia::solver::native::NativeSolver;
@@ -46,15 +48,16 @@ fn one_run(sc: &Scenario, gyro_deg: f64, seed: u64) -> [f64; 6] {
         .unwrap()
     };
     let full = estimate(&out.samples);
-    let half: Vec<Sample> = out.samples.iter().step_by(2).copied().collect();
-    let j_half = estimate(&half);
+    let thinned =
+        |every: usize| -> Vec<Sample> { out.samples.iter().step_by(every).copied().collect() };
+    let (j_half, j_quarter) = (estimate(&thinned(2)), estimate(&thinned(4)));
     let noise = diagnose(
         &batch::reduce(&out.samples, VariationalRows::default()).unwrap(),
         &ObservabilitySettings::default(),
     )
     .element_sigma
     .unwrap();
-    let u = combine(&noise, &full, Some(&j_half));
+    let u = combine(&noise, &full, Some(&j_half), Some(&j_quarter));
     let truth = j_from_matrix(&out.inertia_kg_m2);
     core::array::from_fn(|k| (full[k] - truth[k]).abs() / u.sigma_kg_m2[k])
 }
@@ -104,5 +107,62 @@ fn three_sigma_coverage_is_between_90_and_100_percent() {
                 sc.name()
             );
         }
+    }
+}
+
+/// The paper's estimator through the pipeline on `samples` (a solve at every sample): its final answer, whether it
+/// is "determined" and whether the truth lies within 3σ of it.
+fn variational_final(samples: &[Sample], truth: &nalgebra::Matrix3<f64>) -> (bool, bool) {
+    let settings = PipelineSettings {
+        estimator: "variational".into(),
+        ..PipelineSettings::default()
+    };
+    let mut p = Pipeline::new(&settings).unwrap();
+    for s in samples {
+        p.push(s).unwrap();
+    }
+    let e = p.last().unwrap();
+    (
+        matches!(e.observability, Observability::Determined { .. }),
+        e.within_3sigma(truth) == Some(true),
+    )
+}
+
+/// Attitude noise shrinks the paper's estimate by an amount that falls with the step
+/// (errors in variables): a 60 s slew with the paper's gyro came out 3.2σ low on J33
+/// (5 %) and a spin with a FOG-propagated attitude 1 % low, both "determined", when σ
+/// took the bias for a discretisation remainder of order 2. With the order the steps h,
+/// 2h and 4h show, every determined answer holds the truth within 3σ (and most answers
+/// are determined: σ is widened, not the data refused).
+#[test]
+fn the_step_size_bias_covers_the_errors_in_variables_shrinkage() {
+    let cases = [
+        (Scenario::slew(), 1e-5, Some(60.0)),
+        (Scenario::spin(), 0.02 / 60.0, None),
+    ];
+    for (sc, gyro, duration_s) in cases {
+        let mut determined = 0;
+        for seed in 31..=36 {
+            let out = sc
+                .simulate(&Common {
+                    gyro_noise_deg_s_rthz: gyro,
+                    duration_s,
+                    seed,
+                    ..Common::physical()
+                })
+                .unwrap();
+            let (d, within) = variational_final(&out.samples, &out.inertia_kg_m2);
+            assert!(
+                !d || within,
+                "{} seed {seed}: determined beyond 3σ",
+                sc.name()
+            );
+            determined += usize::from(d);
+        }
+        assert!(
+            determined >= 4,
+            "{}: {determined} of 6 determined",
+            sc.name()
+        );
     }
 }
