@@ -36,7 +36,8 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
 
 import numpy as np
 
-from . import DataError, _pandas, estimate, read_csv, simulate
+from . import DataError, estimate, read_csv, simulate
+from ._common import _pandas
 
 __all__ = ["estimate_files", "monte_carlo", "summary", "ELEMENTS"]
 
