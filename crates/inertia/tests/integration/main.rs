@@ -31,7 +31,6 @@ mod rotor_scale;
 mod short_records;
 mod sim_effects;
 mod sim_realism;
-mod solver_agreement;
 mod solver_random;
 mod uncertainty;
 mod wheel_delay;

@@ -1,5 +1,5 @@
 //! The native solver on seeded random problems, judged by its own optimality conditions
-//! (runs in the default build; `solver_agreement.rs` compares with Clarabel).
+//! (runs in the default build; `tests/solver_agreement.rs` compares with Clarabel).
 
 use crate::common;
 

@@ -12,9 +12,13 @@
 //! the *reference's* suboptimality; the `j` criterion then adds nothing and is applied
 //! only where the native objective is the higher one. (Such cases are counted: they are
 //! zero-residual problems whose optimum lies exactly on the boundary.)
+//!
+//! A test binary of its own, so that `.ci/run` builds only this file and the random
+//! problems beside the library with the feature (not the whole integration binary).
 #![cfg(feature = "clarabel")]
 
-use crate::common;
+#[path = "integration/common/mod.rs"]
+mod common;
 
 use inertia::solver::clarabel_backend::ClarabelSolver;
 use inertia::solver::native::NativeSolver;
