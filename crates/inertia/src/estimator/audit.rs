@@ -87,6 +87,7 @@ pub(crate) fn audit_at(
             e.observability = Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma,
                 threshold: max_relative_sigma,
+                dominant: u.dominant_part(),
             });
             e.solution = None;
             e.uncertainty = None;

@@ -72,12 +72,17 @@ pub enum Unobservable {
         /// Numerical rank of `R`.
         rank: usize,
     },
-    /// The rows explain too little: the estimate is mostly noise.
+    /// The answer's relative σ exceeds the threshold: the rows explain too little, or a
+    /// part of σ beyond their noise is too large.
     Uncertain {
-        /// `‖σ_j‖/‖ĵ‖` of the unconstrained estimate.
+        /// `‖σ_j‖_F/‖Ĵ‖_F`.
         relative_sigma: f64,
         /// The threshold it exceeds.
         threshold: f64,
+        /// The part of σ that dominates ([`Uncertainty::dominant_part`]).
+        ///
+        /// [`Uncertainty::dominant_part`]: super::uncertainty::Uncertainty::dominant_part
+        dominant: super::uncertainty::SigmaPart,
     },
     /// With errors-in-variables compensation, the gyro noise outweighs the excitation
     /// (the compensated information matrix is not positive definite).
@@ -210,11 +215,12 @@ impl core::fmt::Display for Unobservable {
             Unobservable::Uncertain {
                 relative_sigma,
                 threshold,
+                dominant,
             } => {
                 if relative_sigma.is_finite() {
                     write!(
                         f,
-                        "relative standard deviation of J {relative_sigma:.2e} > {threshold}: the data barely excite the dynamics, the answer moves with the sample step beyond its noise (attitude noise in the paper's estimator), or a stated uncertainty (the wheels' scale) exceeds it"
+                        "relative standard deviation of J {relative_sigma:.2e} > {threshold}, most of it from {dominant}"
                     )
                 } else {
                     write!(
@@ -504,6 +510,7 @@ pub(crate) fn assess_with(
             return Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: rel,
                 threshold: settings.max_relative_sigma,
+                dominant: super::uncertainty::SigmaPart::Noise,
             });
         }
         (Unobservable::NoExcitation, weak.max(1))
@@ -523,6 +530,7 @@ pub(crate) fn assess_with(
             return Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: rel,
                 threshold: settings.max_relative_sigma,
+                dominant: super::uncertainty::SigmaPart::Noise,
             });
         }
         return Observability::Determined { condition };

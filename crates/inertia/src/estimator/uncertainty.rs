@@ -70,8 +70,91 @@ pub struct Uncertainty {
     pub principal_sigma_kg_m2: [f64; 3],
 }
 
+/// One part of an answer's σ ([`Uncertainty`]'s fields): the one that dominates says why
+/// a relative σ withholds an answer ([`super::observability::Unobservable::Uncertain`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[non_exhaustive]
+pub enum SigmaPart {
+    /// The rows' noise (`noise_kg_m2`): the data barely excite the dynamics.
+    Noise,
+    /// The step-size bias (`bias_kg_m2`): the answer moves with the sample step.
+    StepBias,
+    /// What the named parts leave of σ: the scatter between parts of the record (the
+    /// resampling estimate) or between candidate models.
+    Spread,
+    /// The rotor momentum's stated scale σ (`rotor_scale_kg_m2`).
+    RotorScale,
+    /// The wheel-speed time tag (`time_tag_kg_m2`).
+    TimeTag,
+    /// The rotors' stated spin-inertia σ (`rotor_inertia_kg_m2`).
+    RotorInertia,
+    /// The known torque's stated scale σ (`torque_scale_kg_m2`).
+    TorqueScale,
+}
+
+impl core::fmt::Display for SigmaPart {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            SigmaPart::Noise => "the rows' noise: the data barely excite the dynamics",
+            SigmaPart::StepBias => {
+                "the step-size bias: the answer moves with the sample step beyond its noise (attitude noise in the paper's estimator)"
+            }
+            SigmaPart::Spread => {
+                "the scatter between parts of the record: they disagree beyond their noise"
+            }
+            SigmaPart::RotorScale => "the stated uncertainty of the wheels' scale",
+            SigmaPart::TimeTag => "the wheel speeds' time tag",
+            SigmaPart::RotorInertia => "the rotors' stated spin-inertia uncertainty",
+            SigmaPart::TorqueScale => "the known torque's stated scale uncertainty",
+        })
+    }
+}
+
+/// `‖x‖²` of per-element values as `‖·‖_F²` of the tensor (each product of inertia twice).
+fn frobenius_squared(x: &[f64; 6]) -> f64 {
+    x[0] * x[0] + x[1] * x[1] + x[2] * x[2] + 2.0 * (x[3] * x[3] + x[4] * x[4] + x[5] * x[5])
+}
+
 #[cfg_attr(not(feature = "std"), allow(dead_code))]
 impl Uncertainty {
+    /// The part of σ with the largest Frobenius norm; [`SigmaPart::Spread`] is what the
+    /// named parts leave of `σ_F²`.
+    #[must_use]
+    pub fn dominant_part(&self) -> SigmaPart {
+        let named = [
+            (SigmaPart::Noise, frobenius_squared(&self.noise_kg_m2)),
+            (SigmaPart::StepBias, frobenius_squared(&self.bias_kg_m2)),
+            (
+                SigmaPart::RotorScale,
+                frobenius_squared(&self.rotor_scale_kg_m2),
+            ),
+            (SigmaPart::TimeTag, frobenius_squared(&self.time_tag_kg_m2)),
+            (
+                SigmaPart::RotorInertia,
+                frobenius_squared(&self.rotor_inertia_kg_m2),
+            ),
+            (
+                SigmaPart::TorqueScale,
+                frobenius_squared(&self.torque_scale_kg_m2),
+            ),
+        ];
+        let spread =
+            frobenius_squared(&self.sigma_kg_m2) - named.iter().map(|(_, v)| v).sum::<f64>();
+        named
+            .into_iter()
+            .chain(core::iter::once((SigmaPart::Spread, spread)))
+            .fold((SigmaPart::Noise, f64::NEG_INFINITY), |best, (part, v)| {
+                if v > best.1 {
+                    (part, v)
+                } else {
+                    best
+                }
+            })
+            .0
+    }
+
     /// The part of each element's σ beyond its noise (discretisation bias, model spread,
     /// consider terms), `√(σ² − σ_noise²)`, kg m².
     #[must_use]
@@ -152,13 +235,7 @@ impl Uncertainty {
     /// product of inertia appears twice in J.
     #[must_use]
     pub fn frobenius_sigma_kg_m2(&self) -> f64 {
-        let s = &self.sigma_kg_m2;
-        crate::math::sqrt(
-            s[0] * s[0]
-                + s[1] * s[1]
-                + s[2] * s[2]
-                + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]),
-        )
+        crate::math::sqrt(frobenius_squared(&self.sigma_kg_m2))
     }
 }
 
@@ -307,5 +384,37 @@ mod tests {
         // Without the estimate at 4h, the order 2 of the rows.
         let u = combine(&[0.0; 6], &at(2.0, 1.0), Some(&at(2.0, 2.0)), None);
         assert!((u.bias_kg_m2[2] - c[2].abs()).abs() <= 1e-12);
+    }
+
+    /// Problem: σ made of one large part at a time. Reference: that part, with the
+    /// products of inertia counted twice (as in `‖·‖_F`), and what the named parts leave
+    /// of σ² as the spread.
+    #[test]
+    fn the_dominant_part_is_the_largest_in_the_frobenius_norm() {
+        let j = InertiaVector::from_column_slice(&[1.0, 2.0, 3.0, 0.0, 0.0, 0.0]);
+        let noise = [1e-3; 6];
+        let u = combine(&noise, &j, None, None);
+        assert_eq!(u.dominant_part(), SigmaPart::Noise);
+        let shifted = j + InertiaVector::from_column_slice(&[0.0, 0.0, 0.1, 0.0, 0.0, 0.0]);
+        let u = combine(&noise, &j, Some(&shifted), None);
+        assert_eq!(u.dominant_part(), SigmaPart::StepBias);
+        assert_eq!(
+            u.with_rotor_scale(&j, 0.5).dominant_part(),
+            SigmaPart::RotorScale
+        );
+        // J11's bias 1.0 against J12's noise 0.8, which counts twice: 1.28 > 1.
+        let u = Uncertainty {
+            sigma_kg_m2: [1.0, 0.0, 0.0, 0.8, 0.0, 0.0],
+            noise_kg_m2: [0.0, 0.0, 0.0, 0.8, 0.0, 0.0],
+            bias_kg_m2: [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            ..combine(&[0.0; 6], &j, None, None)
+        };
+        assert_eq!(u.dominant_part(), SigmaPart::Noise);
+        // σ three times its noise, nothing named beside it: the rest is spread.
+        let u = Uncertainty {
+            sigma_kg_m2: [3e-3; 6],
+            ..combine(&noise, &j, None, None)
+        };
+        assert_eq!(u.dominant_part(), SigmaPart::Spread);
     }
 }

@@ -328,6 +328,7 @@ mod tests {
             Observability::NotObservable(Unobservable::Uncertain {
                 relative_sigma: f64::INFINITY,
                 threshold: 0.1,
+                dominant: crate::estimator::uncertainty::SigmaPart::Noise,
             }),
             Observability::Unchecked,
         ];

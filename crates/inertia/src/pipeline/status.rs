@@ -154,6 +154,7 @@ fn widen(
         e.observability = Observability::NotObservable(Unobservable::Uncertain {
             relative_sigma,
             threshold,
+            dominant: u.dominant_part(),
         });
     }
 }

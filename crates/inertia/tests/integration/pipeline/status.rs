@@ -405,7 +405,7 @@ fn a_sigma_comparable_to_j_is_not_determined() {
     assert!(
         matches!(
             e.observability,
-            Observability::NotObservable(Unobservable::Uncertain { relative_sigma, threshold })
+            Observability::NotObservable(Unobservable::Uncertain { relative_sigma, threshold, .. })
                 if relative_sigma > threshold
         ),
         "{}",
