@@ -7,7 +7,8 @@
 //! WHEEL_DELAY=estimate cargo run --release -p inertia-cli --example records -- 20
 //! ```
 //!
-//! `WHEEL_DELAY`: the wheel speeds' time tag (`off`, seconds or `estimate`), off when unset.
+//! `WHEEL_DELAY`: the wheel speeds' time tag (`off`, seconds or `estimate`), off when unset;
+//! `INERTIAL`: the inertial torque (`off`, `on`, `auto`, `short`), the default when unset.
 //!
 //! **Data.** Each set is `n` records of one spacecraft, each record with its own seed,
 //! initial state and disturbances:
@@ -30,7 +31,7 @@
 
 use inertia::estimator::observability::Observability;
 use inertia::estimator::Estimate;
-use inertia::pipeline::{PipelineSettings, Run};
+use inertia::pipeline::{InertialTorque, PipelineSettings, Run};
 use inertia::sample::Sample;
 use inertia::sim::presets::Preset;
 use inertia::sim::scenario::{Common, Scenario, SlewPlan};
@@ -43,6 +44,10 @@ use rayon::prelude::*;
 fn pooled(records: &[Vec<Sample>]) -> Option<Estimate> {
     let config = PipelineSettings {
         wheel_delay: wheel_delay_from_env(),
+        inertial_torque: std::env::var("INERTIAL").map_or(Default::default(), |v| {
+            v.parse::<InertialTorque>()
+                .unwrap_or_else(|e| panic!("INERTIAL: {e}"))
+        }),
         ..PipelineSettings::default()
     }
     .validate()

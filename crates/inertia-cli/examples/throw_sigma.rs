@@ -5,14 +5,17 @@
 //!
 //! `cargo run --release -p inertia-cli --example throw_sigma -- [THROWS]` (default 60,
 //! seeds from `FROM`, default 0; `WHEEL_DELAY=off|SECONDS|estimate` the wheel speeds'
-//! time tag, off when unset). Results: the book, "What you tell the run: the wheel
-//! speeds' time tag".
+//! time tag, off when unset; `WITHOUT=vibration,speed,inertial,drag` lab effects left
+//! out; `INERTIAL=off|on|auto|short` the inertial torque, the default when unset; `DETAIL=1`
+//! each determined answer beyond 3σ on stderr: seed, worst element and the parts of its
+//! σ). Results: the book, "What you tell the run: the wheel speeds' time tag" and "A
+//! torque fixed in the inertial frame".
 
 use inertia::estimator::observability::Observability;
 use inertia::estimator::Estimate;
-use inertia::pipeline::{PipelineSettings, Run};
+use inertia::pipeline::{InertialTorque, PipelineSettings, Run};
 use inertia::sample::Sample;
-use inertia::sim::presets::Preset;
+use inertia::sim::presets::{LabEffect, Preset};
 use inertia::tensor::j_from_matrix;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
@@ -24,6 +27,10 @@ fn estimate(samples: &[Sample], batch: bool) -> Option<Estimate> {
     let config = PipelineSettings {
         solve_every: 50,
         wheel_delay,
+        inertial_torque: std::env::var("INERTIAL").map_or(Default::default(), |v| {
+            v.parse::<InertialTorque>()
+                .unwrap_or_else(|e| panic!("INERTIAL: {e}"))
+        }),
         ..PipelineSettings::default()
     }
     .validate()
@@ -45,6 +52,21 @@ fn judge(e: Option<Estimate>, truth: &Matrix3<f64>) -> (bool, bool, bool) {
     let t = j_from_matrix(truth);
     let determined = matches!(e.observability, Observability::Determined { .. });
     let beyond = (0..6).any(|k| (j[k] - t[k]).abs() > 3.0 * s[k]);
+    if std::env::var("DETAIL").is_ok() && determined && beyond {
+        let u = e.uncertainty.unwrap();
+        let k = (0..6)
+            .max_by(|&a, &b| ((j[a] - t[a]).abs() / s[a]).total_cmp(&((j[b] - t[b]).abs() / s[b])))
+            .unwrap();
+        eprintln!(
+            "element {k}: z {:.2} err {:.2e} sigma {:.2e} noise {:.2e} bias {:.2e} tag {:.2e}",
+            (j[k] - t[k]) / s[k],
+            j[k] - t[k],
+            s[k],
+            u.noise_kg_m2[k],
+            u.bias_kg_m2[k],
+            u.time_tag_kg_m2[k]
+        );
+    }
     (true, determined, determined && beyond)
 }
 
@@ -56,10 +78,28 @@ fn main() {
     let runs: Vec<[(bool, bool, bool); 2]> = (from..from + n)
         .into_par_iter()
         .map(|seed| {
-            let mut p = Preset::throw().with_drawn_tumble(seed);
+            let without: Vec<LabEffect> = std::env::var("WITHOUT")
+                .unwrap_or_default()
+                .split(',')
+                .filter(|w| !w.is_empty())
+                .map(|w| match w {
+                    "vibration" => LabEffect::Vibration,
+                    "speed" => LabEffect::SpeedTelemetry,
+                    "inertial" => LabEffect::InertialTorque,
+                    "drag" => LabEffect::Drag,
+                    _ => panic!("WITHOUT: {w}"),
+                })
+                .collect();
+            let mut p = Preset::throw_without(&without).with_drawn_tumble(seed);
             p.common.seed = seed;
             let out = p.simulate().expect("simulation");
-            [false, true].map(|batch| judge(estimate(&out.samples, batch), &out.inertia_kg_m2))
+            [false, true].map(|batch| {
+                let r = judge(estimate(&out.samples, batch), &out.inertia_kg_m2);
+                if r.2 && std::env::var("DETAIL").is_ok() {
+                    eprintln!("seed {seed} (batch: {batch}) determined beyond 3σ");
+                }
+                r
+            })
         })
         .collect();
     println!("| run | throws | answered | determined | determined beyond 3σ |");

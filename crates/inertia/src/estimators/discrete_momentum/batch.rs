@@ -5,7 +5,9 @@
 use super::candidates::{candidates, chained_siblings};
 use super::cross_check::COMPARABLE_FIT;
 use super::finish::{finish, Evidence, Finished};
-use super::select::{alternatives_from_s, in_running, pick, test_inertial_torque};
+use super::select::{
+    alternatives_from_s, in_running, pick, rejected_inertial_twin, test_inertial_torque,
+};
 use super::sigma::{
     discretisation_bias, double_step, model_spread, own_answer, sibling_jackknife,
     with_torque_model_shift,
@@ -234,7 +236,8 @@ struct BatchRun<'a> {
     /// Every candidate's rows and their reduction.
     reduced: &'a [(MomentumRowSettings, BatchReduction)],
     /// Their fits as the choice saw them: a model the inertial torque's test rejected
-    /// has an infinite variance ([`test_inertial_torque`]) and is no alternative.
+    /// has an infinite variance ([`test_inertial_torque`]) and is no alternative, except
+    /// for the model spread as the chosen one's twin ([`rejected_inertial_twin`]).
     fits: &'a [(f64, f64, Option<f64>)],
     chosen: usize,
     /// The shortest chain of an alternative ([`alternatives_from_s`]).
@@ -337,7 +340,10 @@ impl Evidence for BatchRun<'_> {
             .iter()
             .enumerate()
             .filter(|&(i, (r, _))| {
-                i != self.chosen && in_running(r, self.from_s) && self.fits[i].0.is_finite()
+                i != self.chosen
+                    && in_running(r, self.from_s)
+                    && (self.fits[i].0.is_finite()
+                        || rejected_inertial_twin(&self.reduced[self.chosen].0, r))
             })
             .map(|(_, (r, b))| (b.qr, self.config.gyro_noise_for(r.rotation)));
         let chosen = self.reduced[self.chosen].0.rotation;

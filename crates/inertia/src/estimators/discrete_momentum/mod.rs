@@ -425,6 +425,20 @@ impl DiscreteMomentum {
         Ok(Some(e))
     }
 
+    /// Whether candidate `i` is an alternative to the chosen one for the model spread:
+    /// standing, in the running, and not rejected by the inertial torque's test unless
+    /// as the chosen one's twin ([`select::rejected_inertial_twin`]).
+    fn spread_alternative(&self, i: usize, c: &Candidate) -> bool {
+        i != self.chosen
+            && self.standing.live(i)
+            && in_running(c.row_settings(), self.from_s)
+            && (self.fits.get(i).is_some_and(|f| f.0.is_finite())
+                || select::rejected_inertial_twin(
+                    self.candidates[self.chosen].row_settings(),
+                    c.row_settings(),
+                ))
+    }
+
     /// The outside torques' σ with their model spread in quadrature ([`outside_spread`]),
     /// over the candidates [`Evidence::model_spread`] takes for `j`.
     fn widened_by_model_spread(&self, o: OutsideEstimates) -> OutsideEstimates {
@@ -432,12 +446,7 @@ impl DiscreteMomentum {
             .candidates
             .iter()
             .enumerate()
-            .filter(|&(i, c)| {
-                i != self.chosen
-                    && self.standing.live(i)
-                    && self.fits.get(i).is_some_and(|f| f.0.is_finite())
-                    && in_running(c.row_settings(), self.from_s)
-            })
+            .filter(|&(i, c)| self.spread_alternative(i, c))
             .map(|(_, c)| c);
         let (config, constraints) = (&self.config, &self.config.constraints);
         let mut spread = outside_spread(
@@ -613,12 +622,7 @@ impl Evidence for Streaming<'_> {
             .candidates
             .iter()
             .enumerate()
-            .filter(|&(i, c)| {
-                i != run.chosen
-                    && run.standing.live(i)
-                    && run.fits.get(i).is_some_and(|f| f.0.is_finite())
-                    && in_running(c.row_settings(), run.from_s)
-            })
+            .filter(|&(i, c)| run.spread_alternative(i, c))
             .map(|(_, c)| {
                 let gyro = run.config.gyro_noise_for(c.row_settings().rotation);
                 (c.qr().reduced(), gyro)

@@ -194,6 +194,26 @@ pub(super) fn test_inertial_torque(
     }
 }
 
+/// Whether candidate `i`'s rows are the `chosen` one's twin with the inertial torque, which
+/// [`test_inertial_torque`] rejected: an alternative for the model spread all the same
+/// ([`super::sigma::model_spread`]). The test holds the torque at zero unless the data
+/// need it beyond `max(χ²_k(1 − 10⁻³), k ln n)`; below that line a real torque is not
+/// ruled out, only not confirmed, and the answer is uncertain by the move of `ĵ` it
+/// makes (on throws each tumbling its own way with the wheel speeds' time tag
+/// estimated, 4 of 59 determined answers beyond 3σ with the move left out, 0 with the
+/// torque always estimated).
+pub(super) fn rejected_inertial_twin(
+    chosen: &MomentumRowSettings,
+    i: &MomentumRowSettings,
+) -> bool {
+    !chosen.inertial_torque
+        && i.inertial_torque
+        && MomentumRowSettings {
+            inertial_torque: false,
+            ..*i
+        } == *chosen
+}
+
 impl super::DiscreteMomentum {
     /// Choose the candidate to solve ([`pick`]) and the alternatives to it
     /// ([`alternatives_from_s`]).

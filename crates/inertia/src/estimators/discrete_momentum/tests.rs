@@ -5,7 +5,7 @@ use super::candidates::{candidates, chained_siblings, LONG_CHAIN_FACTOR, SHORT_C
 use super::cross_check::{
     cross_check_every, disagreement, disagreement_beyond, CROSS_CHECK_EVERY, DISAGREE_Z,
 };
-use super::select::{alternatives_from_s, choose, pick};
+use super::select::{alternatives_from_s, choose, pick, rejected_inertial_twin};
 use super::sigma::sibling_jackknife;
 use super::*;
 use crate::pipeline::PipelineSettings;
@@ -513,5 +513,40 @@ fn the_whole_record_is_chosen_where_nothing_drifts() {
         }
         let chosen = p.candidates[p.chosen].row_settings();
         assert!(chosen.max_chain_s.is_some(), "seed {seed}: {chosen:?}");
+    }
+}
+
+/// The inertial torque's twin of a chosen candidate without it counts for the model
+/// spread; nothing else does: not the chosen rows themselves, not a twin that differs in
+/// anything else, and not the twin without the torque of a chosen candidate that has it
+/// (the test confirmed that torque).
+#[test]
+fn only_the_chosen_rows_with_the_inertial_torque_are_its_rejected_twin() {
+    use crate::estimator::momentum_rows::{MomentumRowSettings, Stencil};
+    let without = MomentumRowSettings {
+        stencil: Stencil::Plain,
+        inertial_torque: false,
+        max_chain_s: Some(30.0),
+        ..MomentumRowSettings::default()
+    };
+    let with = MomentumRowSettings {
+        inertial_torque: true,
+        ..without
+    };
+    assert!(rejected_inertial_twin(&without, &with));
+    assert!(!rejected_inertial_twin(&without, &without));
+    assert!(!rejected_inertial_twin(&with, &without));
+    assert!(!rejected_inertial_twin(&with, &with));
+    for other in [
+        MomentumRowSettings {
+            max_chain_s: Some(7.5),
+            ..with
+        },
+        MomentumRowSettings {
+            stencil: Stencil::Smooth,
+            ..with
+        },
+    ] {
+        assert!(!rejected_inertial_twin(&without, &other), "{other:?}");
     }
 }
