@@ -358,6 +358,7 @@ impl RotorFit {
                 &mut u.sigma_kg_m2,
                 &mut u.noise_kg_m2,
                 &mut u.bias_kg_m2,
+                &mut u.model_spread_kg_m2,
                 &mut u.rotor_scale_kg_m2,
                 &mut u.time_tag_kg_m2,
                 &mut u.rotor_inertia_kg_m2,

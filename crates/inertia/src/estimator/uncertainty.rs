@@ -51,6 +51,11 @@ pub struct Uncertainty {
     /// Its step-size bias part `|b̂|` (discretisation, attitude noise), kg m² (zero without the
     /// shadow estimates at 2h and 4h; the discrete momentum estimator's discretisation bias).
     pub bias_kg_m2: [f64; 6],
+    /// Of the bias part, what the spread between models the data cannot tell apart
+    /// contributes: row models of comparable fit, the inertial torque a test left out,
+    /// rotation sources that disagree (the discrete momentum estimator; zero otherwise),
+    /// kg m².
+    pub model_spread_kg_m2: [f64; 6],
     /// Its consider part from the rotor momentum's scale uncertainty, `r · |ĵ|`, kg m²
     /// (zero unless given, `Uncertainty::with_rotor_scale`).
     pub rotor_scale_kg_m2: [f64; 6],
@@ -79,8 +84,11 @@ pub struct Uncertainty {
 pub enum SigmaPart {
     /// The rows' noise (`noise_kg_m2`): the data barely excite the dynamics.
     Noise,
-    /// The step-size bias (`bias_kg_m2`): the answer moves with the sample step.
+    /// The step-size bias (`bias_kg_m2` beyond `model_spread_kg_m2`): the answer moves
+    /// with the sample step.
     StepBias,
+    /// The spread between models the data cannot tell apart (`model_spread_kg_m2`).
+    ModelSpread,
     /// What the named parts leave of σ: the scatter between parts of the record (the
     /// resampling estimate) or between candidate models.
     Spread,
@@ -100,6 +108,9 @@ impl core::fmt::Display for SigmaPart {
             SigmaPart::Noise => "the rows' noise: the data barely excite the dynamics",
             SigmaPart::StepBias => {
                 "the step-size bias: the answer moves with the sample step beyond its noise (attitude noise in the paper's estimator)"
+            }
+            SigmaPart::ModelSpread => {
+                "the spread between models the data cannot tell apart (row models, a torque fixed in space that the test did not confirm, rotation sources)"
             }
             SigmaPart::Spread => {
                 "the scatter between parts of the record: they disagree beyond their noise"
@@ -125,7 +136,15 @@ impl Uncertainty {
     pub fn dominant_part(&self) -> SigmaPart {
         let named = [
             (SigmaPart::Noise, frobenius_squared(&self.noise_kg_m2)),
-            (SigmaPart::StepBias, frobenius_squared(&self.bias_kg_m2)),
+            (
+                SigmaPart::StepBias,
+                (frobenius_squared(&self.bias_kg_m2) - frobenius_squared(&self.model_spread_kg_m2))
+                    .max(0.0),
+            ),
+            (
+                SigmaPart::ModelSpread,
+                frobenius_squared(&self.model_spread_kg_m2),
+            ),
             (
                 SigmaPart::RotorScale,
                 frobenius_squared(&self.rotor_scale_kg_m2),
@@ -348,6 +367,7 @@ pub(crate) fn with_bias_at(
         sigma_kg_m2: sigma,
         noise_kg_m2: *noise,
         bias_kg_m2: bias,
+        model_spread_kg_m2: [0.0; 6],
         rotor_scale_kg_m2: [0.0; 6],
         time_tag_kg_m2: [0.0; 6],
         rotor_inertia_kg_m2: [0.0; 6],
@@ -416,5 +436,14 @@ mod tests {
             ..combine(&noise, &j, None, None)
         };
         assert_eq!(u.dominant_part(), SigmaPart::Spread);
+        // J11's σ all bias, of which the spread between models is 0.9 (0.81 of 1) or 0.3
+        // (0.09: the step's 0.91 dominates).
+        for (spread, part) in [(0.9, SigmaPart::ModelSpread), (0.3, SigmaPart::StepBias)] {
+            let mut u = combine(&[0.0; 6], &j, None, None);
+            u.sigma_kg_m2[0] = 1.0;
+            u.bias_kg_m2[0] = 1.0;
+            u.model_spread_kg_m2[0] = spread;
+            assert_eq!(u.dominant_part(), part, "{spread}");
+        }
     }
 }

@@ -305,6 +305,7 @@ mod tests {
             sigma_kg_m2: [1e-3, 2.5e-4, 3.0, 1e-300, 7.0, 0.1],
             noise_kg_m2: [0.0; 6],
             bias_kg_m2: [0.0; 6],
+            model_spread_kg_m2: [0.0; 6],
             rotor_scale_kg_m2: [0.0; 6],
             time_tag_kg_m2: [0.0; 6],
             rotor_inertia_kg_m2: [0.0; 6],

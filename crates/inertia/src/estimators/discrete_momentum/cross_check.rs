@@ -7,7 +7,7 @@ use super::select::in_running;
 use super::sigma::{candidate_noise_sigma, Eigen};
 use super::DiscreteMomentum;
 use crate::estimator::observability::{Observability, Unobservable};
-use crate::estimator::uncertainty::with_bias_at;
+use crate::estimator::uncertainty::{with_bias_at, Uncertainty};
 use crate::estimator::Estimate;
 use crate::estimator::EstimatorError;
 use crate::tensor::{matrix_from_j, InertiaVector};
@@ -79,7 +79,7 @@ pub(super) fn reconcile(
     let (Some(j), Some(u)) = (e.j(), e.uncertainty) else {
         return;
     };
-    let mut bias = u.bias_kg_m2;
+    let (mut bias, mut spread) = (u.bias_kg_m2, u.model_spread_kg_m2);
     let mut worst: f64 = 0.0;
     // The answer's noise σ for the comparison, with a difference the answers may have for
     // a known reason (`slack`) in quadrature.
@@ -92,14 +92,18 @@ pub(super) fn reconcile(
             continue;
         };
         worst = worst.max(z);
-        for (b, (x, y)) in bias.iter_mut().zip(j.iter().zip(jb.iter())) {
-            *b = b.max((x - y).abs());
+        for (k, (x, y)) in j.iter().zip(jb.iter()).enumerate() {
+            bias[k] = bias[k].max((x - y).abs());
+            spread[k] = spread[k].max((x - y).abs());
         }
     }
     if worst == 0.0 {
         return;
     }
-    let u = with_bias_at(&u.noise_kg_m2, &bias, eig);
+    let u = Uncertainty {
+        model_spread_kg_m2: spread,
+        ..with_bias_at(&u.noise_kg_m2, &bias, eig)
+    };
     let relative = u.frobenius_sigma_kg_m2() / matrix_from_j(&j).norm();
     if relative <= max_relative_sigma {
         e.uncertainty = Some(u);

@@ -20,7 +20,7 @@ use crate::estimator::audit::{audit_at, reversed_at_floor};
 use crate::estimator::consistency::{self, ResidualSegments};
 use crate::estimator::observability::{Observability, Unobservable, NEGATIVE_DAMPING_Z};
 use crate::estimator::qr::RecursiveQr;
-use crate::estimator::uncertainty::with_bias_at;
+use crate::estimator::uncertainty::{with_bias_at, Uncertainty};
 use crate::estimator::Estimate;
 use crate::pipeline::config::PipelineConfig;
 use crate::tensor::{matrix_from_j, InertiaVector};
@@ -98,7 +98,10 @@ pub(super) fn finish<V: Evidence>(
             let spread = evidence.model_spread();
             let discretisation = evidence.discretisation_bias();
             let bias = quadrature(&spread, &discretisation);
-            e.uncertainty = Some(with_bias_at(&noise, &bias, &eig));
+            e.uncertainty = Some(Uncertainty {
+                model_spread_kg_m2: spread,
+                ..with_bias_at(&noise, &bias, &eig)
+            });
         }
     }
     if reversed_at_floor(e, evidence.solved(), epsilon, max_relative_sigma, &eig.0) {
