@@ -545,6 +545,20 @@ mod tests {
         assert_eq!(chain, chain1);
     }
 
+    /// `held` is `want`: `R` and `z` to 1e-12 of their largest entry (up to the signs of
+    /// rows), `ρ²` to 1e-10 relative.
+    fn assert_same_reduced(held: &RecursiveQr, want: &RecursiveQr) {
+        let scale = want.r.amax();
+        for i in 0..6 {
+            let sign = held.r[(i, i)].signum() * want.r[(i, i)].signum();
+            for k in 0..6 {
+                assert!((held.r[(i, k)] - sign * want.r[(i, k)]).abs() <= 1e-12 * scale);
+            }
+            assert!((held.z[i] - sign * want.z[i]).abs() <= 1e-12 * want.z.amax());
+        }
+        assert!((held.rss - want.rss).abs() <= 1e-10 * want.rss);
+    }
+
     /// Holding the torque at zero ([`SharedQr::reduced_without_torque`]) is folding the
     /// same rows with the torque's columns zeroed: the reduced `R` and `z` to 1e-12 of
     /// their largest entry (up to the signs of rows), `ρ²` to 1e-10 relative, and the
@@ -573,17 +587,52 @@ mod tests {
         }
         let (held, growth) = with.shared().reduced_without_torque();
         let want = without.reduced();
-        let scale = want.r.amax();
-        for i in 0..6 {
-            let sign = held.r[(i, i)].signum() * want.r[(i, i)].signum();
-            for k in 0..6 {
-                assert!((held.r[(i, k)] - sign * want.r[(i, k)]).abs() <= 1e-12 * scale);
-            }
-            assert!((held.z[i] - sign * want.z[i]).abs() <= 1e-12 * want.z.amax());
-        }
-        assert!((held.rss - want.rss).abs() <= 1e-10 * want.rss);
+        assert_same_reduced(&held, &want);
         assert!((growth - (want.rss - with.rss())).abs() <= 1e-10 * want.rss);
         assert!(growth > 0.0);
+    }
+
+    /// Holding the damping at zero ([`SharedQr::damping_row`] folded into the reduced
+    /// state, [`RecursiveQr::holding_at_zero`]) is folding the same rows with its column
+    /// zeroed, with the torque free and with the torque held at zero as well: `R` and `z`
+    /// to 1e-12 of their largest entry (up to the signs of rows), `ρ²` to 1e-10 relative,
+    /// one nuisance unknown fewer.
+    #[test]
+    fn holding_the_damping_at_zero_is_dropping_its_column() {
+        use crate::estimator::momentum_rows::{DAMPING, TORQUE};
+        let mut rnd = crate::testing::uniform(0x3c6e_f372_fe94_f82b);
+        let mut with = AugmentedQr::new(4);
+        let (mut no_d, mut neither) = (AugmentedQr::new(0), AugmentedQr::new(0));
+        for k in 0..60 {
+            if k == 25 {
+                for q in [&mut with, &mut no_d, &mut neither] {
+                    q.eliminate_anchors();
+                }
+            }
+            let row = block(&mut rnd, k % 2);
+            let (mut d0, mut both0) = (row, row);
+            for m in 0..3 {
+                d0.a[(m, DAMPING)] = 0.0;
+                both0.a[(m, DAMPING)] = 0.0;
+                for t in TORQUE..TORQUE + 3 {
+                    both0.a[(m, t)] = 0.0;
+                }
+            }
+            with.add(&row, None);
+            no_d.add(&d0, None);
+            neither.add(&both0, None);
+        }
+        let shared = with.shared();
+        for (torque_held, start, want) in [
+            (false, shared.reduced(), no_d.reduced()),
+            (true, shared.reduced_without_torque().0, neither.reduced()),
+        ] {
+            let (r_dj, z_d) = shared.damping_row(torque_held).expect("the rows use D");
+            let held = start.holding_at_zero(&r_dj, z_d);
+            assert_same_reduced(&held, &want);
+            assert!(held.rss > start.rss);
+            assert_eq!(held.nuisance, start.nuisance - 1.0);
+        }
     }
 
     /// Merging a chain's state (its rows in a wavefront) is folding its rows one by one.

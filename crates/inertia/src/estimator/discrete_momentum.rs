@@ -526,6 +526,17 @@ impl<B: Backend> DiscreteMomentumEstimator<B> {
         &self.reduced
     }
 
+    /// [`Self::reduced`] with the damping `D` held at zero instead of estimated (and the
+    /// disturbance torque as the torque test left it): the answer of the model without
+    /// the drag, an alternative for the model spread. `None` where the rows do not
+    /// estimate `D`.
+    #[must_use]
+    pub(crate) fn reduced_without_damping(&self) -> Option<RecursiveQr> {
+        let torque_held = self.torque_test.is_some_and(|t| t.held_at_zero);
+        let (r_dj, z_d) = self.qr.shared().damping_row(torque_held)?;
+        Some(self.reduced.holding_at_zero(&r_dj, z_d))
+    }
+
     /// `Self::reduced` with the prior knowledge stacked on: the state the last solve
     /// used.
     #[must_use]

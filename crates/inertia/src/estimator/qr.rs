@@ -91,6 +91,19 @@ impl RecursiveQr {
         residual_variance(self.rss, self.residual_dof())
     }
 
+    /// The state with one unknown eliminated before `j` held at zero instead of
+    /// minimised out: its row of the factor `r_u u + r_jᵀ j = z_u` (`u` the last unknown
+    /// before `j`), without its column, folded in. The residual grows by what `u`
+    /// explained; the rows are the same, and one nuisance unknown fewer is counted.
+    #[must_use]
+    pub(crate) fn holding_at_zero(&self, r_j: &Vector6<f64>, z_u: f64) -> RecursiveQr {
+        let mut out = *self;
+        let left = fold_row(&mut out.r, r_j, Some((&mut out.z, z_u)));
+        out.rss += left * left;
+        out.nuisance -= 1.0;
+        out
+    }
+
     /// Multiply the whole state by `√λ` (exponential forgetting of old rows, `0 < λ ≤ 1`).
     pub(crate) fn scale(&mut self, lambda: f64) {
         let s = sqrt(lambda);

@@ -20,6 +20,9 @@ use nalgebra::{Matrix3, Matrix6, SMatrix, SVector, Vector6};
 
 /// Position of `j` among the shared unknowns.
 pub(crate) const J_SHARED: usize = Block::J.shared_column();
+/// The first shared unknown after the disturbance torque `τ_b`, and how many there are.
+const AFTER_TORQUE: usize = Block::BodyTorque.shared_column() + 3;
+const AFTER_TORQUE_REST: usize = SHARED - AFTER_TORQUE;
 
 /// A 3-row block in the shared unknowns with its right-hand sides.
 pub(crate) type SharedBlock = ([SVector<f64, SHARED>; 3], [f64; 3]);
@@ -342,23 +345,8 @@ impl SharedQr {
     /// only (the count of the torque unknowns is not weighted).
     #[must_use]
     pub(crate) fn reduced_without_torque(&self) -> (RecursiveQr, f64) {
-        // The unknowns before τ_b (the outside torques' `m`, `c`) keep their rows: they
-        // fit them exactly whatever τ_b is (or the rows are zero where unused), so only the
-        // rows after τ_b hold the reduced problem.
-        const T0: usize = Block::BodyTorque.shared_column();
-        const AFTER: usize = T0 + 3;
-        const REST: usize = SHARED - AFTER;
-        // Rᵀ of the trailing factor, and the torque's rows of R without its columns.
-        let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| self.rt[(i + AFTER, k + AFTER)]);
-        let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + AFTER]);
-        let mut a: [SVector<f64, REST>; 3] =
-            core::array::from_fn(|t| SVector::from_fn(|k, _| self.rt[(k + AFTER, T0 + t)]));
-        let mut beta: [f64; 3] = core::array::from_fn(|t| self.z[T0 + t]);
-        for i in 0..REST {
-            reflect(&mut rt, &mut z, &mut a, &mut beta, i);
-        }
-        let growth: f64 = beta.iter().map(|b| b * b).sum();
-        let off = J_SHARED - AFTER;
+        let (rt, z, growth) = self.folded_without_torque();
+        let off = J_SHARED - AFTER_TORQUE;
         let reduced = RecursiveQr {
             r: Matrix6::from_fn(|i, k| rt[(off + k, off + i)]),
             z: Vector6::from_fn(|i, _| z[off + i]),
@@ -370,6 +358,54 @@ impl SharedQr {
             nuisance: self.nuisance - 3.0,
         };
         (reduced, growth)
+    }
+
+    /// `Rᵀ` and `z` of the unknowns after `τ_b`, `[κ; D; j]`, with `τ_b` held at zero
+    /// ([`Self::reduced_without_torque`]), and the growth of `ρ²` that costs.
+    fn folded_without_torque(
+        &self,
+    ) -> (
+        SMatrix<f64, AFTER_TORQUE_REST, AFTER_TORQUE_REST>,
+        SVector<f64, AFTER_TORQUE_REST>,
+        f64,
+    ) {
+        // The unknowns before τ_b (the outside torques' `m`, `c`) keep their rows: they
+        // fit them exactly whatever τ_b is (or the rows are zero where unused), so only the
+        // rows after τ_b hold the reduced problem.
+        const T0: usize = Block::BodyTorque.shared_column();
+        const REST: usize = AFTER_TORQUE_REST;
+        // Rᵀ of the trailing factor, and the torque's rows of R without its columns.
+        let mut rt = SMatrix::<f64, REST, REST>::from_fn(|i, k| {
+            self.rt[(i + AFTER_TORQUE, k + AFTER_TORQUE)]
+        });
+        let mut z = SVector::<f64, REST>::from_fn(|i, _| self.z[i + AFTER_TORQUE]);
+        let mut a: [SVector<f64, REST>; 3] =
+            core::array::from_fn(|t| SVector::from_fn(|k, _| self.rt[(k + AFTER_TORQUE, T0 + t)]));
+        let mut beta: [f64; 3] = core::array::from_fn(|t| self.z[T0 + t]);
+        for i in 0..REST {
+            reflect(&mut rt, &mut z, &mut a, &mut beta, i);
+        }
+        let growth: f64 = beta.iter().map(|b| b * b).sum();
+        (rt, z, growth)
+    }
+
+    /// The damping's row of the factor, `r_dd D + r_djᵀ j = z_d` once `j` is fixed (`D`
+    /// is the last unknown before `j`), as `(r_dj, z_d)`: with the disturbance torque
+    /// held at zero where `torque_held` ([`Self::reduced_without_torque`]), free
+    /// otherwise. `None` where the rows do not use `D`.
+    #[must_use]
+    pub(crate) fn damping_row(&self, torque_held: bool) -> Option<(Vector6<f64>, f64)> {
+        const D: usize = Block::Damping.shared_column();
+        const _: () = assert!(D + 1 == J_SHARED, "D is the last unknown before j");
+        let row = if torque_held {
+            let (rt, z, _) = self.folded_without_torque();
+            let (d, off) = (D - AFTER_TORQUE, J_SHARED - AFTER_TORQUE);
+            (rt[(d, d)], Vector6::from_fn(|k, _| rt[(off + k, d)]), z[d])
+        } else {
+            let r_dj = Vector6::from_fn(|k, _| self.rt[(J_SHARED + k, D)]);
+            (self.rt[(D, D)], r_dj, self.z[D])
+        };
+        (row.0 != 0.0).then_some((row.1, row.2))
     }
 
     /// `[τ_b; κ]` at a given `j`: back-substitution through the leading rows; zero for

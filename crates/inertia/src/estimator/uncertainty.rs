@@ -110,7 +110,7 @@ impl core::fmt::Display for SigmaPart {
                 "the step-size bias: the answer moves with the sample step beyond its noise (attitude noise in the paper's estimator)"
             }
             SigmaPart::ModelSpread => {
-                "the spread between models the data cannot tell apart (row models, a torque fixed in space that the test did not confirm, rotation sources)"
+                "the spread between models the data cannot tell apart (row models, a torque fixed in space that the test did not confirm, a drag the data do not rule out, rotation sources)"
             }
             SigmaPart::Spread => {
                 "the scatter between parts of the record: they disagree beyond their noise"

@@ -162,3 +162,55 @@ fn damping_is_refused_by_estimators_without_a_row_model() {
     .expect_err("not applicable");
     assert!(e.to_string().contains("damping"), "{e}");
 }
+
+/// The final answer of a run with `--damping` (streaming, or batch) as the lab cells run
+/// it (`examples/matrix.rs`, `DAMPING=1`).
+fn damped_run(samples: &[Sample], batch: bool) -> inertia::estimator::Estimate {
+    let config = PipelineSettings {
+        damping: true,
+        solve_every: 50,
+        ..PipelineSettings::default()
+    }
+    .validate()
+    .expect("valid settings");
+    let mut run = inertia::pipeline::Run::new(config, batch).expect("run");
+    let mut last = None;
+    for s in samples {
+        run.push(s, |e| last = Some(*e)).expect("push");
+    }
+    run.finish(|e| last = Some(*e)).expect("finish");
+    last.expect("an estimate")
+}
+
+/// Problem: throws whose gyro vibrates at the rotor's frequency, with no drag, run with
+/// `--damping`, streaming and batch, seeds 1–20 (the lab cell "only vibration").
+/// Reference: the simulated J. `D` takes up part of the vibration; the data cannot tell
+/// the model with it from the one with `D` held at zero (residual variances within
+/// `1 + 3√(2/ν)`), so σ carries the move of J between the two
+/// (`RecursiveQr::holding_at_zero`, the model spread). Before it did, the streaming
+/// answers of seeds 3, 17 and 19 were determined with J13 3–4σ off; now every answer is
+/// determined and holds the truth within 3σ in every element.
+#[test]
+fn the_model_without_the_drag_widens_sigma_where_the_data_cannot_rule_it_out() {
+    for seed in 1..=20 {
+        let mut p = Preset::throw_with(&[LabEffect::Vibration]);
+        p.common.seed = seed;
+        let out = p.simulate().expect("valid settings");
+        for batch in [false, true] {
+            let e = damped_run(&out.samples, batch);
+            let what = format!("seed {seed}, batch {batch}");
+            assert!(
+                matches!(e.observability, Observability::Determined { .. }),
+                "{what}: {}",
+                e.observability
+            );
+            assert_eq!(
+                e.within_3sigma(&out.inertia_kg_m2),
+                Some(true),
+                "{what}: {:?} ± {:?}",
+                e.j(),
+                e.sigma_kg_m2()
+            );
+        }
+    }
+}

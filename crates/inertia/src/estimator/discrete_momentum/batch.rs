@@ -28,6 +28,8 @@ pub(crate) struct BatchReduction {
     pub(crate) without_torque: Option<(RecursiveQr, f64)>,
     /// The damping's row of the shared factor, where the rows estimate one.
     pub(crate) damping: Option<DampingRow>,
+    /// The reduced states with the damping held at zero, where the rows estimate it.
+    pub(crate) without_damping: Option<WithoutDamping>,
     /// The shared factor, for the outside torques' and the rotors' values, where the rows
     /// use them.
     pub(crate) shared: Option<SharedFactor>,
@@ -180,6 +182,40 @@ impl DampingRow {
     pub(crate) fn at(&self, j: &InertiaVector) -> (f64, Option<f64>) {
         ((self.z_d - self.r_dj.dot(j)) / self.r_dd, self.sigma_nms)
     }
+}
+
+/// The reduced states with the damping `D` held at zero instead of estimated: the answers
+/// of the model without the drag, alternatives for the model spread
+/// ([`crate::estimator::qr::RecursiveQr::holding_at_zero`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct WithoutDamping {
+    /// With the disturbance torque free ([`BatchReduction::qr`]).
+    pub(crate) torque_free: RecursiveQr,
+    /// With the disturbance torque held at zero as well
+    /// ([`BatchReduction::without_torque`]); `None` where the torque is not estimated.
+    pub(crate) torque_held: Option<RecursiveQr>,
+}
+
+impl WithoutDamping {
+    /// The state that matches the torque test's outcome (`torque_held`: it held the torque
+    /// at zero).
+    #[must_use]
+    pub(crate) fn for_torque(&self, torque_held: bool) -> Option<&RecursiveQr> {
+        if torque_held {
+            self.torque_held.as_ref()
+        } else {
+            Some(&self.torque_free)
+        }
+    }
+}
+
+/// `qr` with the damping held at zero, from the damping's row `(r_dd, r_dj, z_d, _)` of
+/// the same factor; `None` where the rows do not use `D`.
+fn without_damping(
+    qr: &RecursiveQr,
+    (r_dd, r_dj, z_d, _): &(f64, Vector6<f64>, f64, nalgebra::DMatrix<f64>),
+) -> Option<RecursiveQr> {
+    (*r_dd != 0.0).then(|| qr.holding_at_zero(r_dj, *z_d))
 }
 
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
@@ -427,7 +463,8 @@ pub(crate) fn reduce_batch(
                 }
             }
             let rss = (energy - qty.norm_squared()).max(0.0);
-            let damping = damping_at.filter(|_| drop == 0).map(|p| {
+            let damping = damping_at.filter(|&p| p >= drop).map(|p| {
+                let p = p - drop;
                 let r_dj = Vector6::from_fn(|i, _| r[(p, off + i)]);
                 (r[(p, p)], r_dj, qty[p], r.clone())
             });
@@ -487,7 +524,7 @@ pub(crate) fn reduce_batch(
         0
     };
     let without_torque = (torque > 0).then(|| {
-        let (r, z, held_rss, _, _) = solve_shared(&blocks, &|_| true, torque);
+        let (r, z, held_rss, held_damping, _) = solve_shared(&blocks, &|_| true, torque);
         // With several records' torques, `k > 3` unknowns: the growth on the scale of
         // the test's χ²₃, matched at its threshold ([`equivalent_chi2_scale`]).
         let growth = (held_rss - shared_rss).max(0.0) * equivalent_chi2_scale(torque);
@@ -501,8 +538,10 @@ pub(crate) fn reduce_batch(
             noise_s,
             nuisance: nuisance - torque as f64,
         };
-        (qr, growth)
+        let twin = held_damping.and_then(|d| without_damping(&qr, &d));
+        ((qr, growth), twin)
     });
+    let (without_torque, held_twin) = without_torque.unzip();
     rss += shared_rss;
     // The jackknife's groups: the chains, or with fewer than MIN_GROUPS of them, time
     // blocks ([`crate::estimator::jackknife`], "Records of few chains"): each delete-one problem
@@ -602,20 +641,29 @@ pub(crate) fn reduce_batch(
             .and_then(|e| j_sigma(e, time_block_scale)),
         by_record.as_deref().and_then(|e| j_sigma(e, 1.0)),
     );
+    let qr = RecursiveQr {
+        r: rr,
+        z,
+        rss,
+        y_energy,
+        rows,
+        weight: rows as f64,
+        noise_s,
+        nuisance,
+    };
+    let without_damping = damping_factor
+        .as_ref()
+        .and_then(|d| without_damping(&qr, d))
+        .map(|torque_free| WithoutDamping {
+            torque_free,
+            torque_held: held_twin.flatten(),
+        });
     Ok(BatchReduction {
-        qr: RecursiveQr {
-            r: rr,
-            z,
-            rss,
-            y_energy,
-            rows,
-            weight: rows as f64,
-            noise_s,
-            nuisance,
-        },
+        qr,
         gaps,
         jackknife_sigma_kg_m2,
         without_torque,
+        without_damping,
         shared: full
             .filter(|_| {
                 n_rotor > 0

@@ -128,6 +128,10 @@ pub(super) fn run_batch(
         chosen,
         from_s,
         tested,
+        without_damping: batch.without_damping.as_ref().and_then(|w| {
+            w.for_torque(torque_test.is_some_and(|t| t.held_at_zero))
+                .copied()
+        }),
         // The chosen rows with the prior's: what the audit judges.
         augmented: prior::augment(&tested, &c.constraints).0,
         backend: c.backend.build(),
@@ -244,6 +248,9 @@ struct BatchRun<'a> {
     from_s: f64,
     /// The chosen candidate's rows, torque-tested ([`torque_tested`]).
     tested: RecursiveQr,
+    /// The same with the damping held at zero, where the rows estimate it: the model
+    /// without the drag, an alternative for the model spread.
+    without_damping: Option<RecursiveQr>,
     /// The same with the prior's rows.
     augmented: RecursiveQr,
     backend: Box<dyn Backend + Send>,
@@ -347,9 +354,10 @@ impl Evidence for BatchRun<'_> {
             })
             .map(|(_, (r, b))| (b.qr, self.config.gyro_noise_for(r.rotation)));
         let chosen = self.reduced[self.chosen].0.rotation;
+        let gyro = self.config.gyro_noise_for(chosen);
         model_spread(
-            (&self.tested, self.config.gyro_noise_for(chosen)),
-            others,
+            (&self.tested, gyro),
+            others.chain(self.without_damping.map(|qr| (qr, gyro))),
             &self.config.constraints,
         )
     }

@@ -628,9 +628,12 @@ impl Evidence for Streaming<'_> {
                 (c.qr().reduced(), gyro)
             });
         let chosen = run.candidates[run.chosen].row_settings().rotation;
+        let gyro = run.config.gyro_noise_for(chosen);
+        // The model without the drag, where the rows estimate it.
+        let without_damping = self.chosen().reduced_without_damping();
         model_spread(
-            (self.chosen().reduced(), run.config.gyro_noise_for(chosen)),
-            others,
+            (self.chosen().reduced(), gyro),
+            others.chain(without_damping.map(|qr| (qr, gyro))),
             &run.config.constraints,
         )
     }

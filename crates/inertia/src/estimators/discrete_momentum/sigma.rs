@@ -43,7 +43,10 @@ pub(super) fn sibling_jackknife(
 /// of the ratio of two variance estimates with ν degrees of freedom each). When two models of the
 /// wheels, or two rotation sources, fit the data equally well, neither is known to be
 /// right, and the answer is uncertain by at least their difference. Zero when the chosen
-/// model fits significantly best.
+/// model fits significantly best. The alternatives: the other candidates in the running,
+/// the chosen one's twin with the inertial torque its test left out
+/// ([`super::select::rejected_inertial_twin`]) and, with `--damping`, the chosen rows with
+/// `D` held at zero (`RecursiveQr::holding_at_zero`).
 pub(super) fn model_spread(
     (best, gyro): (&RecursiveQr, Option<f64>),
     others: impl Iterator<Item = (RecursiveQr, Option<f64>)>,
