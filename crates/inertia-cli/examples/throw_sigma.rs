@@ -6,7 +6,8 @@
 //! `cargo run --release -p inertia-cli --example throw_sigma -- [THROWS]` (default 60,
 //! seeds from `FROM`, default 0; `WHEEL_DELAY=off|SECONDS|estimate` the wheel speeds'
 //! time tag, off when unset; `WITHOUT=vibration,speed,inertial,drag` lab effects left
-//! out; `INERTIAL=off|on|auto|short` the inertial torque, the default when unset; `DETAIL=1`
+//! out; `INERTIAL=off|on|auto|short` the inertial torque, the default when unset;
+//! `DAMPING=1` the damping `D` estimated (`--damping`); `DETAIL=1`
 //! each determined answer beyond 3σ on stderr: seed, worst element and the parts of its
 //! σ). Results: the book, "What you tell the run: the wheel speeds' time tag" and "A
 //! torque fixed in the inertial frame".
@@ -27,6 +28,7 @@ fn estimate(samples: &[Sample], batch: bool) -> Option<Estimate> {
     let config = PipelineSettings {
         solve_every: 50,
         wheel_delay,
+        damping: std::env::var("DAMPING").is_ok_and(|v| v == "1"),
         inertial_torque: std::env::var("INERTIAL").map_or(Default::default(), |v| {
             v.parse::<InertialTorque>()
                 .unwrap_or_else(|e| panic!("INERTIAL: {e}"))
