@@ -9,6 +9,10 @@ use super::*;
 use crate::estimator as est;
 use crate::estimator::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
 
+mod damping;
+use damping::without_damping;
+pub(crate) use damping::{DampingRow, WithoutDamping};
+
 /// A row, its rotor parameters' columns ([`est::rotor_calibration::columns`]) and its
 /// record ([`crate::pipeline::interface::BatchInputs::records`]).
 type RowWithRotors<'a> = (AugmentedRow, &'a [Vector3<f64>], usize);
@@ -163,59 +167,6 @@ pub(crate) fn equivalent_chi2_scale(k: usize) -> f64 {
     let a = 2.0 / (9.0 * k);
     let q = k * (1.0 - a + 3.0902 * crate::math::sqrt(a)).powi(3);
     super::TORQUE_CHI2 / q
-}
-
-/// The damping's row of an upper-triangular factor over the shared unknowns, `j` last:
-/// `r_dd D + r_dj·j = z_d` once the unknowns after it are fixed, and its least-squares σ.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct DampingRow {
-    r_dd: f64,
-    r_dj: nalgebra::Vector6<f64>,
-    z_d: f64,
-    sigma_nms: Option<f64>,
-}
-
-impl DampingRow {
-    /// `D` at `j` with its σ (the unknowns between `D` and `j` are none: `D` is the last
-    /// before `j`, [`crate::estimator::unknowns::Block::ALL`]).
-    #[must_use]
-    pub(crate) fn at(&self, j: &InertiaVector) -> (f64, Option<f64>) {
-        ((self.z_d - self.r_dj.dot(j)) / self.r_dd, self.sigma_nms)
-    }
-}
-
-/// The reduced states with the damping `D` held at zero instead of estimated: the answers
-/// of the model without the drag, alternatives for the model spread
-/// ([`crate::estimator::qr::RecursiveQr::holding_at_zero`]).
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct WithoutDamping {
-    /// With the disturbance torque free ([`BatchReduction::qr`]).
-    pub(crate) torque_free: RecursiveQr,
-    /// With the disturbance torque held at zero as well
-    /// ([`BatchReduction::without_torque`]); `None` where the torque is not estimated.
-    pub(crate) torque_held: Option<RecursiveQr>,
-}
-
-impl WithoutDamping {
-    /// The state that matches the torque test's outcome (`torque_held`: it held the torque
-    /// at zero).
-    #[must_use]
-    pub(crate) fn for_torque(&self, torque_held: bool) -> Option<&RecursiveQr> {
-        if torque_held {
-            self.torque_held.as_ref()
-        } else {
-            Some(&self.torque_free)
-        }
-    }
-}
-
-/// `qr` with the damping held at zero, from the damping's row `(r_dd, r_dj, z_d, _)` of
-/// the same factor; `None` where the rows do not use `D`.
-fn without_damping(
-    qr: &RecursiveQr,
-    (r_dd, r_dj, z_d, _): &(f64, Vector6<f64>, f64, nalgebra::DMatrix<f64>),
-) -> Option<RecursiveQr> {
-    (*r_dd != 0.0).then(|| qr.holding_at_zero(r_dj, *z_d))
 }
 
 /// The reduced least-squares state of all samples at once, by dense Householder QR: per
