@@ -5,13 +5,19 @@
 //! Where Clarabel reports an optimal answer, the two must agree to 1e-7 in objective
 //! (relative to the data scale ‖z‖²) and 1e-6 in `j` measured as ‖R(j_a − j_b)‖/‖z‖.
 //! On ill-conditioned problems Clarabel sometimes stops short (`AlmostSolved`) or fails;
-//! there the native answer must be feasible and no worse than Clarabel's.
+//! there the native answer must be feasible and no worse than Clarabel's where Clarabel's
+//! is feasible.
 //!
 //! For this convex quadratic, first-order optimality gives `‖R(j − j*)‖² ≤ f(j) − f*`.
 //! So when the native objective is at most Clarabel's, any difference in `j` is bounded by
 //! the *reference's* suboptimality; the `j` criterion then adds nothing and is applied
 //! only where the native objective is the higher one. (Such cases are counted: they are
-//! zero-residual problems whose optimum lies exactly on the boundary.)
+//! zero-residual problems whose optimum lies exactly on the boundary.) Where it is higher
+//! by `δ`, the same bound with Clarabel's answer as the optimum allows
+//! `‖R(j_a − j_b)‖ ≤ √δ`: a `j` difference within it is native's suboptimality, which
+//! the objective criterion judges, not another answer. (Problem 4749 on one machine's
+//! OpenBLAS: `j` 1.09e-6 apart with the native objective 2.6e-13 above Clarabel's,
+//! `√δ/‖z‖` = 1.3e-6.)
 //!
 //! A test binary of its own, so that `.ci/run` builds only this file and the random
 //! problems beside the library with the feature (not the whole integration binary).
@@ -49,15 +55,20 @@ fn native_agrees_with_clarabel_on_random_problems() {
                 if d_j >= 1e-6 && a.objective <= b.objective {
                     native_better += 1;
                 }
+                // ‖R(j_a − j*)‖² ≤ f(j_a) − f*, with j* ≈ Clarabel's answer.
+                let by_gap = (a.objective - b.objective).max(0.0).sqrt() / p.z.norm();
                 assert!(
-                    d_obj < 1e-7 && (d_j < 1e-6 || a.objective <= b.objective),
+                    d_obj < 1e-7 && (d_j < 1e-6 || a.objective <= b.objective || d_j <= by_gap),
                     "{i} {}: objective {d_obj:e}, j {d_j:e}\nnative {a:?}\nclarabel {b:?}",
                     p.label
                 );
             }
             other => {
                 reference_weak += 1;
-                if let Ok(b) = other {
+                // An inaccurate answer outside the set (problem 6577 on one machine's
+                // OpenBLAS: margin −2.6e-5) can buy a lower objective with its
+                // infeasibility: no bound on native's then.
+                if let Some(b) = other.ok().filter(|b| c.margin(&b.j) > -1e-9) {
                     assert!(
                         a.objective <= b.objective * (1.0 + 1e-9) + 1e-12 * scale,
                         "{i} {}: native {} worse than inaccurate clarabel {}",
