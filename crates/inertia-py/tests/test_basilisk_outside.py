@@ -155,6 +155,28 @@ def test_per_wheel_speeds_and_the_spacecraft_file_give_the_same_answer_as_rho(cl
     assert out.returncode != 0 and "max_torque_nm" in out.stderr, out.stderr
 
 
+def test_the_spacecraft_file_carries_each_wheels_time_tag_sigma(cli, tmp_path):
+    """Problem: a σ of each wheel's own time tag, one per wheel. Reference: the file's keys,
+    and the CLI reading the file (its run prints the time tags' consider term)."""
+    from test_basilisk import GS as GS3, JS as JS3, simulate
+
+    text = bsk.spacecraft_toml(JS3, GS3, wheel_names=["a", "b", "c"],
+                               time_tag_sigma_s=[0.01, 0.02, 0.0])
+    assert [l for l in text.splitlines() if l.startswith("time_tag")] == [
+        "time_tag_sigma_s = 0.01", "time_tag_sigma_s = 0.02", "time_tag_sigma_s = 0.0"]
+    with pytest.raises(ValueError, match="time_tag_sigma_s"):
+        bsk.spacecraft_toml(JS3, GS3, time_tag_sigma_s=-0.01)
+    sim = simulate()
+    data = bsk.from_basilisk(sim["t_ns"], sim["sigma"], sim["omega"], wheel_speeds=sim["Omega"],
+                             Js=JS3, gs_B=GS3, per_wheel=True, wheel_names=["a", "b", "c"])
+    bsk.to_csv(tmp_path / "wheels.csv", data)
+    sc = tmp_path / "wheels.toml"
+    sc.write_text(text)
+    out = cli_estimate(cli, tmp_path / "wheels.csv", "--spacecraft", sc)
+    assert out["rotor_inertia"]["time_tag_sigma_s"] == [0.01, 0.02, 0.0]
+    assert out["rotor_inertia"]["sources"] == ["a time tag", "b time tag"]
+
+
 # --------------------------------------------------------------------- Basilisk itself
 
 

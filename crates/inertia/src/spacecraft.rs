@@ -18,6 +18,7 @@
 //! spin_inertia_kg_m2 = 1.2e-3         # about the spin axis
 //! spin_inertia_sigma_kg_m2 = 2.4e-5   # its 1σ uncertainty (default 0: exact)
 //! spin_axis_sigma_deg = 0.5           # 1σ tilt of the axis, each way (default 0)
+//! time_tag_sigma_s = 0.05             # 1σ of its speed's own time tag (default 0)
 //! speed_column = "rw1_speed"          # the telemetry column of its speed
 //! speed_unit = "rpm"                  # rad/s (default), rpm or deg/s
 //! max_torque_nm = 0.01                # motor torque limit (optional; `plan` needs it)
@@ -68,14 +69,19 @@
 //! # The consider term
 //!
 //! Each rotor's spin inertia ± σ (errors shared by every rotor, or independent) and its
-//! axis's tilt ± σ (two small angles, independent per rotor) are consider parameters:
+//! axis's tilt ± σ (two small angles, independent per rotor) and its speed's own time
+//! tag ± σ (`time_tag_sigma_s`: the wheel's speed read that much later than the run's
+//! wheel-speed time tag says, independent per rotor) are consider parameters:
 //! the answer's move for each 1σ error source is measured by re-running the estimator,
-//! and σ widens by their root sum square (`crate::estimator::rotor_inertia`).
+//! and σ widens by their root sum square (`crate::estimator::rotor_inertia`); in a batch
+//! run with `calibrate_rotors` they are estimated with J instead
+//! (`crate::estimator::rotor_calibration`).
 //!
 //! # Validation
 //!
 //! Unknown keys, a missing key, a non-unit axis, a spin inertia that is not positive, a
-//! σ not in `[0, J_i)`, an unknown speed unit, two rotors with one name or one column,
+//! σ not in `[0, J_i)`, a tilt σ over 10°, a time-tag σ over `MAX_TIME_TAG_SIGMA_S`,
+//! an unknown speed unit, two rotors with one name or one column,
 //! more than `MAX_ROTORS` rotors or none: each refused with the file, the line and the
 //! key ([`SpacecraftError`]).
 
@@ -113,6 +119,11 @@ pub(crate) const MAX_ROTORS: usize = 16;
 
 /// How far an axis's norm may differ from 1 (it is then normalised).
 pub(crate) const AXIS_NORM_TOLERANCE: f64 = 1e-3;
+
+/// The largest 1σ a rotor's own time tag may have, s: the wheel-speed time tag's search
+/// range (`crate::estimator::wheel_delay`); a rotor's offset is modelled by its first
+/// order about the run's time tag, re-linearised once.
+pub(crate) const MAX_TIME_TAG_SIGMA_S: f64 = 0.25;
 
 /// The unit of a rotor's speed column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -186,6 +197,9 @@ pub struct Rotor {
     pub spin_inertia_sigma_kg_m2: f64,
     /// The 1σ tilt of its axis about each of two perpendicular directions, deg (0: exact).
     pub spin_axis_sigma_deg: f64,
+    /// The 1σ of its speed's time tag about the run's wheel-speed time tag, s (0: on
+    /// time): each wheel's telemetry may be read at its own instant.
+    pub time_tag_sigma_s: f64,
     /// The telemetry column that holds its speed.
     pub speed_column: String,
     /// The unit of that column.
@@ -281,13 +295,15 @@ impl Spacecraft {
         self.thrusters.iter().map(|t| t.column.clone()).collect()
     }
 
-    /// Whether any rotor's spin inertia or axis carries an uncertainty (a consider term
-    /// applies).
+    /// Whether any rotor's spin inertia, axis or time tag carries an uncertainty (a
+    /// consider term applies).
     #[must_use]
     pub(crate) fn has_inertia_sigma(&self) -> bool {
-        self.rotors
-            .iter()
-            .any(|r| r.spin_inertia_sigma_kg_m2 > 0.0 || r.spin_axis_sigma_deg > 0.0)
+        self.rotors.iter().any(|r| {
+            r.spin_inertia_sigma_kg_m2 > 0.0
+                || r.spin_axis_sigma_deg > 0.0
+                || r.time_tag_sigma_s > 0.0
+        })
     }
 
     /// The relative σ of the rotor momentum the file states, for the checks that compare

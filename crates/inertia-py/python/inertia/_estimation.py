@@ -129,10 +129,11 @@ def estimate(
             ``report["row_model"]``).
             damping: estimate a linear damping torque −D ω (air drag; ``report["damping_nms"]``).
             calibrate_rotors: with ``batch=True`` and a ``spacecraft`` file whose rotors have a
-            σ, estimate each rotor's spin-inertia error and axis tilts with J, the file's σ
-            their prior (``report["rotor_calibration"]``: values, σ, how many combinations
-            the data fix); the wheels' common scale stays the file's σ, and the record needs
-            a total angular momentum (else a warning, and the file's σ a consider term).
+            σ, estimate each rotor's spin-inertia error, axis tilts and time tag with J, the
+            file's σ their prior (``report["rotor_calibration"]``: values, σ, how many
+            combinations the data fix); the wheels' common scale stays the file's σ. Unless
+            every parameter is a time tag, the record needs a total angular momentum (else
+            a warning, and the file's σ a consider term).
             outside: which torques of the outside measurements are modelled, a dict
             (``--no-gravity-gradient``, ``--gravity-mu``, ``--no-residual-dipole``,
             ``--no-centre-of-mass``): ``gravity_gradient`` (default ``True``),

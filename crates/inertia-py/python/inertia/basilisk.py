@@ -532,15 +532,17 @@ def spacecraft_toml(
     wheel_names=None,
     Js_sigma=None,
     axis_sigma_deg=None,
+    time_tag_sigma_s=None,
     max_torque_nm=None,
     max_speed_rad_s=None,
 ) -> str:
     """The spacecraft file (TOML, ``--spacecraft``) of Basilisk's wheels: one ``[[rotor]]``
     per wheel with its spin axis ``gs_B`` (body axes) and spin inertia ``Js``, its speed
     read from :func:`to_csv`'s per-wheel column in rad/s (relative to the body: Basilisk's
-    ``Omega``). Optional, each a scalar or one value per wheel: ``Js_sigma`` (kg m²) and
-    ``axis_sigma_deg``, the file's σ (what ``--calibrate-rotors`` estimates against, and
-    the consider term without it); ``max_torque_nm`` and ``max_speed_rad_s`` (Basilisk's
+    ``Omega``). Optional, each a scalar or one value per wheel: ``Js_sigma`` (kg m²),
+    ``axis_sigma_deg`` and ``time_tag_sigma_s`` (each wheel's speed read at its own
+    instant), the file's σ (what ``--calibrate-rotors`` estimates against, and the
+    consider term without it); ``max_torque_nm`` and ``max_speed_rad_s`` (Basilisk's
     ``u_max`` and ``Omega_max``), the limits ``inertia plan`` keeps (the momentum limit is
     ``Js · Omega_max``)."""
     Js = np.atleast_1d(np.asarray(Js, dtype=float))
@@ -564,6 +566,7 @@ def spacecraft_toml(
 
     js_sigma = per_wheel("Js_sigma", Js_sigma)
     tilt = per_wheel("axis_sigma_deg", axis_sigma_deg)
+    tag = per_wheel("time_tag_sigma_s", time_tag_sigma_s)
     torque = per_wheel("max_torque_nm", max_torque_nm)
     speed = per_wheel("max_speed_rad_s", max_speed_rad_s)
     lines = ["# Basilisk's reaction wheels (inertia.basilisk.spacecraft_toml)"]
@@ -579,6 +582,8 @@ def spacecraft_toml(
             lines.append(f"spin_inertia_sigma_kg_m2 = {js_sigma[i]!r}")
         if tilt[i] is not None:
             lines.append(f"spin_axis_sigma_deg = {tilt[i]!r}")
+        if tag[i] is not None:
+            lines.append(f"time_tag_sigma_s = {tag[i]!r}")
         lines += [f'speed_column = "{speed_column(name)}"', 'speed_unit = "rad/s"']
         if torque[i] is not None:
             lines.append(f"max_torque_nm = {torque[i]!r}")

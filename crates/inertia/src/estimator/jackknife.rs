@@ -84,19 +84,30 @@ pub(crate) const BLOCK_ROWS: usize = 16;
 /// with fewer than [`MIN_GROUPS`] of them.
 #[must_use]
 pub(crate) fn jackknife_sigma(estimates: &[InertiaVector]) -> Option<[f64; 6]> {
-    let g = estimates.len();
-    if g < MIN_GROUPS {
-        return None;
+    let mut out = [0.0; 6];
+    jackknife_sigma_by(estimates.len(), |g, k| estimates[g][k], &mut out).then_some(out)
+}
+
+/// [`jackknife_sigma`] of `groups` estimates of `out.len()` values each (`value(g, k)` the
+/// `k`-th of estimate `g`), into `out`; false (and `out` as it was) with fewer than
+/// [`MIN_GROUPS`] of them.
+pub(crate) fn jackknife_sigma_by(
+    groups: usize,
+    value: impl Fn(usize, usize) -> f64,
+    out: &mut [f64],
+) -> bool {
+    if groups < MIN_GROUPS {
+        return false;
     }
-    let n = g as f64;
-    let mean: InertiaVector = estimates.iter().sum::<InertiaVector>() / n;
-    Some(core::array::from_fn(|k| {
-        let ss: f64 = estimates
-            .iter()
-            .map(|e| (e[k] - mean[k]) * (e[k] - mean[k]))
+    let n = groups as f64;
+    for (k, o) in out.iter_mut().enumerate() {
+        let mean = (0..groups).map(|g| value(g, k)).sum::<f64>() / n;
+        let ss: f64 = (0..groups)
+            .map(|g| (value(g, k) - mean) * (value(g, k) - mean))
             .sum();
-        crate::math::sqrt((n - 1.0) / n * ss)
-    }))
+        *o = crate::math::sqrt((n - 1.0) / n * ss);
+    }
+    true
 }
 
 /// The noise σ reported: element by element the larger of the least-squares σ and the

@@ -14,8 +14,11 @@
 //!
 //! with one independent standard normal source `z_v` per error the file gives a σ
 //! (the sources of `super::rotor_inertia`: one shared spin-inertia source or one per
-//! rotor, two tilts per rotor) and `δρ_v` that source's 1σ change of the momentum (read at
-//! the run's wheel-speed time tag). The rows of [`super::momentum_rows`] are linear in
+//! rotor, two tilts per rotor, one time tag per rotor) and `δρ_v` that source's 1σ change
+//! of the momentum (read at the run's wheel-speed time tag). A rotor whose speed is read
+//! `δ_i` later than the run's time tag says has the momentum `ρ_i(t + δ_i) ≈ ρ_i(t) +
+//! δ_i ρ̇_i(t)`: its source is `δ_i = z σ_δ,i` with `δρ = σ_δ,i ρ̇_i`, the slope of the
+//! interpolated speeds (`super::wheel_delay::shift_rho`) at the rotor's time tag. The rows of [`super::momentum_rows`] are linear in
 //! `ρ` (`ρ` enters their right-hand side `b`), so the rows of the true momentum are
 //!
 //! ```text
@@ -27,8 +30,10 @@
 //! (`columns`). (The adaptive stencil's curvature column is also linear in `ρ`; its
 //! change, `κ Σ_v z_v …`, is of second order in the small `κ z` and left out.) The tilts'
 //! first-order model leaves out `θ²/2` of a rotor's momentum along its axis, 1.5e-4 of
-//! it at 1°: the run estimates once about the file's values, then once more about the
-//! rotors moved to that estimate (exactly: axes turned, inertias scaled; each rotor's
+//! it at 1°, and a time tag's leaves out the curvature of `ρ_i` over `δ_i`: the run
+//! estimates once about the file's values, then once more about the rotors moved to
+//! that estimate (exactly: axes turned, inertias scaled, speeds read at the estimated
+//! time tags; each rotor's
 //! source directions turned with its axis by the smallest rotation, so that the second
 //! pass's values are in the first's directions), its prior still the file's σ about the
 //! file's values (a prior mean `−ẑ`), and reports the sum.
@@ -71,7 +76,15 @@
 //! the small satellite so were the spin-inertia differences. So the run estimates the
 //! parameters only where the record's total momentum stands out from its scatter by
 //! [`MIN_MOMENTUM_SIGNIFICANCE`] (`total_momentum`); below it they stay a
-//! consider term.
+//! consider term. Time tags alone are estimated whatever the momentum: their columns,
+//! `δ_i ρ̇_i`, are no calibration `M ρ` of the rotor momentum for J to take up (on the
+//! slew without a momentum bias, the calibrated error was that of the record with every
+//! wheel on time, `tests/integration/rotor_time_tags.rs`).
+//!
+//! **σ.** The posterior covariance takes the rows' errors as independent; along a chain
+//! they are not (`super::jackknife`), and on 120 s slews the time tags found were up to
+//! 8 of those σ off. So each parameter's σ is no smaller than its jackknife over the
+//! same delete-one groups as J's (`RotorFit::with_jackknife`): the worst was then 2.2σ.
 
 use super::momentum_rows::{MomentumRowSettings, MomentumRows};
 use super::EstimatorError;
@@ -121,6 +134,24 @@ impl RotorFit {
             scale,
             scale_sigma,
         }
+    }
+}
+
+impl RotorFit {
+    /// Each σ no smaller than the jackknife's over the rows' chain groups (`None`: none):
+    /// the posterior covariance takes the rows' errors as independent, and along a
+    /// chain they are not (`super::jackknife`). The overall scale's σ and the count of
+    /// combinations the data fix stay the least-squares ones.
+    #[must_use]
+    pub(crate) fn with_jackknife(mut self, jackknife: Option<&[f64]>) -> Self {
+        if let Some(jk) = jackknife.filter(|jk| jk.len() == self.sigma.len()) {
+            for (s, j) in self.sigma.iter_mut().zip(jk) {
+                if j.is_finite() {
+                    *s = s.max(*j);
+                }
+            }
+        }
+        self
     }
 }
 
@@ -183,11 +214,12 @@ pub(crate) type Columns = (Vec<Vec<Vector3<f64>>>, Vec<f64>);
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RotorCalibration {
     /// Each parameter: `spin inertia` (one scale shared by every rotor), `rw1 spin
-    /// inertia`, `rw1 axis tilt 1`, … (`super::rotor_inertia`'s sources).
+    /// inertia`, `rw1 axis tilt 1`, `rw1 time tag`, … (`super::rotor_inertia`'s sources).
     pub sources: Vec<std::string::String>,
     /// Each one's unit: `relative` (the spin inertia's relative error; for a shared
-    /// scale, that of the rotor with the largest σ) or `deg` (a tilt of the axis towards
-    /// [`crate::spacecraft::Rotor::tilt_directions`]).
+    /// scale, that of the rotor with the largest σ), `deg` (a tilt of the axis towards
+    /// [`crate::spacecraft::Rotor::tilt_directions`]) or `s` (the rotor's speed read that
+    /// much later than the run's wheel-speed time tag).
     pub unit: Vec<&'static str>,
     /// The file's σ (the prior), in the unit.
     pub prior_sigma: Vec<f64>,

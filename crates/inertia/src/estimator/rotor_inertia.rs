@@ -1,6 +1,6 @@
 //! The rotors' uncertainty as a consider parameter (issues #30 "What the user said", #31
 //! "Per-rotor parameters"): how far `ĵ` moves for each independent 1σ error of the
-//! rotors' spin inertias and axes, and the σ that this adds.
+//! rotors' spin inertias, axes and time tags, and the σ that this adds.
 //!
 //! A relative error `ε_i` of rotor `i`'s spin inertia scales its momentum `ρ_i` by
 //! `1 + ε_i`; a small tilt of its axis by angles `(θ_1, θ_2)` towards the two directions
@@ -12,7 +12,10 @@
 //!   `ε_i = z s_i` (wheels of one model whose catalogue value is off);
 //! * **independent** spin-inertia errors: one source per rotor with a σ, `ε_i = z_i s_i`;
 //! * **axis tilts**: two sources per rotor with a tilt σ, `θ_j = z σ_θ,i` (mounting
-//!   errors are each wheel's own).
+//!   errors are each wheel's own);
+//! * **time tags**: one source per rotor with a time-tag σ, its speed read `δ_i = z σ_δ,i`
+//!   later than the run's wheel-speed time tag, to first order `ρ_i(t) + δ_i ρ̇_i(t)`
+//!   (`ρ̇_i` the slope of its interpolated speeds, `Change::TimeTag`).
 //!
 //! Each source's move `m_v = ĵ(z_v = 1) − ĵ` is measured on the estimator itself: the
 //! run's estimator (same settings, same samples, the run's wheel-speed time tag applied to
@@ -21,8 +24,9 @@
 //! length, inertial torque, body torque held or estimated:
 //! `PipelineConfig::pinned_to`), so that the move is the answer's sensitivity and not a
 //! switch of model (without it, a streaming and a batch run of the same data gave moves
-//! 5× apart). It is a secant over one σ, so it includes what that model does (its
-//! constraints, its chains' momenta). The consider term per element is
+//! 5× apart). It is a secant over one σ (a time tag's: over the slope of the speeds
+//! times σ), so it includes what that model does (its constraints, its chains'
+//! momenta). The consider term per element is
 //!
 //! ```text
 //! c_k = √(Σ_v m_v,k²)
@@ -103,10 +107,8 @@ pub(crate) fn consider(
         .map(crate::spacecraft::Rotor::relative_sigma)
         .collect();
     let sources = sources(spacecraft);
-    let sources: Vec<(std::string::String, Vec<Vector3<f64>>)> = sources
-        .into_iter()
-        .map(|s| (s.label, s.directions))
-        .collect();
+    let sources: Vec<(std::string::String, Change)> =
+        sources.into_iter().map(|s| (s.label, s.change)).collect();
     if sources.is_empty() {
         return Err(RotorInertiaError::NotComputable("no rotor has a σ"));
     }
@@ -115,8 +117,8 @@ pub(crate) fn consider(
     ))?;
     let mut scaled: Vec<Sample> = samples.to_vec();
     let mut moves = Vec::with_capacity(sources.len());
-    for (_, directions) in &sources {
-        let delta = source_momentum(samples, speeds, spacecraft, directions, delay_s);
+    for (_, change) in &sources {
+        let delta = source_momentum(samples, speeds, spacecraft, change, delay_s, &[]);
         for ((x, s), d) in scaled.iter_mut().zip(samples).zip(&delta) {
             x.rho_nms = s.rho_nms + d;
         }
@@ -138,46 +140,123 @@ pub(crate) fn consider(
 pub(crate) struct Source {
     /// `spin inertia` (shared), `rw1 spin inertia`, `rw1 axis tilt 1`, ….
     pub(crate) label: std::string::String,
-    /// Per rotor, the change of its momentum's direction per unit of its momentum.
-    pub(crate) directions: Vec<Vector3<f64>>,
+    /// What its 1σ changes.
+    pub(crate) change: Change,
     /// Its σ in [`Self::unit`]: the relative σ of the spin inertia (the largest of the
-    /// rotors' for a shared source), or the tilt's σ in degrees.
+    /// rotors' for a shared source), the tilt's σ in degrees, or the time tag's in s.
     pub(crate) sigma: f64,
-    /// `relative` or `deg`.
+    /// `relative`, `deg` or `s`.
     pub(crate) unit: &'static str,
 }
 
-/// The change of each sample's rotor momentum that a source's `directions` make:
-/// `Σ_i J_i u_i ω̃_i d_i`, read at the run's time tag `delay_s` (as the sum was).
+/// The half-step of the central difference that gives a time tag's column, relative to
+/// its σ.
+const TIME_TAG_STEP: f64 = 0.01;
+
+/// What one error source's 1σ changes.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Change {
+    /// Per rotor, the change of its momentum's direction per unit of its momentum (`s_i
+    /// a_i` for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
+    Directions(Vec<Vector3<f64>>),
+    /// Rotor `rotor`'s speed read `sigma_s` later: to first order its momentum
+    /// `σ ρ̇_i(t)`, `ρ̇_i` the slope of the interpolated speeds
+    /// ([`super::wheel_delay::shift_rho`]) at the rotor's time tag.
+    TimeTag {
+        /// The rotor, in the file's order.
+        rotor: usize,
+        /// The time tag's σ, s.
+        sigma_s: f64,
+    },
+}
+
+/// Rotor `i`'s momentum per sample, its speeds times `per_unit` (N m s per stored unit,
+/// body axes), read `shift_s` later ([`super::wheel_delay::shift_rho`]).
+fn rotor_momentum(
+    samples: &[Sample],
+    speeds: &[f64],
+    m: usize,
+    i: usize,
+    per_unit: Vector3<f64>,
+    shift_s: f64,
+) -> Vec<Sample> {
+    let mut rotor: Vec<Sample> = samples.to_vec();
+    for (k, x) in rotor.iter_mut().enumerate() {
+        x.rho_nms = per_unit * speeds[k * m + i];
+    }
+    super::wheel_delay::shift_rho(&mut rotor, shift_s);
+    rotor
+}
+
+/// The samples' rotor momentum `Σ_i J_i u_i ω̃_i(t + δ + δ_i) a_i` with each rotor's
+/// speeds read at the run's time tag `delay_s` plus its own `tags_s[i]` (none: 0).
+pub(crate) fn momentum(
+    samples: &[Sample],
+    speeds: &[f64],
+    spacecraft: &Spacecraft,
+    delay_s: f64,
+    tags_s: &[f64],
+) -> Vec<Vector3<f64>> {
+    let m = spacecraft.rotors.len();
+    let mut out = vec![Vector3::zeros(); samples.len()];
+    for (i, r) in spacecraft.rotors.iter().enumerate() {
+        let shift = delay_s + tags_s.get(i).copied().unwrap_or(0.0);
+        let part = rotor_momentum(samples, speeds, m, i, r.momentum_per_unit(), shift);
+        for (o, p) in out.iter_mut().zip(&part) {
+            *o += p.rho_nms;
+        }
+    }
+    out
+}
+
+/// The change of each sample's rotor momentum that a source's `change` makes, each
+/// rotor read at the run's time tag `delay_s` plus its own `tags_s[i]` (none: 0), as the
+/// sum was: `Σ_i J_i u_i ω̃_i d_i` for directions, `σ ρ̇_i(t)` for a time tag.
 pub(crate) fn source_momentum(
     samples: &[Sample],
     speeds: &[f64],
     spacecraft: &Spacecraft,
-    directions: &[Vector3<f64>],
+    change: &Change,
     delay_s: f64,
+    tags_s: &[f64],
 ) -> Vec<Vector3<f64>> {
     let m = spacecraft.rotors.len();
+    let shift = |i: usize| delay_s + tags_s.get(i).copied().unwrap_or(0.0);
     let mut out = vec![Vector3::zeros(); samples.len()];
-    let mut rotor: Vec<Sample> = samples.to_vec();
-    for (i, (r, d)) in spacecraft.rotors.iter().zip(directions).enumerate() {
-        if *d == Vector3::zeros() {
-            continue;
+    match change {
+        Change::Directions(directions) => {
+            for (i, (r, d)) in spacecraft.rotors.iter().zip(directions).enumerate() {
+                if *d == Vector3::zeros() {
+                    continue;
+                }
+                let per_unit = d * (r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s());
+                let part = rotor_momentum(samples, speeds, m, i, per_unit, shift(i));
+                for (o, p) in out.iter_mut().zip(&part) {
+                    *o += p.rho_nms;
+                }
+            }
         }
-        let per_unit = d * (r.spin_inertia_kg_m2 * r.speed_unit.to_rad_s());
-        for (k, x) in rotor.iter_mut().enumerate() {
-            x.rho_nms = per_unit * speeds[k * m + i];
-        }
-        super::wheel_delay::shift_rho(&mut rotor, delay_s);
-        for (o, part) in out.iter_mut().zip(&rotor) {
-            *o += part.rho_nms;
+        &Change::TimeTag { rotor: i, sigma_s } => {
+            let Some(r) = spacecraft.rotors.get(i) else {
+                return out;
+            };
+            // The derivative at the rotor's time tag (a central difference over a
+            // hundredth of σ) times σ: a secant over σ itself is a poor slope where σ is
+            // a good part of the sample period, and the second pass, linearised about
+            // the estimate, then converges only slowly.
+            let eps = sigma_s * TIME_TAG_STEP;
+            let at = |s: f64| rotor_momentum(samples, speeds, m, i, r.momentum_per_unit(), s);
+            let (late, early) = (at(shift(i) + eps), at(shift(i) - eps));
+            for ((o, a), b) in out.iter_mut().zip(&late).zip(&early) {
+                *o = (a.rho_nms - b.rho_nms) * (sigma_s / (2.0 * eps));
+            }
         }
     }
     out
 }
 
 /// The independent 1σ error sources of `spacecraft` ([module docs](self)): a label, and
-/// per rotor the change of its momentum's direction per unit of its momentum (`s_i a_i`
-/// for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
+/// what each changes ([`Change`]).
 pub(crate) fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
     let rotors = &spacecraft.rotors;
     let axis = |i: usize| Vector3::from(rotors[i].axis);
@@ -196,9 +275,11 @@ pub(crate) fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
             if largest > 0.0 {
                 out.push(Source {
                     label: "spin inertia".into(),
-                    directions: (0..rotors.len())
-                        .map(|i| axis(i) * rotors[i].relative_sigma())
-                        .collect(),
+                    change: Change::Directions(
+                        (0..rotors.len())
+                            .map(|i| axis(i) * rotors[i].relative_sigma())
+                            .collect(),
+                    ),
                     sigma: largest,
                     unit: "relative",
                 });
@@ -209,7 +290,7 @@ pub(crate) fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
                 if r.relative_sigma() > 0.0 {
                     out.push(Source {
                         label: std::format!("{} spin inertia", r.name),
-                        directions: only(i, axis(i) * r.relative_sigma()),
+                        change: Change::Directions(only(i, axis(i) * r.relative_sigma())),
                         sigma: r.relative_sigma(),
                         unit: "relative",
                     });
@@ -223,11 +304,24 @@ pub(crate) fn sources(spacecraft: &Spacecraft) -> Vec<Source> {
             for (j, e) in r.tilt_directions().iter().enumerate() {
                 out.push(Source {
                     label: std::format!("{} axis tilt {}", r.name, j + 1),
-                    directions: only(i, e * t),
+                    change: Change::Directions(only(i, e * t)),
                     sigma: r.spin_axis_sigma_deg,
                     unit: "deg",
                 });
             }
+        }
+    }
+    for (i, r) in rotors.iter().enumerate() {
+        if r.time_tag_sigma_s > 0.0 {
+            out.push(Source {
+                label: std::format!("{} time tag", r.name),
+                change: Change::TimeTag {
+                    rotor: i,
+                    sigma_s: r.time_tag_sigma_s,
+                },
+                sigma: r.time_tag_sigma_s,
+                unit: "s",
+            });
         }
     }
     out

@@ -229,7 +229,10 @@ pub struct RotorInertiaEntry {
     pub errors: crate::spacecraft::RotorErrors,
     /// Each rotor's axis tilt σ, deg.
     pub axis_sigma_deg: std::vec::Vec<f64>,
-    /// The independent 1σ error sources (`spin inertia`, `rw1 axis tilt 1`, …).
+    /// Each rotor's own time-tag σ, s.
+    pub time_tag_sigma_s: std::vec::Vec<f64>,
+    /// The independent 1σ error sources (`spin inertia`, `rw1 axis tilt 1`, `rw1 time
+    /// tag`, …).
     pub sources: std::vec::Vec<String>,
     /// The answer's move for each source, kg m².
     pub moves_kg_m2: std::vec::Vec<[f64; 6]>,
@@ -458,6 +461,7 @@ impl Report {
                     relative_sigma: c.relative_sigma.clone(),
                     errors: c.errors,
                     axis_sigma_deg: sc.rotors.iter().map(|r| r.spin_axis_sigma_deg).collect(),
+                    time_tag_sigma_s: sc.rotors.iter().map(|r| r.time_tag_sigma_s).collect(),
                     sources: c.sources.clone(),
                     moves_kg_m2: c.moves_kg_m2.clone(),
                     sigma_kg_m2: c.consider_kg_m2(),

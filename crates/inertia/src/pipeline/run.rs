@@ -201,10 +201,10 @@ impl Run {
 
     /// This run with a spacecraft file's rotors ([`crate::spacecraft`]): every sample's
     /// rotor momentum is computed from its rotors' speeds ([`Self::push_with_speeds`]),
-    /// and where a rotor's spin inertia or axis has a σ the run keeps the samples until
-    /// [`Self::finish`], which measures their consider term by running the estimator once
-    /// more per error source (one for shared spin-inertia errors or one per rotor for
-    /// independent ones, two per tilted axis), plus once
+    /// and where a rotor's spin inertia, axis or time tag has a σ the run keeps the
+    /// samples until [`Self::finish`], which measures their consider term by running the
+    /// estimator once more per error source (one for shared spin-inertia errors or one per
+    /// rotor for independent ones, two per tilted axis, one per time tag), plus once
     /// (`crate::estimator::rotor_inertia`), and widens σ by it.
     #[must_use]
     pub fn with_spacecraft(mut self, spacecraft: Spacecraft) -> Self {

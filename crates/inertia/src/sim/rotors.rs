@@ -35,6 +35,7 @@ pub fn pyramid(
                 spin_inertia_kg_m2: spin_inertia_kg_m2[i],
                 spin_inertia_sigma_kg_m2: relative_sigma * spin_inertia_kg_m2[i],
                 spin_axis_sigma_deg: 0.0,
+                time_tag_sigma_s: 0.0,
                 speed_column: std::format!("rw{}_rpm", i + 1),
                 speed_unit: SpeedUnit::Rpm,
                 max_torque_nm: None,
@@ -89,6 +90,7 @@ pub fn stated_exact(spacecraft: &Spacecraft) -> Spacecraft {
     for r in &mut sc.rotors {
         r.spin_inertia_sigma_kg_m2 = 0.0;
         r.spin_axis_sigma_deg = 0.0;
+        r.time_tag_sigma_s = 0.0;
     }
     sc
 }
@@ -121,6 +123,39 @@ pub fn speeds(samples: &[Sample], spacecraft: &Spacecraft) -> Result<Vec<f64>, S
     for s in samples {
         let y = inverse * s.rho_nms;
         out.extend(axes.iter().zip(&per_unit).map(|(a, u)| a.dot(&y) / u));
+    }
+    Ok(out)
+}
+
+/// The rotors' stored speeds where each rotor's telemetry has its own time tag: rotor
+/// `i`'s speeds are [`speeds`] of `records[i]`, the same record simulated with the wheel
+/// telemetry's skew ([`super::wheels::WheelTelemetry::skew_s`]) set to that rotor's own
+/// (the skew changes the telemetered momentum only, not the motion). So rotor `i` reads
+/// its true speed at `t + skew_i`, and the summed momentum of the file's rotors is
+/// `Σ_i J_i ω_i(t + skew_i) a_i`.
+pub fn speeds_each(records: &[&[Sample]], spacecraft: &Spacecraft) -> Result<Vec<f64>, SimError> {
+    let m = spacecraft.rotors.len();
+    if records.len() != m || m == 0 {
+        return Err(SimError::InvalidSetting {
+            field: "rotor records",
+            value: records.len() as f64,
+            why: "one record per rotor is needed",
+        });
+    }
+    let n = records[0].len();
+    let mut out = vec![0.0; n * m];
+    for (i, r) in records.iter().enumerate() {
+        if r.len() != n {
+            return Err(SimError::InvalidSetting {
+                field: "rotor records",
+                value: r.len() as f64,
+                why: "every rotor's record must have the same samples",
+            });
+        }
+        let w = speeds(r, spacecraft)?;
+        for k in 0..n {
+            out[k * m + i] = w[k * m + i];
+        }
     }
     Ok(out)
 }

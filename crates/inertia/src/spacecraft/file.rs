@@ -4,7 +4,7 @@
 use super::{
     thrusters, Prior, Rotor, RotorErrors, Sensors, Spacecraft, SpacecraftError, SpeedUnit,
 };
-use super::{AXIS_NORM_TOLERANCE, MAX_ROTORS};
+use super::{AXIS_NORM_TOLERANCE, MAX_ROTORS, MAX_TIME_TAG_SIGMA_S};
 use crate::text::Clipped;
 use nalgebra::Vector3;
 use serde::Deserialize;
@@ -67,6 +67,8 @@ struct RawRotor {
     spin_inertia_sigma_kg_m2: Option<toml::Spanned<f64>>,
     #[serde(default)]
     spin_axis_sigma_deg: Option<toml::Spanned<f64>>,
+    #[serde(default)]
+    time_tag_sigma_s: Option<toml::Spanned<f64>>,
     speed_column: toml::Spanned<String>,
     #[serde(default)]
     speed_unit: Option<toml::Spanned<String>>,
@@ -203,6 +205,18 @@ impl Spacecraft {
                     ),
                 ));
             }
+            let time_tag = r.time_tag_sigma_s.as_ref().map_or(0.0, |s| *s.get_ref());
+            if !(time_tag.is_finite() && (0.0..=MAX_TIME_TAG_SIGMA_S).contains(&time_tag)) {
+                return Err(err(
+                    r.time_tag_sigma_s.as_ref().map(toml::Spanned::span),
+                    key("time_tag_sigma_s"),
+                    format!(
+                        "{} must be at least 0 and at most {} s (a small offset)",
+                        crate::text::Num(time_tag),
+                        crate::text::Num(MAX_TIME_TAG_SIGMA_S)
+                    ),
+                ));
+            }
             let speed_column = r.speed_column.get_ref().trim().to_string();
             if speed_column.is_empty() {
                 return Err(err(
@@ -256,6 +270,7 @@ impl Spacecraft {
                 spin_inertia_kg_m2: j,
                 spin_inertia_sigma_kg_m2: sigma,
                 spin_axis_sigma_deg: tilt,
+                time_tag_sigma_s: time_tag,
                 speed_column,
                 speed_unit,
                 max_torque_nm,

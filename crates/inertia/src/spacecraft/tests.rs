@@ -39,6 +39,17 @@ fn a_good_file_is_read_with_its_units_and_defaults() {
     );
     assert!((rho - expected).norm() < 1e-15, "{rho} vs {expected}");
     assert_eq!(s.speed_columns(), ["rw1_speed", "rw2_speed"]);
+    assert_eq!(s.rotors[0].time_tag_sigma_s, 0.0);
+    // A time tag's σ alone is an uncertainty of the rotors.
+    let tagged = GOOD
+        .replace("spin_inertia_sigma_kg_m2 = 2.0e-5\n", "")
+        .replace(
+            "speed_unit = \"rpm\"",
+            "speed_unit = \"rpm\"\ntime_tag_sigma_s = 0.02",
+        );
+    let t = Spacecraft::parse(&tagged, "sc.toml").unwrap();
+    assert_eq!(t.rotors[0].time_tag_sigma_s, 0.02);
+    assert!(t.has_inertia_sigma());
 }
 
 #[test]
@@ -71,6 +82,8 @@ fn bad_files_are_refused_with_file_line_and_key() {
         ("speed_unit = \"rpm\"", "speed_units = \"rpm\"", "sc.toml:10: `speed_units`: unknown field"),
         ("speed_column = \"rw2_speed\"", "", "missing field `speed_column`"),
         ("spin_inertia_kg_m2 = 1.0e-3", "spin_inertia_kg_m2 = \"heavy\"", "sc.toml:7: `spin_inertia_kg_m2`:"),
+        ("speed_unit = \"rpm\"", "speed_unit = \"rpm\"\ntime_tag_sigma_s = 0.5", "sc.toml:11: `rotor[0].time_tag_sigma_s`: 0.5 must be at least 0 and at most 0.25 s"),
+        ("speed_unit = \"rpm\"", "speed_unit = \"rpm\"\ntime_tag_sigma_s = -0.01", "sc.toml:11: `rotor[0].time_tag_sigma_s`: -0.01 must be at least 0"),
     ];
     for (from, to, expected) in cases {
         let text = GOOD.replace(from, to);

@@ -4,6 +4,7 @@
 //! the momentum is large (the spin), leaves a momentum-free slew alone, keeps σ honest,
 //! and refuses settings it cannot use.
 
+use crate::common::wheels::median;
 use inertia::constraints::ConstraintSet;
 use inertia::estimator::observability::Observability;
 use inertia::pipeline::{batch, Pipeline, PipelineError, PipelineSettings};
@@ -54,11 +55,6 @@ fn runs(scenario: &Scenario, seeds: u64) -> Vec<(f64, f64, bool, bool, Option<bo
             (errors[0], errors[1], within, determined, weighted)
         })
         .collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Paper spin, attitude propagated from the paper's gyro, 10 seeds: the random walk of

@@ -28,6 +28,7 @@ mod records;
 mod rotor_calibration;
 mod rotor_inertia;
 mod rotor_scale;
+mod rotor_time_tags;
 mod short_records;
 mod sim_effects;
 mod sim_realism;

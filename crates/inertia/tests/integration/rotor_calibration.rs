@@ -4,6 +4,7 @@
 //! momentum bias. Reference: the simulated J, the same record with the true wheels
 //! (effect-free), and the file's wheels taken as exact (uncalibrated).
 
+use crate::common::wheels::{batch_with_wheels as run, median};
 use inertia::estimator::observability::Observability;
 use inertia::estimator::rotor_calibration::NotMade;
 use inertia::estimator::Estimate;
@@ -43,24 +44,6 @@ fn slew(seed: u64, bias: f64, wheels: &Spacecraft) -> (Vec<Sample>, Vec<f64>, Ma
     (out.samples, speeds, out.inertia_kg_m2)
 }
 
-/// The batch answer with `sc`'s rotors, calibrated or not, and the run.
-fn run(samples: &[Sample], speeds: &[f64], sc: Spacecraft, calibrate: bool) -> (Estimate, Run) {
-    let config = PipelineSettings {
-        calibrate_rotors: calibrate,
-        ..PipelineSettings::default()
-    }
-    .validate()
-    .expect("settings");
-    let mut r = Run::new(config, true).expect("run").with_spacecraft(sc);
-    let mut last = None;
-    for (k, s) in samples.iter().enumerate() {
-        r.push_with_speeds(s, &speeds[4 * k..4 * k + 4], |e| last = Some(*e))
-            .expect("push");
-    }
-    r.finish(|e| last = Some(*e)).expect("finish");
-    (last.expect("an estimate"), r)
-}
-
 /// The true wheels (axes tilted by draws of `tilt_deg`, inertias off the file's by draws
 /// of `scale`, independent), and the file: nominal axes, the drawn-off inertias, those σ.
 fn drawn(seed: u64, tilt_deg: f64, scale: f64) -> (Spacecraft, Spacecraft) {
@@ -76,11 +59,6 @@ fn assert_tilts_covered(tilt_z: &[f64]) {
         within >= 0.95 && worst <= 5.0,
         "{within} within 3σ, worst {worst}"
     );
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Problem: each wheel's axis tilted by draws of 0.5°, on a slew with a momentum bias, 6

@@ -12,6 +12,8 @@ use crate::estimator::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
 mod damping;
 use damping::without_damping;
 pub(crate) use damping::{DampingRow, WithoutDamping};
+mod shared_factor;
+pub(crate) use shared_factor::{SharedFactor, ROTOR};
 
 /// A row, its rotor parameters' columns ([`est::rotor_calibration::columns`]) and its
 /// record ([`crate::pipeline::interface::BatchInputs::records`]).
@@ -39,109 +41,9 @@ pub(crate) struct BatchReduction {
     pub(crate) shared: Option<SharedFactor>,
 }
 
-/// The first column index of the rotor parameters' unknowns
-/// ([`crate::estimator::rotor_calibration`]) in a batch reduction's shared columns: past
-/// the rows' own unknowns, source `v` at `ROTOR + v`.
-pub(crate) const ROTOR: usize = crate::estimator::unknowns::UNKNOWNS;
-
-/// The shared factor of a batch reduction, kept for the values of the outside torques
-/// ([`crate::estimator::external_torque`]) and the rotor parameters
-/// ([`crate::estimator::rotor_calibration`]): `R` (upper triangular over the shared columns
-/// used, `j` last, with the rotors' prior rows), `Qᵀy`, the columns, the residual variance
-/// and the weight `s` of the rotors' prior rows.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct SharedFactor {
-    r: nalgebra::DMatrix<f64>,
-    qty: nalgebra::DVector<f64>,
-    columns: std::vec::Vec<usize>,
-    pub(crate) s2: f64,
-    pub(crate) prior_weight: f64,
-    /// The rotor parameters' shares of the momentum's own scale (their `γ_v`).
-    gamma: std::vec::Vec<f64>,
-}
-
-/// A 3-vector unknown's value and σ per component.
-pub(crate) type ValueSigma = ([f64; 3], [Option<f64>; 3]);
-
-impl SharedFactor {
-    /// The unknowns before `j` at `j`: back-substitution with `j` fixed.
-    fn leading_at(&self, j: &InertiaVector) -> nalgebra::DVector<f64> {
-        let lead = self.columns.len() - 6;
-        let mut x = nalgebra::DVector::zeros(lead);
-        for i in (0..lead).rev() {
-            let d = self.r[(i, i)];
-            if d == 0.0 {
-                continue;
-            }
-            let mut s = self.qty[i];
-            for k in i + 1..lead {
-                s -= self.r[(i, k)] * x[k];
-            }
-            for k in 0..6 {
-                s -= self.r[(i, lead + k)] * j[k];
-            }
-            x[i] = s / d;
-        }
-        x
-    }
-
-    /// The rotor parameters at `j`, with their posterior covariance (whitened: the file's
-    /// σ is 1), where the rows estimate them.
-    #[must_use]
-    pub(crate) fn rotors_at(
-        &self,
-        j: &InertiaVector,
-    ) -> Option<crate::estimator::rotor_calibration::RotorFit> {
-        let at: std::vec::Vec<usize> = (0..self.columns.len())
-            .filter(|&p| (ROTOR..ROTOR + self.gamma.len()).contains(&self.columns[p]))
-            .collect();
-        if at.is_empty() || !(self.prior_weight > 0.0) {
-            return None;
-        }
-        let x = self.leading_at(j);
-        let n = self.columns.len();
-        let e = nalgebra::DMatrix::from_fn(n, at.len(), |i, v| f64::from(u8::from(i == at[v])));
-        let u = self.r.transpose().solve_lower_triangular(&e);
-        let u = u?;
-        let c = (u.transpose() * u) * (self.prior_weight * self.prior_weight);
-        Some(
-            crate::estimator::rotor_calibration::RotorFit::from_covariance(
-                at.iter().map(|&p| x[p]).collect(),
-                &c,
-                &self.gamma,
-            ),
-        )
-    }
-
-    /// The residual dipole and the centre of mass at `j` (where the rows use them), each
-    /// with its least-squares σ per component (every other unknown free).
-    #[must_use]
-    pub(crate) fn at(&self, j: &InertiaVector) -> [Option<ValueSigma>; 2] {
-        use est::momentum_rows::{CENTRE_OF_MASS, DIPOLE};
-        let n = self.columns.len();
-        let x = self.leading_at(j);
-        let sigma = |p: usize| {
-            let mut e = nalgebra::DVector::zeros(n);
-            e[p] = 1.0;
-            self.r
-                .transpose()
-                .solve_lower_triangular(&e)
-                .filter(|_| self.s2.is_finite() && self.r[(p, p)] != 0.0)
-                .map(|u| crate::math::sqrt(self.s2 * u.norm_squared()))
-        };
-        [DIPOLE, CENTRE_OF_MASS].map(|block| {
-            let at: std::vec::Vec<usize> = (block..block + 3)
-                .filter_map(|k| self.columns.iter().position(|&c| c == k))
-                .collect();
-            (at.len() == 3).then(|| {
-                (
-                    [x[at[0]], x[at[1]], x[at[2]]],
-                    [sigma(at[0]), sigma(at[1]), sigma(at[2])],
-                )
-            })
-        })
-    }
-}
+/// A delete-one-group answer: `j`, the damping `D` (where the rows estimate it) and the
+/// rotor parameters (whitened, where the rows estimate them).
+type Deleted = (InertiaVector, Option<f64>, Option<std::vec::Vec<f64>>);
 
 #[cfg(test)]
 impl BatchReduction {
@@ -422,6 +324,18 @@ pub(crate) fn reduce_batch(
             let full = (drop == 0).then_some((r, qty));
             (rr, z, rss, damping, full)
         };
+    // Every shared unknown's least-squares value (j unconstrained) from a full factor.
+    let shared_solution = |(r, qty): &(DMatrix<f64>, DVector<f64>)| {
+        let n = r.ncols();
+        let r = r.rows(0, n).into_owned();
+        r.solve_upper_triangular(&qty.rows(0, n).into_owned())
+    };
+    // The rotor parameters' values (whitened) from a full factor.
+    let rotor_values = |full: &Option<(DMatrix<f64>, DVector<f64>)>| {
+        let x = shared_solution(full.as_ref()?)?;
+        let at = rotor_at.filter(|_| n_rotor > 0)?;
+        Some((0..n_rotor).map(|v| x[at + v]).collect::<Vec<f64>>())
+    };
     // The rotor parameters' prior weight `s`, the rows' residual σ: first with the
     // parameters held at their prior mean (a prior row of far more weight than any data row; with
     // them free, the rows fit a zero J and a zero rotor momentum exactly), then once more
@@ -432,10 +346,8 @@ pub(crate) fn reduce_batch(
         let sigma_at = |w: f64| {
             let (_, _, shared_rss, _, full) = solve_with(&blocks, &|_| true, 0, w);
             // The data rows' share of ρ²: less the prior rows' `w² |ẑ − μ|²`.
-            let penalty = full.and_then(|(r, qty)| {
-                let n = r.ncols();
-                let r = r.rows(0, n).into_owned();
-                let x = r.solve_upper_triangular(&qty.rows(0, n).into_owned())?;
+            let penalty = full.as_ref().and_then(|f| {
+                let x = shared_solution(f)?;
                 let at = rotor_at?;
                 Some(
                     w * w
@@ -502,9 +414,9 @@ pub(crate) fn reduce_batch(
     let estimates: Option<Vec<_>> = if chains.len() >= MIN_GROUPS {
         (0..chains.len().min(GROUPS))
             .map(|g| {
-                let (r, z, _, d, _) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
+                let (r, z, _, d, f) = solve_shared(&blocks, &|c| c % GROUPS != g, 0);
                 let j = crate::solver::unconstrained_minimiser(&r, &z)?;
-                Some((j, damping_of(&d, &j)))
+                Some((j, damping_of(&d, &j), rotor_values(&f)))
             })
             .collect()
     } else {
@@ -531,13 +443,13 @@ pub(crate) fn reduce_batch(
                         reduce_chain(&kept).0
                     })
                     .collect();
-                let (r, z, _, d, _) = solve_shared(&without, &|_| true, 0);
+                let (r, z, _, d, f) = solve_shared(&without, &|_| true, 0);
                 let j = crate::solver::unconstrained_minimiser(&r, &z)?;
-                Some((j, damping_of(&d, &j)))
+                Some((j, damping_of(&d, &j), rotor_values(&f)))
             })
             .collect()
     };
-    let estimates: Option<Vec<(InertiaVector, Option<f64>)>> = estimates;
+    let estimates: Option<Vec<Deleted>> = estimates;
     // With at least MIN_GROUPS records, the records are groups too: what differs from one
     // pass or throw to the next is then in σ. Their few groups make a noisy σ (with four
     // records, three degrees of freedom), so the larger of the two is kept, element by
@@ -551,14 +463,14 @@ pub(crate) fn reduce_batch(
             present.iter().position(|&p| p == r).unwrap_or(0)
         })
         .collect();
-    let by_record: Option<Vec<(InertiaVector, Option<f64>)>> = (present.len() >= MIN_GROUPS)
+    let by_record: Option<Vec<Deleted>> = (present.len() >= MIN_GROUPS)
         .then(|| {
             (0..present.len().min(GROUPS))
                 .map(|g| {
                     let keep = |c: usize| group_of_chain[c] % GROUPS != g;
-                    let (r, z, _, d, _) = solve_shared(&blocks, &keep, 0);
+                    let (r, z, _, d, f) = solve_shared(&blocks, &keep, 0);
                     let j = crate::solver::unconstrained_minimiser(&r, &z)?;
-                    Some((j, damping_of(&d, &j)))
+                    Some((j, damping_of(&d, &j), rotor_values(&f)))
                 })
                 .collect()
         })
@@ -568,10 +480,10 @@ pub(crate) fn reduce_batch(
         (a, b) => a.or(b),
     };
     // The delete-one answers' D, as one more element of the jackknife.
-    let damping_sigma = |e: &[(InertiaVector, Option<f64>)], scale: f64| {
+    let damping_sigma = |e: &[Deleted], scale: f64| {
         let d: Option<Vec<InertiaVector>> = e
             .iter()
-            .map(|(_, d)| d.map(InertiaVector::from_element))
+            .map(|(_, d, _)| d.map(InertiaVector::from_element))
             .collect();
         jackknife_sigma(&d?).map(|s| s.map(|v| v * scale))
     };
@@ -582,8 +494,31 @@ pub(crate) fn reduce_batch(
         by_record.as_deref().and_then(|e| damping_sigma(e, 1.0)),
     )
     .map(|s| s[0]);
-    let j_sigma = |e: &[(InertiaVector, Option<f64>)], scale: f64| {
-        let j: Vec<InertiaVector> = e.iter().map(|(j, _)| *j).collect();
+    // The delete-one answers' rotor parameters, as more elements of the jackknife: their
+    // σ is then no smaller than the spread the chains' correlated errors give them.
+    let rotor_sigma = |e: &[Deleted], scale: f64| {
+        let v: Vec<&[f64]> = e
+            .iter()
+            .map(|(_, _, v)| v.as_deref())
+            .collect::<Option<_>>()?;
+        let mut out = vec![0.0; v.first()?.len()];
+        if v.iter().any(|x| x.len() != out.len()) {
+            return None;
+        }
+        est::jackknife::jackknife_sigma_by(v.len(), |g, k| v[g][k], &mut out)
+            .then(|| out.iter().map(|x| x * scale).collect::<Vec<f64>>())
+    };
+    let rotor_jackknife: Option<Vec<f64>> = match (
+        estimates
+            .as_deref()
+            .and_then(|e| rotor_sigma(e, time_block_scale)),
+        by_record.as_deref().and_then(|e| rotor_sigma(e, 1.0)),
+    ) {
+        (Some(a), Some(b)) => Some(a.iter().zip(&b).map(|(x, y)| x.max(*y)).collect()),
+        (a, b) => a.or(b),
+    };
+    let j_sigma = |e: &[Deleted], scale: f64| {
+        let j: Vec<InertiaVector> = e.iter().map(|(j, _, _)| *j).collect();
         jackknife_sigma(&j).map(|s| s.map(|v| v * scale))
     };
     let jackknife_sigma_kg_m2 = larger(
@@ -629,6 +564,7 @@ pub(crate) fn reduce_batch(
                 s2: est::qr::residual_variance(rss, rows as f64 - 6.0 - nuisance),
                 prior_weight,
                 gamma: gamma.clone(),
+                rotor_jackknife: rotor_jackknife.clone(),
             }),
         damping: damping_factor
             .zip(damping_at)

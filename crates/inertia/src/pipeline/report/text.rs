@@ -211,6 +211,12 @@ impl fmt::Display for ReportText<'_> {
             } else {
                 String::new()
             };
+            let tag = ri.time_tag_sigma_s.iter().fold(0.0f64, |a, &b| a.max(b));
+            let tilt = if tag > 0.0 {
+                format!("{tilt}, own time tags up to {tag:.3} s")
+            } else {
+                tilt
+            };
             writeln!(
                 s,
                 "rotors ({} rotors, {errors} spin-inertia errors up to {:.2} % each{tilt}; {} error sources): their σ in each element's σ up to {:.1e} kg m²",
@@ -232,6 +238,7 @@ impl fmt::Display for ReportText<'_> {
             for (k, name) in c.sources.iter().enumerate() {
                 let (scale, unit) = match c.unit[k] {
                     "relative" => (100.0, " %"),
+                    "s" => (1e3, " ms"),
                     _ => (1.0, "°"),
                 };
                 writeln!(

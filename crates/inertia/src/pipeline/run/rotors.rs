@@ -7,7 +7,7 @@ use super::{PipelineError, Run, RunError, RunErrorKind};
 use crate::estimator::rotor_calibration::{
     self, NotMade, RotorCalibration, RotorFit, MIN_MOMENTUM_SIGNIFICANCE,
 };
-use crate::estimator::rotor_inertia::{self, Source};
+use crate::estimator::rotor_inertia::{self, Change, Source};
 use crate::pipeline::interface::BatchInputs;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
@@ -29,7 +29,8 @@ pub(super) enum Calibrated {
 /// estimate moved), each time with the file's σ about the file's values as the prior.
 /// The parameters are reported against the file's values. None with a known torque, with
 /// a record whose total momentum does not stand out from its scatter by
-/// [`MIN_MOMENTUM_SIGNIFICANCE`], or where the rows give no fit of them ([`NotMade`]).
+/// [`MIN_MOMENTUM_SIGNIFICANCE`] (unless every parameter is a time tag), or where the
+/// rows give no fit of them ([`NotMade`]).
 pub(super) fn calibrated_batch(
     samples: &[Sample],
     config: &PipelineConfig,
@@ -50,17 +51,19 @@ pub(super) fn calibrated_batch(
         return Ok(Calibrated::NotMade(NotMade::KnownTorque));
     }
     let sources = rotor_inertia::sources(sc);
-    let momenta = |sc: &Spacecraft, sources: &[Source]| -> Vec<_> {
+    let momenta = |sc: &Spacecraft, sources: &[Source], tags_s: &[f64]| -> Vec<_> {
         sources
             .iter()
-            .map(|s| rotor_inertia::source_momentum(samples, speeds, sc, &s.directions, delay_s))
+            .map(|s| {
+                rotor_inertia::source_momentum(samples, speeds, sc, &s.change, delay_s, tags_s)
+            })
             .collect()
     };
     let first = batch_with(
         samples,
         config,
         &BatchInputs {
-            momenta: momenta(sc, &sources),
+            momenta: momenta(sc, &sources, &[]),
             prior_mean: vec![0.0; sources.len()],
             records: Vec::new(),
         },
@@ -72,19 +75,25 @@ pub(super) fn calibrated_batch(
         return Ok(Calibrated::NotMade(NotMade::NoFit));
     };
     let momentum = rotor_calibration::total_momentum(samples, &j);
-    if !(momentum.1 >= MIN_MOMENTUM_SIGNIFICANCE) {
+    // Time tags alone need no total momentum: their columns, `δ_i ρ̇_i`, are not a
+    // calibration of the rotor momentum (`M ρ`) that J can take up.
+    let tags_only = sources
+        .iter()
+        .all(|s| matches!(s.change, Change::TimeTag { .. }));
+    if !tags_only && !(momentum.1 >= MIN_MOMENTUM_SIGNIFICANCE) {
         return Ok(Calibrated::NotMade(NotMade::NoMomentum {
             ratio: momentum.0,
             significance: momentum.1,
         }));
     }
-    // The rotors at the estimate, and the samples' momentum from them.
-    let moved = moved(sc, &sources, &fit.value);
+    // The rotors at the estimate, and the samples' momentum from them (each rotor read at
+    // its own time tag).
+    let (moved, tags_s) = moved(sc, &sources, &fit.value);
     let mut again: Vec<Sample> = samples.to_vec();
-    for (k, s) in again.iter_mut().enumerate() {
-        s.rho_nms = moved.momentum_nms(&speeds[k * m..(k + 1) * m]);
+    let rho = rotor_inertia::momentum(samples, speeds, &moved, delay_s, &tags_s);
+    for (s, r) in again.iter_mut().zip(rho) {
+        s.rho_nms = r;
     }
-    crate::estimator::wheel_delay::shift_rho(&mut again, delay_s);
     // The same sources about the moved rotors: each rotor's directions turned with its axis
     // (the file's tilt directions carried along, so that the second pass's values add to
     // the first's; `Rotor::tilt_directions` of a moved axis may be others).
@@ -97,12 +106,12 @@ pub(super) fn calibrated_batch(
     let second_sources: Vec<Source> = sources
         .iter()
         .map(|s| Source {
-            directions: s
-                .directions
-                .iter()
-                .zip(&turns)
-                .map(|(d, t)| t * d)
-                .collect(),
+            change: match &s.change {
+                Change::Directions(d) => {
+                    Change::Directions(d.iter().zip(&turns).map(|(d, t)| t * d).collect())
+                }
+                tag @ Change::TimeTag { .. } => tag.clone(),
+            },
             ..s.clone()
         })
         .collect();
@@ -110,7 +119,7 @@ pub(super) fn calibrated_batch(
         &again,
         config,
         &BatchInputs {
-            momenta: momenta(&moved, &second_sources),
+            momenta: momenta(&moved, &second_sources, &tags_s),
             prior_mean: fit.value.iter().map(|z| -z).collect(),
             records: Vec::new(),
         },
@@ -144,15 +153,27 @@ fn minimal_rotation(
 
 /// `sc` with each rotor's spin inertia and axis moved by the sources' values `z` (in
 /// their σ): the inertia by its relative error, the axis turned by its two tilts (exactly,
-/// not to first order). The σ stay relative to the moved values.
-fn moved(sc: &Spacecraft, sources: &[Source], z: &[f64]) -> Spacecraft {
+/// not to first order); and each rotor's own time tag, s. The σ stay relative to the
+/// moved values.
+fn moved(sc: &Spacecraft, sources: &[Source], z: &[f64]) -> (Spacecraft, Vec<f64>) {
     let mut out = sc.clone();
+    let mut tags_s = vec![0.0; sc.rotors.len()];
+    for (s, zv) in sources.iter().zip(z) {
+        if let Change::TimeTag { rotor, sigma_s } = s.change {
+            if let Some(t) = tags_s.get_mut(rotor) {
+                *t += zv * sigma_s;
+            }
+        }
+    }
     for (i, r) in out.rotors.iter_mut().enumerate() {
         let axis = nalgebra::Vector3::from(r.axis);
         let mut scale = 0.0;
         let mut tilt = nalgebra::Vector3::zeros();
         for (s, zv) in sources.iter().zip(z) {
-            let d = s.directions[i] * *zv;
+            let Change::Directions(directions) = &s.change else {
+                continue;
+            };
+            let d = directions[i] * *zv;
             scale += d.dot(&axis);
             tilt += d - axis * d.dot(&axis);
         }
@@ -166,7 +187,7 @@ fn moved(sc: &Spacecraft, sources: &[Source], z: &[f64]) -> Spacecraft {
             r.axis = a.normalize().into();
         }
     }
-    out
+    (out, tags_s)
 }
 
 impl Run {
@@ -180,7 +201,7 @@ impl Run {
                 RunErrorKind::Pipeline(PipelineError::NeedsSetting {
                     setting: "calibrate_rotors",
                     needs: "spacecraft",
-                    requirement: "with a σ for some rotor's spin inertia or axis",
+                    requirement: "with a σ for some rotor's spin inertia, axis or time tag",
                     why: "the rotors' parameters are estimated about the file's values, the file's σ their prior",
                 }),
             ));

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod momentum_balance;
+pub mod wheels;
 
 use inertia::attitude::Quaternion;
 use inertia::constraints::ConstraintSet;
