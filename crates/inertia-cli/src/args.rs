@@ -571,9 +571,9 @@ pub struct EstimateArgs {
     /// Estimate the spacecraft file's rotor parameters with J (each wheel's spin-inertia
     /// error, the two tilts of its axis and its own time tag, wherever the file gives them
     /// a σ, which is their prior; with --batch). The overall scale of the wheels stays the
-    /// file's σ. Unless every parameter is a time tag, the record needs a total angular
-    /// momentum (a momentum bias), else the file's σ is a consider term and the report
-    /// says why.
+    /// file's σ, and a record with a known torque is not calibrated. Unless every
+    /// parameter is a time tag, the record needs a total angular momentum (a momentum
+    /// bias), else the file's σ is a consider term and the report says why.
     #[arg(long)]
     pub calibrate_rotors: bool,
     /// Do not model the gravity-gradient torque from the telemetry's positions

@@ -197,8 +197,9 @@ pub struct Rotor {
     pub spin_inertia_sigma_kg_m2: f64,
     /// The 1σ tilt of its axis about each of two perpendicular directions, deg (0: exact).
     pub spin_axis_sigma_deg: f64,
-    /// The 1σ of its speed's time tag about the run's wheel-speed time tag, s (0: on
-    /// time): each wheel's telemetry may be read at its own instant.
+    /// The 1σ of its speed's own time tag about the run's wheel-speed time tag, s (0: on
+    /// time): each wheel's telemetry may be read at its own instant. A positive value of
+    /// it lags (the speed read at `t` is the one of `t − δ_i`), as `--wheel-delay`'s.
     pub time_tag_sigma_s: f64,
     /// The telemetry column that holds its speed.
     pub speed_column: String,

@@ -133,7 +133,8 @@ def estimate(
             file's σ their prior (``report["rotor_calibration"]``: values, σ, how many
             combinations the data fix); the wheels' common scale stays the file's σ. Unless
             every parameter is a time tag, the record needs a total angular momentum (else
-            a warning, and the file's σ a consider term).
+            a warning, and the file's σ a consider term); with a known torque the
+            calibration is not made (a warning).
             outside: which torques of the outside measurements are modelled, a dict
             (``--no-gravity-gradient``, ``--gravity-mu``, ``--no-residual-dipole``,
             ``--no-centre-of-mass``): ``gravity_gradient`` (default ``True``),

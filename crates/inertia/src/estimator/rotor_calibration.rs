@@ -15,10 +15,11 @@
 //! with one independent standard normal source `z_v` per error the file gives a σ
 //! (the sources of `super::rotor_inertia`: one shared spin-inertia source or one per
 //! rotor, two tilts per rotor, one time tag per rotor) and `δρ_v` that source's 1σ change
-//! of the momentum (read at the run's wheel-speed time tag). A rotor whose speed is read
-//! `δ_i` later than the run's time tag says has the momentum `ρ_i(t + δ_i) ≈ ρ_i(t) +
-//! δ_i ρ̇_i(t)`: its source is `δ_i = z σ_δ,i` with `δρ = σ_δ,i ρ̇_i`, the slope of the
-//! interpolated speeds (`super::wheel_delay::shift_rho`) at the rotor's time tag. The rows of [`super::momentum_rows`] are linear in
+//! of the momentum (read at the run's wheel-speed time tag). A rotor whose telemetry
+//! lags that time tag by `δ_i` (its speed read at `t` is the one of `t − δ_i`) has the
+//! momentum `ρ_i(t + δ_i) ≈ ρ_i(t) + δ_i ρ̇_i(t)`: its source is `δ_i = z σ_δ,i` with
+//! `δρ = ρ_i(t + σ_δ,i) − ρ_i(t)` of the interpolated speeds
+//! (`super::wheel_delay::shift_rho`). The rows of [`super::momentum_rows`] are linear in
 //! `ρ` (`ρ` enters their right-hand side `b`), so the rows of the true momentum are
 //!
 //! ```text
@@ -82,9 +83,11 @@
 //! wheel on time, `tests/integration/rotor_time_tags.rs`).
 //!
 //! **σ.** The posterior covariance takes the rows' errors as independent; along a chain
-//! they are not (`super::jackknife`), and on 120 s slews the time tags found were up to
-//! 8 of those σ off. So each parameter's σ is no smaller than its jackknife over the
-//! same delete-one groups as J's (`RotorFit::with_jackknife`): the worst was then 2.2σ.
+//! they are not (`super::jackknife`): on 120 s slews it alone would leave the time tags
+//! found up to 8σ off. So each parameter's σ, and the overall scale's `σ_c`, is no
+//! smaller than its jackknife over the same delete-one groups as J's
+//! (`RotorFit::with_jackknife`; the worst time tag on those slews, with and without a
+//! momentum bias, is then 2.2σ off).
 
 use super::momentum_rows::{MomentumRowSettings, MomentumRows};
 use super::EstimatorError;
@@ -98,7 +101,8 @@ use std::vec::Vec;
 pub struct RotorFit {
     /// Each source's value `ẑ_v` at the answer.
     pub value: Vec<f64>,
-    /// Each source's posterior σ (1 where the data add nothing to the prior).
+    /// Each source's σ after the data: its posterior σ (1 where the data add nothing to
+    /// the prior), or its jackknife's where larger (`Self::with_jackknife`).
     pub sigma: Vec<f64>,
     /// How many independent combinations of the sources the data fix better than the
     /// prior (eigenvalues of the data's information beyond the prior's).
@@ -106,7 +110,8 @@ pub struct RotorFit {
     /// The overall scale of the rotor momentum the estimate implies, `ĉ = Σ_v ẑ_v γ_v`
     /// ([module docs](self), "The overall scale"): J is the rows' answer times `1 + ĉ`.
     pub scale: f64,
-    /// Its σ, `√(γᵀ C γ)`: the part of the rotors' uncertainty the rows cannot fix.
+    /// Its σ, `√(γᵀ C γ)` (or its jackknife's where larger, `Self::with_jackknife`): the
+    /// part of the rotors' uncertainty the rows cannot fix.
     pub scale_sigma: f64,
 }
 
@@ -138,17 +143,22 @@ impl RotorFit {
 }
 
 impl RotorFit {
-    /// Each σ no smaller than the jackknife's over the rows' chain groups (`None`: none):
-    /// the posterior covariance takes the rows' errors as independent, and along a
-    /// chain they are not (`super::jackknife`). The overall scale's σ and the count of
-    /// combinations the data fix stay the least-squares ones.
+    /// Each σ, and the overall scale's, no smaller than the jackknife's over the rows'
+    /// chain groups (`jackknife`: one per source, then the scale's; `None`: none): the
+    /// posterior covariance takes the rows' errors as independent, and along a chain they
+    /// are not (`super::jackknife`). The count of combinations the data fix stays the
+    /// least-squares one.
     #[must_use]
     pub(crate) fn with_jackknife(mut self, jackknife: Option<&[f64]>) -> Self {
-        if let Some(jk) = jackknife.filter(|jk| jk.len() == self.sigma.len()) {
+        let n = self.sigma.len();
+        if let Some(jk) = jackknife.filter(|jk| jk.len() == n + 1) {
             for (s, j) in self.sigma.iter_mut().zip(jk) {
                 if j.is_finite() {
                     *s = s.max(*j);
                 }
+            }
+            if jk[n].is_finite() {
+                self.scale_sigma = self.scale_sigma.max(jk[n]);
             }
         }
         self
@@ -233,8 +243,8 @@ pub struct RotorCalibration {
     /// The record's total angular momentum over its rotors' (RMS).
     pub momentum_ratio: f64,
     /// The record's total angular momentum over its scatter along the record: below
-    /// [`MIN_MOMENTUM_SIGNIFICANCE`], the tilts cannot be told from J and no
-    /// parameter is estimated.
+    /// [`MIN_MOMENTUM_SIGNIFICANCE`], the tilts cannot be told from J and no parameter
+    /// is estimated, unless every one is a time tag.
     pub momentum_significance: f64,
 }
 

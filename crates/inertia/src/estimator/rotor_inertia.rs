@@ -13,9 +13,10 @@
 //! * **independent** spin-inertia errors: one source per rotor with a σ, `ε_i = z_i s_i`;
 //! * **axis tilts**: two sources per rotor with a tilt σ, `θ_j = z σ_θ,i` (mounting
 //!   errors are each wheel's own);
-//! * **time tags**: one source per rotor with a time-tag σ, its speed read `δ_i = z σ_δ,i`
-//!   later than the run's wheel-speed time tag, to first order `ρ_i(t) + δ_i ρ̇_i(t)`
-//!   (`ρ̇_i` the slope of its interpolated speeds, `Change::TimeTag`).
+//! * **time tags**: one source per rotor with a time-tag σ, its telemetry lagging the
+//!   run's wheel-speed time tag by `δ_i = z σ_δ,i` (the speed read at `t` is the one of
+//!   `t − δ_i`, as for `--wheel-delay`), so that its momentum is `ρ_i(t + δ_i) ≈ ρ_i(t) +
+//!   δ_i ρ̇_i(t)` of its interpolated speeds (`Change::TimeTag`).
 //!
 //! Each source's move `m_v = ĵ(z_v = 1) − ĵ` is measured on the estimator itself: the
 //! run's estimator (same settings, same samples, the run's wheel-speed time tag applied to
@@ -24,9 +25,8 @@
 //! length, inertial torque, body torque held or estimated:
 //! `PipelineConfig::pinned_to`), so that the move is the answer's sensitivity and not a
 //! switch of model (without it, a streaming and a batch run of the same data gave moves
-//! 5× apart). It is a secant over one σ (a time tag's: over the slope of the speeds
-//! times σ), so it includes what that model does (its constraints, its chains'
-//! momenta). The consider term per element is
+//! 5× apart). It is a secant over one σ, so it includes what that model does (its
+//! constraints, its chains' momenta). The consider term per element is
 //!
 //! ```text
 //! c_k = √(Σ_v m_v,k²)
@@ -149,19 +149,16 @@ pub(crate) struct Source {
     pub(crate) unit: &'static str,
 }
 
-/// The half-step of the central difference that gives a time tag's column, relative to
-/// its σ.
-const TIME_TAG_STEP: f64 = 0.01;
-
 /// What one error source's 1σ changes.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Change {
     /// Per rotor, the change of its momentum's direction per unit of its momentum (`s_i
     /// a_i` for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
     Directions(Vec<Vector3<f64>>),
-    /// Rotor `rotor`'s speed read `sigma_s` later: to first order its momentum
-    /// `σ ρ̇_i(t)`, `ρ̇_i` the slope of the interpolated speeds
-    /// ([`super::wheel_delay::shift_rho`]) at the rotor's time tag.
+    /// Rotor `rotor`'s telemetry lagging by `sigma_s` more (its speed read at `t` is the
+    /// one of `t − σ`): its momentum `ρ_i(t + σ) − ρ_i(t)` of the interpolated speeds
+    /// ([`super::wheel_delay::shift_rho`]) at the rotor's time tag, `σ ρ̇_i` to first
+    /// order.
     TimeTag {
         /// The rotor, in the file's order.
         rotor: usize,
@@ -211,7 +208,7 @@ pub(crate) fn momentum(
 
 /// The change of each sample's rotor momentum that a source's `change` makes, each
 /// rotor read at the run's time tag `delay_s` plus its own `tags_s[i]` (none: 0), as the
-/// sum was: `Σ_i J_i u_i ω̃_i d_i` for directions, `σ ρ̇_i(t)` for a time tag.
+/// sum was: `Σ_i J_i u_i ω̃_i d_i` for directions, `ρ_i(t + σ) − ρ_i(t)` for a time tag.
 pub(crate) fn source_momentum(
     samples: &[Sample],
     speeds: &[f64],
@@ -240,19 +237,48 @@ pub(crate) fn source_momentum(
             let Some(r) = spacecraft.rotors.get(i) else {
                 return out;
             };
-            // The derivative at the rotor's time tag (a central difference over a
-            // hundredth of σ) times σ: a secant over σ itself is a poor slope where σ is
-            // a good part of the sample period, and the second pass, linearised about
-            // the estimate, then converges only slowly.
-            let eps = sigma_s * TIME_TAG_STEP;
+            // The secant over σ: exact where the speeds are held between updates (a
+            // staircase, whose slope is a train of spikes), and the second pass
+            // re-linearises about the estimate.
             let at = |s: f64| rotor_momentum(samples, speeds, m, i, r.momentum_per_unit(), s);
-            let (late, early) = (at(shift(i) + eps), at(shift(i) - eps));
-            for ((o, a), b) in out.iter_mut().zip(&late).zip(&early) {
-                *o = (a.rho_nms - b.rho_nms) * (sigma_s / (2.0 * eps));
+            let (late, now) = (at(shift(i) + sigma_s), at(shift(i)));
+            for ((o, a), b) in out.iter_mut().zip(&late).zip(&now) {
+                *o = a.rho_nms - b.rho_nms;
             }
         }
     }
     out
+}
+
+/// The relative σ of the rotor momentum that `spacecraft`'s time tags state on these
+/// samples: `√(Σ_i Σ_k |δρ_i,k|²) / √(Σ_k |ρ_k|²)`, `δρ_i` rotor `i`'s time tag's 1σ
+/// change ([`Change::TimeTag`]), read at the run's time tag `delay_s`; 0 without time
+/// tags or rotor momentum.
+pub(crate) fn time_tag_relative_sigma(
+    samples: &[Sample],
+    speeds: &[f64],
+    spacecraft: &Spacecraft,
+    delay_s: f64,
+) -> f64 {
+    let m = spacecraft.rotors.len();
+    if m == 0 || speeds.len() != samples.len() * m {
+        return 0.0;
+    }
+    let rho2: f64 = momentum(samples, speeds, spacecraft, delay_s, &[])
+        .iter()
+        .map(Vector3::norm_squared)
+        .sum();
+    let tags2: f64 = sources(spacecraft)
+        .iter()
+        .filter(|s| matches!(s.change, Change::TimeTag { .. }))
+        .flat_map(|s| source_momentum(samples, speeds, spacecraft, &s.change, delay_s, &[]))
+        .map(|d| d.norm_squared())
+        .sum();
+    if rho2 > 0.0 {
+        crate::math::sqrt(tags2 / rho2)
+    } else {
+        0.0
+    }
 }
 
 /// The independent 1σ error sources of `spacecraft` ([module docs](self)): a label, and
@@ -349,5 +375,51 @@ mod tests {
             "{x:?}"
         );
         assert!(close(x[5], 0.73f64.sqrt()) && x[2] == 0.0, "{x:?}");
+    }
+
+    /// Problem: one rotor on x whose speed ramps, `ω = 2 t` rad/s at `t = 1 … N` s, its
+    /// time tag ± 0.1 s. Reference: the ramp read 0.1 s later moves every momentum but the
+    /// last (held beyond the record) by `J · 2 · 0.1` against a momentum `J · 2 t`, so the
+    /// relative σ is `√(N − 1) · 0.1 / √(Σ t²)`; without a time-tag σ, 0.
+    #[test]
+    fn the_time_tags_relative_sigma_is_their_share_of_the_momentum() {
+        use crate::spacecraft::{Rotor, SpeedUnit};
+        let n = 50;
+        let rotor = Rotor {
+            name: "x".into(),
+            axis: [1.0, 0.0, 0.0],
+            spin_inertia_kg_m2: 0.01,
+            spin_inertia_sigma_kg_m2: 0.0,
+            spin_axis_sigma_deg: 0.0,
+            time_tag_sigma_s: 0.1,
+            speed_column: "w".into(),
+            speed_unit: SpeedUnit::RadPerS,
+            max_torque_nm: None,
+            max_momentum_nms: None,
+        };
+        let mut sc = Spacecraft {
+            rotors: vec![rotor],
+            ..Spacecraft::default()
+        };
+        let samples: Vec<Sample> = (1..=n)
+            .map(|k| Sample {
+                t_s: k as f64,
+                q: crate::attitude::Quaternion::IDENTITY,
+                rho_nms: Vector3::zeros(),
+                tau_nm: Vector3::zeros(),
+                omega_rad_s: None,
+                external: Default::default(),
+            })
+            .collect();
+        let speeds: Vec<f64> = samples.iter().map(|s| 2.0 * s.t_s).collect();
+        let t2: f64 = samples.iter().map(|s| s.t_s * s.t_s).sum();
+        let expected = ((n - 1) as f64).sqrt() * 0.1 / t2.sqrt();
+        let got = time_tag_relative_sigma(&samples, &speeds, &sc, 0.0);
+        assert!(
+            (got - expected).abs() < 1e-12 * expected,
+            "{got} vs {expected}"
+        );
+        sc.rotors[0].time_tag_sigma_s = 0.0;
+        assert_eq!(time_tag_relative_sigma(&samples, &speeds, &sc, 0.0), 0.0);
     }
 }

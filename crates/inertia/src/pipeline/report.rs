@@ -438,7 +438,7 @@ impl Report {
     }
 
     /// With the rotors' spin-inertia consider term the run computed (`spacecraft`'s
-    /// rotors), or why it could not be.
+    /// rotors), or why it could not be and the relative σ that widened σ instead.
     #[must_use]
     #[cfg_attr(not(feature = "csv"), allow(dead_code))] // used by Run::report
     pub(crate) fn with_rotor_inertia(
@@ -450,6 +450,7 @@ impl Report {
                 crate::estimator::rotor_inertia::RotorInertiaError,
             >,
         >,
+        fallback_relative_sigma: f64,
     ) -> Self {
         let (Some(sc), Some(c)) = (spacecraft, consider) else {
             return self;
@@ -468,7 +469,7 @@ impl Report {
                 });
             }
             Err(e) => {
-                self.rotor_inertia_error = Some((*e, sc.stated_relative_sigma()));
+                self.rotor_inertia_error = Some((*e, fallback_relative_sigma));
             }
         }
         self.refreshed()

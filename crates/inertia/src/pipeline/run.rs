@@ -123,6 +123,9 @@ pub struct Run {
     rotor_speeds: Vec<f64>,
     /// The rotors' consider term, once computed, or why it could not be.
     rotor_consider: Option<Result<RotorInertiaConsider, RotorInertiaError>>,
+    /// The relative σ that widened σ where the rotors' consider term could not be
+    /// computed.
+    rotor_fallback_sigma: f64,
     /// The rotor parameters estimated, once the batch estimate is made.
     calibration: Option<RotorCalibration>,
     /// A calibration asked for and not made, and why: the rotors' σ is then their
@@ -191,6 +194,7 @@ impl Run {
             rotors: None,
             rotor_speeds: Vec::new(),
             rotor_consider: None,
+            rotor_fallback_sigma: 0.0,
             calibration: None,
             calibration_not_made: None,
             records: records::Records::default(),

@@ -330,11 +330,14 @@ pub(crate) fn reduce_batch(
         let r = r.rows(0, n).into_owned();
         r.solve_upper_triangular(&qty.rows(0, n).into_owned())
     };
-    // The rotor parameters' values (whitened) from a full factor.
+    // The rotor parameters' values (whitened) from a full factor, then the overall scale
+    // they imply, `Σ_v γ_v z_v` ([`crate::estimator::rotor_calibration`]).
     let rotor_values = |full: &Option<(DMatrix<f64>, DVector<f64>)>| {
         let x = shared_solution(full.as_ref()?)?;
         let at = rotor_at.filter(|_| n_rotor > 0)?;
-        Some((0..n_rotor).map(|v| x[at + v]).collect::<Vec<f64>>())
+        let z: Vec<f64> = (0..n_rotor).map(|v| x[at + v]).collect();
+        let scale = z.iter().zip(&gamma).map(|(z, g)| z * g).sum::<f64>();
+        Some(z.into_iter().chain([scale]).collect::<Vec<f64>>())
     };
     // The rotor parameters' prior weight `s`, the rows' residual σ: first with the
     // parameters held at their prior mean (a prior row of far more weight than any data row; with
@@ -494,8 +497,9 @@ pub(crate) fn reduce_batch(
         by_record.as_deref().and_then(|e| damping_sigma(e, 1.0)),
     )
     .map(|s| s[0]);
-    // The delete-one answers' rotor parameters, as more elements of the jackknife: their
-    // σ is then no smaller than the spread the chains' correlated errors give them.
+    // The delete-one answers' rotor parameters and their overall scale, as more elements
+    // of the jackknife: their σ is then no smaller than the spread the chains' correlated
+    // errors give them.
     let rotor_sigma = |e: &[Deleted], scale: f64| {
         let v: Vec<&[f64]> = e
             .iter()

@@ -29,7 +29,11 @@ impl Run {
         Some(
             report
                 .with_wheel_delay(self.delay.as_ref())
-                .with_rotor_inertia(self.rotors.as_ref(), self.rotor_consider.as_ref())
+                .with_rotor_inertia(
+                    self.rotors.as_ref(),
+                    self.rotor_consider.as_ref(),
+                    self.rotor_fallback_sigma,
+                )
                 .with_rotor_calibration(self.calibration.as_ref(), self.calibration_not_made)
                 .with_held_speeds(self.held_speeds_period_samples().map(|p| {
                     (

@@ -227,8 +227,9 @@ impl Run {
     /// rotor has a spin-inertia σ) and put it into the configuration ([`super::status`]).
     /// Where it cannot be computed, σ is widened as if every rotor shared the file's
     /// relative σ, the root sum square of all
-    /// ([`crate::spacecraft::Spacecraft::stated_relative_sigma`]; the common scale's term,
-    /// [`super::status`]), and the reason kept
+    /// ([`crate::spacecraft::Spacecraft::stated_relative_sigma`], with the time tags' share
+    /// of these samples' rotor momentum, `rotor_inertia::time_tag_relative_sigma`; the
+    /// common scale's term, [`super::status`]), and the reason kept
     /// ([`Self::rotor_inertia`]).
     pub(super) fn apply_rotor_consider(&mut self, samples: &[Sample]) {
         let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
@@ -273,7 +274,15 @@ impl Run {
         match &c {
             Ok(c) => self.config.rotor_inertia_consider = Some(c.consider_kg_m2()),
             Err(_) => {
-                let r = sc.stated_relative_sigma();
+                // The file's relative σ, with the time tags' on these samples.
+                let tags = rotor_inertia::time_tag_relative_sigma(
+                    samples,
+                    &self.rotor_speeds,
+                    sc,
+                    delay_s,
+                );
+                let r = crate::math::sqrt(sc.stated_relative_sigma().powi(2) + tags * tags);
+                self.rotor_fallback_sigma = r;
                 let old = self.config.rotor_scale_sigma.unwrap_or(0.0);
                 self.config.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
                 // Now in the common scale's: not twice in the checks' reference σ.

@@ -24,7 +24,8 @@ pub(crate) struct SharedFactor {
     pub(crate) prior_weight: f64,
     /// The rotor parameters' shares of the momentum's own scale (their `γ_v`).
     pub(super) gamma: std::vec::Vec<f64>,
-    /// The rotor parameters' jackknife σ (whitened), over the same groups as `j`'s.
+    /// The rotor parameters' jackknife σ (whitened), over the same groups as `j`'s, then
+    /// that of the overall scale they imply.
     pub(super) rotor_jackknife: Option<std::vec::Vec<f64>>,
 }
 
