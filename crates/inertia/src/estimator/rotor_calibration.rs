@@ -18,8 +18,8 @@
 //! of the momentum (read at the run's wheel-speed time tag). A rotor whose telemetry
 //! lags that time tag by `δ_i` (its speed read at `t` is the one of `t − δ_i`) has the
 //! momentum `ρ_i(t + δ_i) ≈ ρ_i(t) + δ_i ρ̇_i(t)`: its source is `δ_i = z σ_δ,i` with
-//! `δρ = ρ_i(t + σ_δ,i) − ρ_i(t)` of the interpolated speeds
-//! (`super::wheel_delay::shift_rho`). The rows of [`super::momentum_rows`] are linear in
+//! `δρ = σ_δ,i ρ̇_i`, the slope of the interpolated speeds
+//! (`super::wheel_delay::shift_rho`) at the rotor's time tag. The rows of [`super::momentum_rows`] are linear in
 //! `ρ` (`ρ` enters their right-hand side `b`), so the rows of the true momentum are
 //!
 //! ```text

@@ -25,8 +25,8 @@
 //! length, inertial torque, body torque held or estimated:
 //! `PipelineConfig::pinned_to`), so that the move is the answer's sensitivity and not a
 //! switch of model (without it, a streaming and a batch run of the same data gave moves
-//! 5× apart). It is a secant over one σ, so it includes what that model does (its
-//! constraints, its chains' momenta). The consider term per element is
+//! 5× apart). It is a secant over one σ (a time tag's: the slope of its speeds times σ),
+//! so it includes what that model does (its constraints, its chains' momenta). The consider term per element is
 //!
 //! ```text
 //! c_k = √(Σ_v m_v,k²)
@@ -149,6 +149,15 @@ pub(crate) struct Source {
     pub(crate) unit: &'static str,
 }
 
+/// The half-step of the central difference that gives a time tag's column, relative to
+/// its σ.
+const TIME_TAG_STEP: f64 = 0.01;
+
+/// The smallest half-step of that difference per second of time stamp: 1e4 times the
+/// precision of a time stamp (`f64::EPSILON` per second), so that the difference keeps
+/// four digits.
+const TIME_RESOLUTION: f64 = 1e4 * f64::EPSILON;
+
 /// What one error source's 1σ changes.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Change {
@@ -156,9 +165,8 @@ pub(crate) enum Change {
     /// a_i` for its spin inertia, `σ_θ e_j` for a tilt; zero where the source leaves it).
     Directions(Vec<Vector3<f64>>),
     /// Rotor `rotor`'s telemetry lagging by `sigma_s` more (its speed read at `t` is the
-    /// one of `t − σ`): its momentum `ρ_i(t + σ) − ρ_i(t)` of the interpolated speeds
-    /// ([`super::wheel_delay::shift_rho`]) at the rotor's time tag, `σ ρ̇_i` to first
-    /// order.
+    /// one of `t − σ`): to first order its momentum `σ ρ̇_i(t)`, `ρ̇_i` the slope of the
+    /// interpolated speeds ([`super::wheel_delay::shift_rho`]) at the rotor's time tag.
     TimeTag {
         /// The rotor, in the file's order.
         rotor: usize,
@@ -208,7 +216,7 @@ pub(crate) fn momentum(
 
 /// The change of each sample's rotor momentum that a source's `change` makes, each
 /// rotor read at the run's time tag `delay_s` plus its own `tags_s[i]` (none: 0), as the
-/// sum was: `Σ_i J_i u_i ω̃_i d_i` for directions, `ρ_i(t + σ) − ρ_i(t)` for a time tag.
+/// sum was: `Σ_i J_i u_i ω̃_i d_i` for directions, `σ ρ̇_i(t)` for a time tag.
 pub(crate) fn source_momentum(
     samples: &[Sample],
     speeds: &[f64],
@@ -237,13 +245,18 @@ pub(crate) fn source_momentum(
             let Some(r) = spacecraft.rotors.get(i) else {
                 return out;
             };
-            // The secant over σ: exact where the speeds are held between updates (a
-            // staircase, whose slope is a train of spikes), and the second pass
-            // re-linearises about the estimate.
+            // The slope at the rotor's time tag times σ (a central difference over a
+            // hundredth of σ, or more where the time stamps' precision needs it: a time
+            // near 1.7e9 s, Unix time, resolves 0.4 µs). A secant over σ itself left the
+            // consider term's changed run without an answer on a Basilisk record
+            // (`tests/test_basilisk_outside.py`), and it is a poorer slope for the second
+            // pass to converge on.
+            let t_max = samples.iter().map(|s| s.t_s.abs()).fold(0.0, f64::max);
+            let eps = (sigma_s * TIME_TAG_STEP).max(TIME_RESOLUTION * (1.0 + t_max));
             let at = |s: f64| rotor_momentum(samples, speeds, m, i, r.momentum_per_unit(), s);
-            let (late, now) = (at(shift(i) + sigma_s), at(shift(i)));
-            for ((o, a), b) in out.iter_mut().zip(&late).zip(&now) {
-                *o = a.rho_nms - b.rho_nms;
+            let (late, early) = (at(shift(i) + eps), at(shift(i) - eps));
+            for ((o, a), b) in out.iter_mut().zip(&late).zip(&early) {
+                *o = (a.rho_nms - b.rho_nms) * (sigma_s / (2.0 * eps));
             }
         }
     }
@@ -378,9 +391,10 @@ mod tests {
     }
 
     /// Problem: one rotor on x whose speed ramps, `ω = 2 t` rad/s at `t = 1 … N` s, its
-    /// time tag ± 0.1 s. Reference: the ramp read 0.1 s later moves every momentum but the
-    /// last (held beyond the record) by `J · 2 · 0.1` against a momentum `J · 2 t`, so the
-    /// relative σ is `√(N − 1) · 0.1 / √(Σ t²)`; without a time-tag σ, 0.
+    /// time tag ± 0.1 s. Reference: the ramp's slope times 0.1 s moves every momentum by
+    /// `J · 2 · 0.1` against a momentum `J · 2 t`, but the first and the last by half
+    /// that (held beyond the record), so the relative σ is `√(4(N − 2) + 2) · 0.1 /
+    /// (2 √(Σ t²))`, on Unix time stamps too; without a time-tag σ, 0.
     #[test]
     fn the_time_tags_relative_sigma_is_their_share_of_the_momentum() {
         use crate::spacecraft::{Rotor, SpeedUnit};
@@ -413,10 +427,26 @@ mod tests {
             .collect();
         let speeds: Vec<f64> = samples.iter().map(|s| 2.0 * s.t_s).collect();
         let t2: f64 = samples.iter().map(|s| s.t_s * s.t_s).sum();
-        let expected = ((n - 1) as f64).sqrt() * 0.1 / t2.sqrt();
+        let expected = (4.0 * (n - 2) as f64 + 2.0).sqrt() * 0.1 / (2.0 * t2.sqrt());
         let got = time_tag_relative_sigma(&samples, &speeds, &sc, 0.0);
         assert!(
-            (got - expected).abs() < 1e-12 * expected,
+            (got - expected).abs() < 1e-9 * expected,
+            "{got} vs {expected}"
+        );
+        // The same ramp on Unix time stamps (1.7e9 s, resolved to 0.24 µs): the difference
+        // keeps its step above their precision, and a σ of 10 µs keeps its share.
+        let epoch: Vec<Sample> = samples
+            .iter()
+            .map(|s| Sample {
+                t_s: s.t_s + 1.7e9,
+                ..*s
+            })
+            .collect();
+        sc.rotors[0].time_tag_sigma_s = 1e-5;
+        let got = time_tag_relative_sigma(&epoch, &speeds, &sc, 0.0);
+        let expected = expected * 1e-4;
+        assert!(
+            (got - expected).abs() < 1e-3 * expected,
             "{got} vs {expected}"
         );
         sc.rotors[0].time_tag_sigma_s = 0.0;
