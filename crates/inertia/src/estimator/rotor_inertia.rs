@@ -202,16 +202,20 @@ pub(crate) fn momentum(
     delay_s: f64,
     tags_s: &[f64],
 ) -> Vec<Vector3<f64>> {
-    let m = spacecraft.rotors.len();
-    let mut out = vec![Vector3::zeros(); samples.len()];
-    for (i, r) in spacecraft.rotors.iter().enumerate() {
-        let shift = delay_s + tags_s.get(i).copied().unwrap_or(0.0);
-        let part = rotor_momentum(samples, speeds, m, i, r.momentum_per_unit(), shift);
-        for (o, p) in out.iter_mut().zip(&part) {
-            *o += p.rho_nms;
-        }
-    }
-    out
+    // Each rotor's whole momentum: the change its own axis makes, per unit of it.
+    let axes = spacecraft
+        .rotors
+        .iter()
+        .map(|r| Vector3::from(r.axis))
+        .collect();
+    source_momentum(
+        samples,
+        speeds,
+        spacecraft,
+        &Change::Directions(axes),
+        delay_s,
+        tags_s,
+    )
 }
 
 /// The change of each sample's rotor momentum that a source's `change` makes, each

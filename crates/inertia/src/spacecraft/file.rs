@@ -194,29 +194,37 @@ impl Spacecraft {
                     ),
                 ));
             }
-            let tilt = r.spin_axis_sigma_deg.as_ref().map_or(0.0, |s| *s.get_ref());
-            if !(tilt.is_finite() && (0.0..=10.0).contains(&tilt)) {
-                return Err(err(
-                    r.spin_axis_sigma_deg.as_ref().map(toml::Spanned::span),
-                    key("spin_axis_sigma_deg"),
-                    format!(
-                        "{} must be at least 0 and at most 10 deg (a small tilt)",
-                        crate::text::Num(tilt)
-                    ),
-                ));
-            }
-            let time_tag = r.time_tag_sigma_s.as_ref().map_or(0.0, |s| *s.get_ref());
-            if !(time_tag.is_finite() && (0.0..=MAX_TIME_TAG_SIGMA_S).contains(&time_tag)) {
-                return Err(err(
-                    r.time_tag_sigma_s.as_ref().map(toml::Spanned::span),
-                    key("time_tag_sigma_s"),
-                    format!(
-                        "{} must be at least 0 and at most {} s (a small offset)",
-                        crate::text::Num(time_tag),
-                        crate::text::Num(MAX_TIME_TAG_SIGMA_S)
-                    ),
-                ));
-            }
+            // A σ from 0 to `max` (default 0), in `unit`, for `what`.
+            let small =
+                |v: &Option<toml::Spanned<f64>>, k: &str, max: f64, unit: &str, what: &str| {
+                    let x = v.as_ref().map_or(0.0, |s| *s.get_ref());
+                    if x.is_finite() && (0.0..=max).contains(&x) {
+                        return Ok(x);
+                    }
+                    Err(err(
+                        v.as_ref().map(toml::Spanned::span),
+                        key(k),
+                        format!(
+                            "{} must be at least 0 and at most {} {unit} ({what})",
+                            crate::text::Num(x),
+                            crate::text::Num(max)
+                        ),
+                    ))
+                };
+            let tilt = small(
+                &r.spin_axis_sigma_deg,
+                "spin_axis_sigma_deg",
+                10.0,
+                "deg",
+                "a small tilt",
+            )?;
+            let time_tag = small(
+                &r.time_tag_sigma_s,
+                "time_tag_sigma_s",
+                MAX_TIME_TAG_SIGMA_S,
+                "s",
+                "a small offset",
+            )?;
             let speed_column = r.speed_column.get_ref().trim().to_string();
             if speed_column.is_empty() {
                 return Err(err(
