@@ -14,8 +14,8 @@
 //! **Errors.** The true wheels differ from the spacecraft file's by draws of its σ: each
 //! axis tilted by two angles of σ 0.5°, and/or each spin inertia off by an independent
 //! relative error of σ 2 %, or each wheel's speed read at its own instant, skewed by a
-//! draw of σ 50 ms (within the 0.1 s telemetry period; `sim::rotors::speeds_each`); the
-//! file states those σ.
+//! draw of σ 50 ms (within the 0.1 s telemetry period; `sim::rotors::speeds_each`), or
+//! both tilts and skews; the file states those σ.
 //!
 //! **Columns.** The median significance of the record's total angular momentum (its
 //! norm over its scatter along the record, `pipeline::MIN_MOMENTUM_SIGNIFICANCE`); median
@@ -23,8 +23,8 @@
 //! (effect-free); the file's wheels taken as exact (uncalibrated); the calibrated batch
 //! run; then the calibrated median over the effect-free one; "3σ cov.": the calibrated
 //! runs with every element within ±3σ; "determined beyond 3σ"; "calibrated": the runs
-//! whose tilts were estimated (the others had too little total momentum and kept the
-//! consider term); the median count of combinations the data fix, of the sources. On
+//! with a calibration (the others had too little total momentum and kept the consider
+//! term; with tilts and time tags, the time tags alone are calibrated then); the median count of combinations the data fix, of the sources. On
 //! stderr, for the time tags: how many were found within 3σ of the drawn skew.
 
 use inertia::estimator::observability::Observability;
@@ -150,6 +150,7 @@ fn main() {
             ("spin inertia 2 %, independent", 0.0, 0.02, 0.0),
             ("both", 0.5, 0.02, 0.0),
             ("time tag 50 ms per wheel", 0.0, 0.0, 0.05),
+            ("axis tilt 0.5° and time tag 50 ms", 0.5, 0.0, 0.05),
         ] {
             let rows: Vec<_> = (1..=seeds)
                 .into_par_iter()
@@ -191,11 +192,14 @@ fn main() {
                         .as_ref()
                         .filter(|_| tag > 0.0)
                         .map(|f| {
+                            // The time tags: the parameters in s, one per wheel in order.
                             f.value
                                 .iter()
                                 .zip(&f.sigma)
+                                .zip(&f.unit)
+                                .filter(|(_, u)| **u == "s")
                                 .zip(&skews)
-                                .map(|((v, s), t)| (v + t).abs() / s)
+                                .map(|(((v, s), _), t)| (v + t).abs() / s)
                                 .collect()
                         })
                         .unwrap_or_default();

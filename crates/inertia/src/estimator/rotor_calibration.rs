@@ -80,7 +80,11 @@
 //! consider term. Time tags alone are estimated whatever the momentum: their columns,
 //! `δ_i ρ̇_i`, are no calibration `M ρ` of the rotor momentum for J to take up (on the
 //! slew without a momentum bias, the calibrated error was that of the record with every
-//! wheel on time, `tests/integration/rotor_time_tags.rs`).
+//! wheel on time, `tests/integration/rotor_time_tags.rs`); where the file also states
+//! tilts or spin inertias and the record has no total momentum (or the calibration of
+//! all gives no fit), the run calibrates the time tags alone, keeps the rest as a
+//! consider term and widens each time tag's σ by the rest's share
+//! (`pipeline::run::rotors::batch_with_tags`).
 //!
 //! **σ.** The posterior covariance takes the rows' errors as independent; along a chain
 //! they are not (`super::jackknife`): on 120 s slews it alone would leave the time tags
@@ -191,7 +195,14 @@ pub enum NotMade {
 
 impl core::fmt::Display for NotMade {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("the rotors were not calibrated: ")?;
+        self.write(f, "the rotors were not calibrated")
+    }
+}
+
+impl NotMade {
+    /// The message: `what` was not calibrated, why, and what σ takes its place.
+    pub(crate) fn write(&self, f: &mut core::fmt::Formatter<'_>, what: &str) -> core::fmt::Result {
+        write!(f, "{what}: ")?;
         match self {
             NotMade::NoMomentum {
                 ratio,

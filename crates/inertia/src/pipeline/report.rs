@@ -384,7 +384,10 @@ impl Report {
             w.push(Warning::RotorInertiaNotComputed(e, r));
         }
         if let Some(why) = self.calibration_not_made {
-            w.push(Warning::RotorCalibrationNotMade(why));
+            w.push(Warning::RotorCalibrationNotMade(
+                why,
+                self.rotor_calibration.is_some(),
+            ));
         }
         w
     }

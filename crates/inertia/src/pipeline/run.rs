@@ -131,6 +131,9 @@ pub struct Run {
     /// A calibration asked for and not made, and why: the rotors' σ is then their
     /// consider term.
     calibration_not_made: Option<crate::estimator::rotor_calibration::NotMade>,
+    /// The rotors' time tags to calibrate alone, and their speeds, where the rest could
+    /// not be (`rotors::tags_alone`).
+    tags_alone: Option<(Spacecraft, Vec<f64>)>,
     /// Several records ([`Self::next_record`]).
     records: records::Records,
     /// Whether any sample carried a known torque (for the torque scale's term).
@@ -197,6 +200,7 @@ impl Run {
             rotor_fallback_sigma: 0.0,
             calibration: None,
             calibration_not_made: None,
+            tags_alone: None,
             records: records::Records::default(),
             known_torque: false,
             outside_scale_move: None,
@@ -554,15 +558,24 @@ impl Run {
                                 Ok(*o)
                             }
                             Ok(rotors::Calibrated::NotMade(why)) => {
-                                // The rotors' consider term instead, as without the option.
+                                // The rotors' consider term instead, as without the option
+                                // (but for time tags that can be calibrated alone).
                                 self.calibration_not_made = Some(why);
                                 self.config.calibrate_rotors = false;
+                                self.tags_alone = rotors::tags_alone(why, sc, &self.rotor_speeds);
                                 return self.finish(on_estimate);
                             }
                             Err(e) => Err(e),
                         }
                     }
-                    None => super::batch_of_records(samples, &config, &self.records.starts),
+                    None => rotors::batch_with_tags(
+                        samples,
+                        &config,
+                        self.tags_alone.take(),
+                        delay_s,
+                        &self.records.starts,
+                        &mut self.calibration,
+                    ),
                 }
                 .map_err(|e| {
                     let sample = match &e {

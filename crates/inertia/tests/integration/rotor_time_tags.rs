@@ -204,28 +204,81 @@ fn each_wheels_time_tag_sigma_widens_sigma() {
 }
 
 /// Problem: the skewed wheels on the slew with no total momentum, calibration asked for,
-/// and the file also states a tilt σ. The tilts need a total momentum: the run makes no
-/// calibration, says why, and leaves the rotors to the consider term: the truth within 3σ.
+/// and the file also states a tilt of σ 0.5° for every axis (the true axes untilted), 6
+/// seeds. The tilts need a total momentum; the time tags do not. Reference: the simulated
+/// J and skews; the record with every wheel on time (effect-free); the same file without
+/// a calibration (every error a consider term). The run says why the tilts were not
+/// calibrated, calibrates the time tags alone (within 3σ of the draws, their σ wider than
+/// with the time tags alone in the file) and keeps the tilts as a consider term: every
+/// answer within 3σ, the median error within 2× the
+/// effect-free one and under a hundredth of the all-consider one (measured: 1.3e-6
+/// against 1.6e-6 effect-free and 2.0e-3 with every error a consider term).
 #[test]
-fn with_a_tilt_and_no_total_momentum_the_time_tags_are_a_consider_term() {
-    let (samples, speeds, truth) = slew(4, 0.0, &drawn_tags(4));
-    let mut sc = stated(TAG_SIGMA_S);
-    sc.rotors[0].spin_axis_sigma_deg = 0.01;
-    let (e, r) = run(&samples, &speeds, sc, true);
+fn with_a_tilt_and_no_total_momentum_the_time_tags_alone_are_calibrated() {
+    let (mut free, mut mixed, mut considered, mut z) = (vec![], vec![], vec![], vec![]);
+    for seed in 1..=6 {
+        let tags = drawn_tags(seed);
+        let (samples, speeds, truth) = slew(seed, 0.0, &tags);
+        let (free_samples, free_speeds, _) = slew(seed, 0.0, &[0.0; 4]);
+        let err = |e: &Estimate| relative_frobenius_error(&e.inertia().expect("J"), &truth);
+        let mut sc = stated(TAG_SIGMA_S);
+        for r in &mut sc.rotors {
+            r.spin_axis_sigma_deg = 0.5;
+        }
+        let (e, r) = run(&samples, &speeds, sc.clone(), true);
+        assert!(
+            matches!(
+                r.rotor_calibration_not_made(),
+                Some(NotMade::NoMomentum { .. })
+            ),
+            "{:?}",
+            r.rotor_calibration_not_made()
+        );
+        z.extend(tag_z(&r, &tags, seed));
+        // Each time tag's σ also carries the tilts', which are not estimated: wider than
+        // with the file's time tags alone.
+        let alone = run(&samples, &speeds, stated(TAG_SIGMA_S), true).1;
+        let (wide, narrow) = (
+            &r.rotor_calibration().expect("calibrated").sigma,
+            &alone.rotor_calibration().expect("calibrated").sigma,
+        );
+        assert!(
+            wide.iter().zip(narrow).all(|(w, n)| w > n),
+            "seed {seed}: {wide:?} against {narrow:?}"
+        );
+        let c = r
+            .rotor_inertia()
+            .and_then(|c| c.as_ref().ok())
+            .expect("the tilts' consider term");
+        assert_eq!(c.sources.len(), 8, "{:?}", c.sources);
+        assert!(c.sources.iter().all(|s| s.contains("axis tilt")));
+        let report = r.report("slew.csv", &Default::default()).expect("report");
+        let w = report
+            .warnings
+            .iter()
+            .find(|w| w.kind == "rotor_calibration_not_made")
+            .expect("the warning");
+        assert!(
+            w.message
+                .contains("spin inertias and axes were not calibrated (their time tags"),
+            "{}",
+            w.message
+        );
+        assert_eq!(
+            e.within_3sigma(&truth),
+            Some(true),
+            "seed {seed}: {}",
+            worst_z(&e, &truth)
+        );
+        mixed.push(err(&e));
+        considered.push(err(&run(&samples, &speeds, sc, false).0));
+        free.push(err(&run(&free_samples, &free_speeds, stated(0.0), false).0));
+    }
+    assert_tags_covered(&z);
+    let (f, m, c) = (median(free), median(mixed), median(considered));
     assert!(
-        matches!(
-            r.rotor_calibration_not_made(),
-            Some(NotMade::NoMomentum { .. })
-        ),
-        "{:?}",
-        r.rotor_calibration_not_made()
-    );
-    assert!(r.rotor_inertia().is_some_and(|c| c.is_ok()));
-    assert_eq!(
-        e.within_3sigma(&truth),
-        Some(true),
-        "{}",
-        worst_z(&e, &truth)
+        m <= 2.0 * f && m <= 0.01 * c,
+        "tags calibrated {m:e}, effect-free {f:e}, all considered {c:e}"
     );
 }
 

@@ -31,8 +31,9 @@ pub(crate) enum Warning {
     /// The rotors' consider term could not be computed: σ was widened as if every rotor
     /// shared this relative σ (the file's, root sum square).
     RotorInertiaNotComputed(crate::estimator::rotor_inertia::RotorInertiaError, f64),
-    /// A rotor calibration asked for and not made, and why.
-    RotorCalibrationNotMade(crate::estimator::rotor_calibration::NotMade),
+    /// A rotor calibration asked for and not made, and why; `true` where the rotors' time
+    /// tags were calibrated alone (they need no total momentum).
+    RotorCalibrationNotMade(crate::estimator::rotor_calibration::NotMade, bool),
     /// A gyro axis reads its range limit while the attitude turns faster
     /// ([`crate::telemetry::gyro_range`]).
     GyroAtRangeLimit(crate::telemetry::gyro_range::ClippedAxis),
@@ -128,7 +129,12 @@ impl fmt::Display for Warning {
                 "{e}; σ is widened as if every rotor shared the file's relative σ (root sum square), {}",
                 Num(*r)
             ),
-            Warning::RotorCalibrationNotMade(why) => write!(f, "{why}"),
+            Warning::RotorCalibrationNotMade(why, false) => write!(f, "{why}"),
+            Warning::RotorCalibrationNotMade(why, true) => why.write(
+                f,
+                "the rotors' spin inertias and axes were not calibrated (their time tags, which \
+                 need no total momentum, were)",
+            ),
             Warning::GyroAtRangeLimit(c) => write!(
                 f,
                 "the gyro's {} axis reads its largest rate, {} rad/s, in {} samples while the \

@@ -135,6 +135,106 @@ pub(super) fn calibrated_batch(
     Ok(Calibrated::Done(std::boxed::Box::new(second), report))
 }
 
+/// The spacecraft file and the rotors' speeds, where a calibration of every error was not
+/// made (for want of a total momentum, or of a fit) and the file states both time tags
+/// and other errors: the time tags need no total momentum (their columns `δ_i ρ̇_i` are
+/// no calibration of the rotor momentum that J could take up), so they are calibrated
+/// alone ([`batch_with_tags`]) and the rest stays a consider term
+/// ([`Run::apply_rotor_consider`]).
+pub(super) fn tags_alone(
+    why: NotMade,
+    sc: &Spacecraft,
+    speeds: &[f64],
+) -> Option<(Spacecraft, Vec<f64>)> {
+    let tagged = sc.rotors.iter().any(|r| r.time_tag_sigma_s > 0.0);
+    let retry = matches!(why, NotMade::NoMomentum { .. } | NotMade::NoFit);
+    (retry && tagged && without_time_tags(sc).has_inertia_sigma())
+        .then(|| (sc.clone(), speeds.to_vec()))
+}
+
+/// `sc` without its rotors' time-tag σ.
+fn without_time_tags(sc: &Spacecraft) -> Spacecraft {
+    let mut rest = sc.clone();
+    for r in &mut rest.rotors {
+        r.time_tag_sigma_s = 0.0;
+    }
+    rest
+}
+
+/// `sc` with its rotors' time-tag σ alone.
+fn time_tags_only(sc: &Spacecraft) -> Spacecraft {
+    let mut tags = sc.clone();
+    for r in &mut tags.rotors {
+        r.spin_inertia_sigma_kg_m2 = 0.0;
+        r.spin_axis_sigma_deg = 0.0;
+    }
+    tags
+}
+
+/// The batch estimate of the records of `samples`, with the time tags of `tags` (the
+/// spacecraft file and its speeds; [`tags_alone`]) calibrated where given; their
+/// calibration goes to `calibration`. Each time tag's σ also carries the file's other
+/// errors, which are not estimated: in quadrature, its move when the calibration is made
+/// again with the rotors moved by each other error's 1σ (the row model pinned to the
+/// answer's). Where one of those calibrations gives no answer, each time tag's σ is at
+/// least the file's.
+pub(super) fn batch_with_tags(
+    samples: &[Sample],
+    config: &PipelineConfig,
+    tags: Option<(Spacecraft, Vec<f64>)>,
+    delay_s: f64,
+    starts: &[usize],
+    calibration: &mut Option<RotorCalibration>,
+) -> Result<BatchOutput, PipelineError> {
+    if let Some((file, speeds)) = tags {
+        let only = time_tags_only(&file);
+        if let Calibrated::Done(o, mut c) =
+            calibrated_batch(samples, config, &only, &speeds, delay_s)?
+        {
+            let pinned = config.pinned_to(o.diagnostics.row_model, o.diagnostics.torque_test);
+            let others = rotor_inertia::sources(&without_time_tags(&file));
+            let mut extra = vec![0.0; c.value.len()];
+            let mut computed = true;
+            for v in 0..others.len() {
+                let z: Vec<f64> = (0..others.len())
+                    .map(|k| f64::from(u8::from(k == v)))
+                    .collect();
+                let (moved_file, _) = moved(&file, &others, &z);
+                let rho = rotor_inertia::momentum(samples, &speeds, &moved_file, delay_s, &[]);
+                let changed: Vec<Sample> = samples
+                    .iter()
+                    .zip(rho)
+                    .map(|(s, r)| Sample { rho_nms: r, ..*s })
+                    .collect();
+                let again = calibrated_batch(
+                    &changed,
+                    &pinned,
+                    &time_tags_only(&moved_file),
+                    &speeds,
+                    delay_s,
+                )?;
+                match again {
+                    Calibrated::Done(_, cv) if cv.value.len() == c.value.len() => {
+                        for ((e, a), b) in extra.iter_mut().zip(&cv.value).zip(&c.value) {
+                            *e += (a - b) * (a - b);
+                        }
+                    }
+                    _ => computed = false,
+                }
+            }
+            for ((s, e), p) in c.sigma.iter_mut().zip(&extra).zip(&c.prior_sigma) {
+                *s = crate::math::sqrt(*s * *s + e);
+                if !computed {
+                    *s = s.max(*p);
+                }
+            }
+            *calibration = Some(c);
+            return Ok(*o);
+        }
+    }
+    crate::pipeline::batch_of_records(samples, config, starts)
+}
+
 /// The smallest rotation taking the unit vector `a` to the unit vector `b` (Rodrigues:
 /// `I + [v]× + [v]×² / (1 + c)`, `v = a × b`, `c = a·b`).
 fn minimal_rotation(
@@ -232,8 +332,16 @@ impl Run {
     /// common scale's term, [`super::status`]), and the reason kept
     /// ([`Self::rotor_inertia`]).
     pub(super) fn apply_rotor_consider(&mut self, samples: &[Sample]) {
-        let Some(sc) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
+        let Some(file) = self.rotors.as_ref().filter(|r| r.has_inertia_sigma()) else {
             return;
+        };
+        // Time tags calibrated alone are not considered.
+        let rest;
+        let sc = if self.tags_alone.is_some() {
+            rest = without_time_tags(file);
+            &rest
+        } else {
+            file
         };
         if self.rotor_consider.is_some() {
             return;
