@@ -11,12 +11,16 @@ impl Run {
     /// The held speeds' lag term over `samples` (`wheel_delay::held_lag_move` at their
     /// mean lag), where the speeds look held and no time tag was asked for.
     ///
-    /// With the damping estimated, the larger, element by element, of that and the
-    /// estimator's own move (its batch solve of the samples and of the speeds read
-    /// `lag_s` later, pinned to the row model the first chose, [`Self::pinned_pair`]):
-    /// the profile's plain rows have no `D`, which takes up part of the lag's signature,
+    /// With the damping estimated, the largest, element by element, of that and the
+    /// estimator's own moves: its batch solve of the samples and of the speeds read
+    /// `lag_s` later, pinned to the row model the first chose ([`Self::pinned_pair`]),
+    /// and in a streaming run its pipeline run again over both ([`Self::streamed_pair`]).
+    /// The profile's plain rows have no `D`, which takes up part of the lag's signature,
     /// and their move understated the answer's (drawn lab throws with `--damping`, seeds
-    /// 5000–5199: 20 of 35 streaming and 40 of 62 batch answers determined beyond 3σ).
+    /// 5000–5199: 20 of 35 streaming and 40 of 62 batch answers determined beyond 3σ);
+    /// a streaming answer's `D` can take up more of it than the batch solve's (seeds
+    /// 10000–10199: 6 of 23 streaming answers determined beyond 3σ with the batch
+    /// solve's move, 0 of 22 with the pipeline's own).
     pub(super) fn held_lag_term(&self, samples: &[Sample]) -> Option<[f64; 6]> {
         let every = self.held_speeds_period_samples()?;
         let lag_s = crate::telemetry::held_speeds::mean_lag_s(every, self.input_step_s());
@@ -24,17 +28,50 @@ impl Run {
         if !self.config.damping {
             return profile;
         }
-        let own = self
-            .pinned_pair(samples, |late| wheel_delay::shift_rho(late, lag_s), true)
-            .and_then(|(a, b)| {
-                let (j0, j1) = (a.estimate.j()?, b.estimate.j()?);
-                let out: [f64; 6] = core::array::from_fn(|k| (j1[k] - j0[k]).abs());
-                out.iter().all(|x| x.is_finite()).then_some(out)
-            });
-        match (profile, own) {
-            (Some(p), Some(o)) => Some(core::array::from_fn(|k| p[k].max(o[k]))),
-            (p, o) => p.or(o),
-        }
+        let moved = |j: Option<([f64; 6], [f64; 6])>| {
+            let (j0, j1) = j?;
+            let out: [f64; 6] = core::array::from_fn(|k| (j1[k] - j0[k]).abs());
+            out.iter().all(|x| x.is_finite()).then_some(out)
+        };
+        let own = moved(
+            self.pinned_pair(samples, |late| wheel_delay::shift_rho(late, lag_s), true)
+                .and_then(|(a, b)| Some((a.estimate.j()?.into(), b.estimate.j()?.into()))),
+        );
+        let streamed =
+            moved(self.streamed_pair(samples, |late| wheel_delay::shift_rho(late, lag_s)));
+        [profile, own, streamed]
+            .into_iter()
+            .flatten()
+            .reduce(|a, b| core::array::from_fn(|k| a[k].max(b[k])))
+    }
+
+    /// A streaming run's own answer over `samples` as given and as `change` leaves them:
+    /// its pipeline run again over each, pinned to the row model of its last answer.
+    /// `None` in batch, or where either run gives no J.
+    fn streamed_pair(
+        &self,
+        samples: &[Sample],
+        change: impl FnOnce(&mut [Sample]),
+    ) -> Option<([f64; 6], [f64; 6])> {
+        let Mode::Streaming(p) = &self.mode else {
+            return None;
+        };
+        let d = p.diagnostics();
+        let config = self
+            .config
+            .with_delay_applied()
+            .pinned_to(d.row_model, d.torque_test);
+        let solve = |s: &[Sample]| -> Option<[f64; 6]> {
+            let mut q = crate::pipeline::Pipeline::from_config(config).ok()?;
+            for x in s {
+                q.push_each(x, |_| {}).ok()?;
+            }
+            q.flush(|_| {}).ok()?;
+            Some(q.last()?.j()?.into())
+        };
+        let mut changed = samples.to_vec();
+        change(&mut changed);
+        Some((solve(samples)?, solve(&changed)?))
     }
 
     /// The run's batch solve of `samples` as given, and again of the samples as `change`
