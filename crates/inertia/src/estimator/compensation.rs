@@ -42,6 +42,21 @@ pub(crate) fn compensate(
     Some((r, z))
 }
 
+/// `qr` as [`super::recursive::solve_with`] solves it: compensated where a density is
+/// given and the compensation exists, else as it is. The audit's χ² of the constraints'
+/// move (`super::audit`) compares the answer with this problem's own least-squares
+/// minimiser; against the uncompensated one it would count the compensation's move,
+/// which removes the errors-in-variables shrinkage, as a conflict with the constraints.
+#[must_use]
+pub(crate) fn as_solved(qr: &RecursiveQr, gyro_noise_rad_s_rthz: Option<f64>) -> RecursiveQr {
+    match gyro_noise_rad_s_rthz {
+        Some(g) if g > 0.0 && qr.noise_s > 0.0 => {
+            compensate(qr, g).map_or(*qr, |(r, z)| RecursiveQr { r, z, ..*qr })
+        }
+        _ => *qr,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

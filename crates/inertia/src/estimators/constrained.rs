@@ -3,6 +3,7 @@
 //! shadow ([`crate::estimator::uncertainty`]) where the row model has one.
 
 use crate::estimator::audit::audit;
+use crate::estimator::compensation::as_solved;
 use crate::estimator::consistency::{self, ResidualSegments, Worst};
 use crate::estimator::excitation::diagnose;
 use crate::estimator::recursive::{RecursiveEstimator, RecursiveSettings};
@@ -72,6 +73,8 @@ pub struct Constrained<S: RowSource, B: Backend> {
     epsilon_kg_m2: f64,
     /// The rotor momentum's stated relative σ ([`PipelineConfig::stated_relative_sigma`]).
     stated_relative_sigma: f64,
+    /// The gyro's rate-noise density the solves compensate for, rad/s/√Hz.
+    gyro_noise_rad_s_rthz: Option<f64>,
 }
 
 impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
@@ -119,6 +122,7 @@ impl<S: RowSource + Default, B: Backend> Constrained<S, B> {
             observability: settings.observability,
             epsilon_kg_m2: constraints.set().epsilon_kg_m2,
             stated_relative_sigma: 0.0,
+            gyro_noise_rad_s_rthz: settings.gyro_noise_rad_s_rthz,
         })
     }
 }
@@ -183,7 +187,7 @@ impl<S: RowSource, B: Backend> Constrained<S, B> {
         }
         audit(
             &mut e,
-            self.main.solved(),
+            &as_solved(self.main.solved(), self.gyro_noise_rad_s_rthz),
             self.epsilon_kg_m2,
             self.observability.max_relative_sigma,
             self.stated_relative_sigma,
@@ -308,7 +312,7 @@ fn run_batch<S: RowSource + Default>(
     }
     audit(
         &mut estimate,
-        &solved,
+        &as_solved(&solved, c.gyro_noise_rad_s_rthz),
         c.constraints.set().epsilon_kg_m2,
         c.observability.max_relative_sigma,
         c.stated_relative_sigma(),
