@@ -220,7 +220,9 @@ impl NotMade {
                 "the record has a known torque, which fixes the momentum's scale that the \
                  calibration takes as given (not supported)",
             )?,
-            NotMade::NoFit => f.write_str("the rows gave no fit of the rotors' parameters")?,
+            NotMade::NoFit => {
+                f.write_str("the rows gave no fit of all the rotors' parameters together")?
+            }
         }
         f.write_str("; their σ from the spacecraft file is a consider term instead")
     }

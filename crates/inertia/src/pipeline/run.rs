@@ -575,6 +575,7 @@ impl Run {
                         delay_s,
                         &self.records.starts,
                         &mut self.calibration,
+                        &mut self.rotor_consider,
                     ),
                 }
                 .map_err(|e| {

@@ -132,8 +132,8 @@ impl fmt::Display for Warning {
             Warning::RotorCalibrationNotMade(why, false) => write!(f, "{why}"),
             Warning::RotorCalibrationNotMade(why, true) => why.write(
                 f,
-                "the rotors' spin inertias and axes were not calibrated (their time tags, which \
-                 need no total momentum, were)",
+                "the rotors' errors other than their time tags were not calibrated with J (the \
+                 time tags, which need no total momentum, were, alone)",
             ),
             Warning::GyroAtRangeLimit(c) => write!(
                 f,

@@ -26,11 +26,17 @@ impl Run {
         if let (Some(o), Some(m)) = (report.outside.as_mut(), self.outside_scale_move) {
             *o = o.widened(&m);
         }
+        // With the time tags calibrated alone, the consider term is the rest's.
+        let rest = self
+            .rotors
+            .as_ref()
+            .filter(|_| self.calibration.is_some() && self.calibration_not_made.is_some())
+            .map(super::rotors::without_time_tags);
         Some(
             report
                 .with_wheel_delay(self.delay.as_ref())
                 .with_rotor_inertia(
-                    self.rotors.as_ref(),
+                    rest.as_ref().or(self.rotors.as_ref()),
                     self.rotor_consider.as_ref(),
                     self.rotor_fallback_sigma,
                 )

@@ -7,7 +7,9 @@ use super::{PipelineError, Run, RunError, RunErrorKind};
 use crate::estimator::rotor_calibration::{
     self, NotMade, RotorCalibration, RotorFit, MIN_MOMENTUM_SIGNIFICANCE,
 };
-use crate::estimator::rotor_inertia::{self, Change, Source};
+use crate::estimator::rotor_inertia::{
+    self, Change, RotorInertiaConsider, RotorInertiaError, Source,
+};
 use crate::pipeline::interface::BatchInputs;
 use crate::sample::Sample;
 use crate::spacecraft::Spacecraft;
@@ -153,7 +155,7 @@ pub(super) fn tags_alone(
 }
 
 /// `sc` without its rotors' time-tag σ.
-fn without_time_tags(sc: &Spacecraft) -> Spacecraft {
+pub(super) fn without_time_tags(sc: &Spacecraft) -> Spacecraft {
     let mut rest = sc.clone();
     for r in &mut rest.rotors {
         r.time_tag_sigma_s = 0.0;
@@ -177,7 +179,9 @@ fn time_tags_only(sc: &Spacecraft) -> Spacecraft {
 /// errors, which are not estimated: in quadrature, its move when the calibration is made
 /// again with the rotors moved by each other error's 1σ (the row model pinned to the
 /// answer's). Where one of those calibrations gives no answer, each time tag's σ is at
-/// least the file's.
+/// least the file's. Where the time tags cannot be calibrated either, they join the
+/// rest's consider term `considered` ([`with_tags_considered`]). (Several records are
+/// not calibrated: `Run::next_record` refuses the calibration.)
 pub(super) fn batch_with_tags(
     samples: &[Sample],
     config: &PipelineConfig,
@@ -185,54 +189,99 @@ pub(super) fn batch_with_tags(
     delay_s: f64,
     starts: &[usize],
     calibration: &mut Option<RotorCalibration>,
+    considered: &mut Option<Result<RotorInertiaConsider, RotorInertiaError>>,
 ) -> Result<BatchOutput, PipelineError> {
-    if let Some((file, speeds)) = tags {
-        let only = time_tags_only(&file);
-        if let Calibrated::Done(o, mut c) =
-            calibrated_batch(samples, config, &only, &speeds, delay_s)?
-        {
-            let pinned = config.pinned_to(o.diagnostics.row_model, o.diagnostics.torque_test);
-            let others = rotor_inertia::sources(&without_time_tags(&file));
-            let mut extra = vec![0.0; c.value.len()];
-            let mut computed = true;
-            for v in 0..others.len() {
-                let z: Vec<f64> = (0..others.len())
-                    .map(|k| f64::from(u8::from(k == v)))
-                    .collect();
-                let (moved_file, _) = moved(&file, &others, &z);
-                let rho = rotor_inertia::momentum(samples, &speeds, &moved_file, delay_s, &[]);
-                let changed: Vec<Sample> = samples
-                    .iter()
-                    .zip(rho)
-                    .map(|(s, r)| Sample { rho_nms: r, ..*s })
-                    .collect();
-                let again = calibrated_batch(
-                    &changed,
-                    &pinned,
-                    &time_tags_only(&moved_file),
-                    &speeds,
-                    delay_s,
-                )?;
-                match again {
-                    Calibrated::Done(_, cv) if cv.value.len() == c.value.len() => {
-                        for ((e, a), b) in extra.iter_mut().zip(&cv.value).zip(&c.value) {
-                            *e += (a - b) * (a - b);
-                        }
-                    }
-                    _ => computed = false,
+    let Some((file, speeds)) = tags else {
+        return crate::pipeline::batch_of_records(samples, config, starts);
+    };
+    let only = time_tags_only(&file);
+    let Ok(Calibrated::Done(o, mut c)) = calibrated_batch(samples, config, &only, &speeds, delay_s)
+    else {
+        let config = with_tags_considered(samples, config, &only, &speeds, delay_s, considered);
+        return crate::pipeline::batch_of_records(samples, &config, starts);
+    };
+    let pinned = config.pinned_to(o.diagnostics.row_model, o.diagnostics.torque_test);
+    let others = rotor_inertia::sources(&without_time_tags(&file));
+    let mut extra = vec![0.0; c.value.len()];
+    let mut computed = true;
+    for v in 0..others.len() {
+        let z: Vec<f64> = (0..others.len())
+            .map(|k| f64::from(u8::from(k == v)))
+            .collect();
+        let (moved_file, _) = moved(&file, &others, &z);
+        let rho = rotor_inertia::momentum(samples, &speeds, &moved_file, delay_s, &[]);
+        let changed: Vec<Sample> = samples
+            .iter()
+            .zip(rho)
+            .map(|(s, r)| Sample { rho_nms: r, ..*s })
+            .collect();
+        let again = calibrated_batch(
+            &changed,
+            &pinned,
+            &time_tags_only(&moved_file),
+            &speeds,
+            delay_s,
+        );
+        match again {
+            Ok(Calibrated::Done(_, cv))
+                if cv.value.len() == c.value.len() && cv.value.iter().all(|x| x.is_finite()) =>
+            {
+                for ((e, a), b) in extra.iter_mut().zip(&cv.value).zip(&c.value) {
+                    *e += (a - b) * (a - b);
                 }
             }
-            for ((s, e), p) in c.sigma.iter_mut().zip(&extra).zip(&c.prior_sigma) {
-                *s = crate::math::sqrt(*s * *s + e);
-                if !computed {
-                    *s = s.max(*p);
-                }
-            }
-            *calibration = Some(c);
-            return Ok(*o);
+            _ => computed = false,
         }
     }
-    crate::pipeline::batch_of_records(samples, config, starts)
+    for ((s, e), p) in c.sigma.iter_mut().zip(&extra).zip(&c.prior_sigma) {
+        *s = crate::math::sqrt(*s * *s + e);
+        if !computed {
+            *s = s.max(*p);
+        }
+    }
+    *calibration = Some(c);
+    Ok(*o)
+}
+
+/// `config` with the time tags of `only` (a file with time tags alone) as a consider
+/// term beside the rest's, `considered`, where they could not be calibrated: measured as
+/// [`Run::apply_rotor_consider`] measures it and added to the rest's sources (σ of
+/// independent sources adds in quadrature); where either cannot be computed, σ widened
+/// by the time tags' share of the rotor momentum, as that fallback does.
+fn with_tags_considered(
+    samples: &[Sample],
+    config: &PipelineConfig,
+    only: &Spacecraft,
+    speeds: &[f64],
+    delay_s: f64,
+    considered: &mut Option<Result<RotorInertiaConsider, RotorInertiaError>>,
+) -> PipelineConfig {
+    let mut solved = *config;
+    let mut first = true;
+    let solve = |s: &[Sample]| -> Option<crate::tensor::InertiaVector> {
+        let o = crate::pipeline::batch_of_records(s, &solved, &[]).ok()?;
+        if core::mem::take(&mut first) {
+            solved = solved.pinned_to(o.diagnostics.row_model, o.diagnostics.torque_test);
+        }
+        o.estimate.j()
+    };
+    let mut out = *config;
+    match (
+        considered.as_mut(),
+        rotor_inertia::consider(samples, speeds, only, delay_s, solve),
+    ) {
+        (Some(Ok(rest)), Ok(tags)) => {
+            rest.sources.extend(tags.sources);
+            rest.moves_kg_m2.extend(tags.moves_kg_m2);
+            out.rotor_inertia_consider = Some(rest.consider_kg_m2());
+        }
+        _ => {
+            let r = rotor_inertia::time_tag_relative_sigma(samples, speeds, only, delay_s);
+            let old = out.rotor_scale_sigma.unwrap_or(0.0);
+            out.rotor_scale_sigma = Some(crate::math::sqrt(old * old + r * r));
+        }
+    }
+    out
 }
 
 /// The smallest rotation taking the unit vector `a` to the unit vector `b` (Rodrigues:
@@ -399,5 +448,83 @@ impl Run {
         }
         self.rotor_consider = Some(c);
         self.rotor_speeds = Vec::new();
+    }
+}
+
+#[cfg(all(test, feature = "sim"))]
+mod tests {
+    use super::*;
+    use crate::sim::rotors::{pyramid, speeds};
+    use crate::sim::scenario::{Common, Scenario};
+    use crate::spacecraft::RotorErrors;
+
+    /// Problem: the time tags could not be calibrated alone (the fallback called
+    /// directly) on a 60 s slew with four wheels whose file states tilts of σ 0.5° and
+    /// time tags of σ 50 ms; the tilts' consider term measured first. Reference: the
+    /// consider term of every source of the file at once. The time tags join the tilts'
+    /// sources, and the consider term is the whole file's (the same solves, to 1e-12).
+    #[test]
+    fn time_tags_not_calibrated_join_the_rest_of_the_consider_term() {
+        let mut file = pyramid(
+            [1.5e-3, 1.6e-3, 1.7e-3, 1.8e-3],
+            0.0,
+            RotorErrors::Independent,
+        );
+        for r in &mut file.rotors {
+            r.spin_axis_sigma_deg = 0.5;
+            r.time_tag_sigma_s = 0.05;
+        }
+        let out = Scenario::slew()
+            .simulate(&Common {
+                duration_s: Some(60.0),
+                ..Common::physical()
+            })
+            .expect("sim");
+        let w = speeds(&out.samples, &file).expect("speeds");
+        let config = crate::pipeline::PipelineSettings::default()
+            .validate()
+            .expect("settings");
+        let consider = |sc: &Spacecraft| {
+            let mut solved = config;
+            let mut first = true;
+            rotor_inertia::consider(&out.samples, &w, sc, 0.0, |s: &[Sample]| {
+                let o = crate::pipeline::batch_of_records(s, &solved, &[]).ok()?;
+                if core::mem::take(&mut first) {
+                    solved = solved.pinned_to(o.diagnostics.row_model, o.diagnostics.torque_test);
+                }
+                o.estimate.j()
+            })
+            .expect("consider")
+        };
+        let all = consider(&file);
+        let rest = consider(&without_time_tags(&file));
+        assert_eq!(rest.sources.len(), 8);
+        let mut considered = Some(Ok(rest.clone()));
+        let with_rest = PipelineConfig {
+            rotor_inertia_consider: Some(rest.consider_kg_m2()),
+            ..config
+        };
+        let out_config = with_tags_considered(
+            &out.samples,
+            &with_rest,
+            &time_tags_only(&file),
+            &w,
+            0.0,
+            &mut considered,
+        );
+        let Some(Ok(joined)) = considered else {
+            panic!("the consider term")
+        };
+        assert_eq!(joined.sources, all.sources);
+        let (got, want) = (
+            out_config.rotor_inertia_consider.expect("σ"),
+            all.consider_kg_m2(),
+        );
+        for k in 0..6 {
+            assert!(
+                (got[k] - want[k]).abs() <= 1e-12 * want[k] && got[k] > rest.consider_kg_m2()[k],
+                "{got:?} against {want:?}"
+            );
+        }
     }
 }
